@@ -1,1 +1,41 @@
-int main() { return 0; }
+// duet: follow a dancer and answer with a virtual partner. See `duet --help`.
+#include <cstdio>
+#include <map>
+
+#include "commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "duet: performance-driven dance motion control of a virtual partner (Mousas 2018).\n"
+      "Motion data: CMU Graphics Lab Motion Capture Database (mocap.cs.cmu.edu)."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "duet 0.1.0");
+
+  std::map<CLI::App*, duet::app::Command> commands;
+  auto add = [&](const char* name, const char* description, auto register_fn) {
+    CLI::App* sub = app.add_subcommand(name, description);
+    commands[sub] = register_fn(*sub);
+  };
+  add("inspect", "Describe a motion file: joints, frames, rate, channels, convention, extent",
+      duet::app::register_inspect);
+  add("convert", "Convert ASF+AMC or BVH to BVH (rescaled, resampled)", duet::app::register_convert);
+  add("follow", "Follow a dancer through a library of duets and answer with the partner",
+      duet::app::register_follow);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return duet::app::kExitUsage;
+  }
+  for (auto& [sub, run] : commands) {
+    if (sub->parsed()) return run();
+  }
+  return duet::app::kExitUsage;
+}

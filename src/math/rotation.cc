@@ -42,10 +42,12 @@ Vec3 euler_from_quat(const Quat& q, const EulerOrder& order) {
   // Sign of the permutation (i, j, k): +1 for cyclic XYZ, YZX, ZXY.
   const double parity = ((j - i + 3) % 3 == 1) ? 1.0 : -1.0;
   const double sin_b = std::clamp(parity * m(i, k), -1.0, 1.0);
-  const double b = std::asin(sin_b);
+  // atan2 rather than asin: asin loses half the digits near +/-90 degrees.
+  const double cos_b = std::hypot(m(i, i), m(i, j));
+  const double b = std::atan2(sin_b, cos_b);
   double a = 0.0;
   double c = 0.0;
-  if (std::abs(sin_b) < 1.0 - 1e-12) {
+  if (cos_b > 1e-12) {
     a = std::atan2(-parity * m(j, k), m(k, k));
     c = std::atan2(-parity * m(i, j), m(i, i));
   } else {

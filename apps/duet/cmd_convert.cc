@@ -1,0 +1,71 @@
+// duet convert INPUT... -o OUT.bvh [--fps F] [--scale S]
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "duet/io/bvh.h"
+#include "duet/io/motion_file.h"
+#include "duet/motion/resample.h"
+#include "motion_options.h"
+
+namespace duet::app {
+
+namespace {
+
+struct ConvertArgs {
+  std::vector<std::string> inputs;
+  std::string output;
+  MotionFileOptions input;
+  std::optional<double> output_fps;
+  double output_units_per_metre = 1.0;
+};
+
+int run_convert(const ConvertArgs& args) {
+  MotionLoadOptions load_options;
+  if (!make_load_options(args.input, load_options)) return kExitFailure;
+  Result<LoadedMotion> loaded = load_motion(args.inputs, load_options);
+  if (!loaded) {
+    fmt::print(stderr, "duet convert: {}\n", loaded.error().message);
+    return kExitFailure;
+  }
+  Clip clip = std::move(loaded.value().clip);
+  if (args.output_fps && *args.output_fps != clip.frame_rate()) {
+    clip = resample(clip, *args.output_fps);
+  }
+  BvhWriteOptions write_options;
+  write_options.units_per_metre = args.output_units_per_metre;
+  Status written = write_bvh(clip, args.output, write_options);
+  if (!written) {
+    fmt::print(stderr, "duet convert: {}\n", written.error().message);
+    return kExitFailure;
+  }
+  fmt::print(stderr, "wrote {}: {} frames at {:.6g} fps, {} joints\n", args.output,
+             clip.frame_count(), clip.frame_rate(), clip.skeleton().animated_joint_count());
+  return kExitOk;
+}
+
+}  // namespace
+
+Command register_convert(CLI::App& app) {
+  auto args = std::make_shared<ConvertArgs>();
+  app.add_option("inputs", args->inputs, "A .bvh file, or an .asf and an .amc file")
+      ->required()
+      ->expected(1, 2)
+      ->check(CLI::ExistingFile);
+  app.add_option("-o,--output", args->output, "Output BVH file (written atomically)")->required();
+  app.add_option("--input-fps", args->input.fps, "Frame rate of the input, overriding its header")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--scale", args->input.scale,
+                 "Metres per input file unit (default: known per skeleton convention)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--map", args->input.map_path, "Skeleton map JSON for the input")
+      ->check(CLI::ExistingFile);
+  app.add_option("--fps", args->output_fps,
+                 "Resample to this frame rate (quaternion interpolation)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--units-per-metre", args->output_units_per_metre,
+                 "Length units of the output per metre (default 1: metres)")
+      ->check(CLI::PositiveNumber);
+  return [args] { return run_convert(*args); };
+}
+
+}  // namespace duet::app

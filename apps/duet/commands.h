@@ -1,0 +1,20 @@
+// Each subcommand registers its options on the CLI app and returns the function that runs it.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace duet::app {
+
+// Exit codes shared by every subcommand.
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;  // bad input file, failed write, ...
+constexpr int kExitUsage = 2;    // bad command line
+
+using Command = std::function<int()>;
+
+Command register_inspect(CLI::App& app);
+Command register_convert(CLI::App& app);
+Command register_follow(CLI::App& app);
+
+}  // namespace duet::app

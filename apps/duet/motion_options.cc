@@ -1,0 +1,38 @@
+#include "motion_options.h"
+
+#include <fmt/format.h>
+
+namespace duet::app {
+
+void add_motion_file_options(CLI::App& app, MotionFileOptions& options, const std::string& prefix) {
+  app.add_option("--" + prefix + "fps", options.fps,
+                 "Frame rate of the file(s), overriding the header (the CMU salsa BVH headers "
+                 "say 120; the takes are 60 Hz)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--" + prefix + "scale", options.scale,
+                 "Metres per file unit (default: known per skeleton convention: salsa DAZ BVH "
+                 "1/0.768, CMU 0.056444, otherwise 1)")
+      ->check(CLI::PositiveNumber);
+  if (prefix.empty()) {
+    app.add_option("--map", options.map_path,
+                   "Skeleton map JSON naming the joint of each role (see docs/skeleton-maps.md)")
+        ->check(CLI::ExistingFile);
+  }
+}
+
+bool make_load_options(const MotionFileOptions& options, MotionLoadOptions& load_options) {
+  load_options.frame_rate = options.fps;
+  load_options.metres_per_unit = options.scale;
+  if (!options.map_path.empty()) {
+    SkeletonMap map;
+    std::string error;
+    if (!load_skeleton_map(options.map_path, map, error)) {
+      fmt::print(stderr, "duet: {}\n", error);
+      return false;
+    }
+    load_options.map = map;
+  }
+  return true;
+}
+
+}  // namespace duet::app

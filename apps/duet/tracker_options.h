@@ -1,0 +1,24 @@
+// Command-line choice of the follower: the jump HMM (default) or a baseline, and its parameters.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "duet/base/result.h"
+#include "duet/follow/template_model.h"
+#include "duet/follow/tracker.h"
+
+namespace duet::app {
+
+struct TrackerArgs {
+  std::string kind = "hmm";        // hmm | left-to-right
+  std::string preset = "default";  // default | paper
+  std::optional<float> sigma;      // emission sigma override
+};
+
+void add_tracker_options(CLI::App& app, TrackerArgs& args);
+Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args, const TemplateModel& model);
+
+}  // namespace duet::app

@@ -1,0 +1,88 @@
+// Feature extraction, one frame at a time (the live path) or a whole clip (offline); both give
+// the same numbers because the clip version runs the per-frame one.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "duet/base/result.h"
+#include "duet/features/feature_spec.h"
+#include "duet/motion/clip.h"
+
+namespace duet {
+
+// One row per frame, row-major float (the follower streams through rows).
+using FeatureMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+class FeatureExtractor {
+ public:
+  // Checks that every role the spec needs exists in the skeleton.
+  static Result<FeatureExtractor> create(std::shared_ptr<const Skeleton> skeleton,
+                                         const JointRoles& roles, const FeatureSpec& spec);
+
+  // What the extractor remembers between frames: recent root and effector positions for the
+  // velocity window, and forward-kinematics scratch. Sized once; reset() at a new performance.
+  class Context {
+   public:
+    void reset() noexcept;
+
+   private:
+    friend class FeatureExtractor;
+    struct Sample {
+      double time_s = 0.0;
+      Vec3 root = Vec3::Zero();
+      double yaw = 0.0;
+      std::array<Vec3, 4> effectors;  // left hand, right hand, left foot, right foot
+    };
+    static constexpr int kHistory = 64;  // enough for a 0.1 s window at 600 Hz
+    std::array<Sample, kHistory> history_{};
+    int newest_ = -1;
+    int count_ = 0;
+    std::vector<Vec3> positions_ws_;
+    std::vector<Quat> rotations_ws_;
+  };
+
+  Context make_context() const;
+  int dimension() const { return spec_.dimension(); }
+  const FeatureSpec& spec() const { return spec_; }
+
+  // Raw (not yet standardised) features of one frame at time `time_s` (seconds, increasing).
+  // A pose with NaN/inf gives NaN features and is not remembered, so it cannot poison the
+  // velocities of later frames. Allocates nothing.
+  void extract(Context& context, std::span<const Vec3> translations_ls,
+               std::span<const Quat> rotations_ls, double time_s,
+               std::span<float> out) const noexcept;
+
+  // Raw features of every frame of a clip (a fresh context, frame times from the clip's rate).
+  FeatureMatrix extract_clip(const Clip& clip) const;
+
+ private:
+  FeatureExtractor() = default;
+  FeatureSpec spec_;
+  std::vector<int> posture_joints_;
+  int root_joint_ = 0;
+  std::array<int, 4> effector_joints_{};
+  std::shared_ptr<const Skeleton> skeleton_;
+};
+
+// Standardisation with the template's statistics (method.md 3): (x - mean) / max(std, floor),
+// times the block weight / sqrt(block dimension).
+class FeatureNormalizer {
+ public:
+  // Fits mean and deviation over the rows of `raw` (the template library).
+  static FeatureNormalizer fit(const FeatureMatrix& raw, const FeatureSpec& spec);
+  void apply(std::span<float> features) const noexcept;
+  void apply(FeatureMatrix& rows) const;
+
+  const Eigen::VectorXf& mean() const { return mean_; }
+  const Eigen::VectorXf& scale() const { return scale_; }
+
+ private:
+  Eigen::VectorXf mean_;
+  Eigen::VectorXf scale_;  // weight / (sqrt(block dims) * max(std, floor))
+};
+
+}  // namespace duet

@@ -1,0 +1,46 @@
+// One user following a duet library, frame by frame (method.md 6, first half of the loop):
+// the user's pose -> raw features -> standardised features -> tracker step.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "duet/base/result.h"
+#include "duet/follow/tracker.h"
+#include "duet/live/duet_library.h"
+
+namespace duet {
+
+class FollowSession {
+ public:
+  // user_skeleton/user_roles describe the incoming motion (any convention with the needed roles).
+  // The library must outlive the session.
+  static Result<FollowSession> create(const DuetLibrary& library,
+                                      std::shared_ptr<const Skeleton> user_skeleton,
+                                      const JointRoles& user_roles,
+                                      std::unique_ptr<Tracker> tracker);
+
+  // One input frame: local pose of the user's skeleton at time_s (seconds, increasing). The time
+  // since the previous frame drives the tracker's rate handling. Allocates nothing.
+  FollowResult step(std::span<const Vec3> translations_ls, std::span<const Quat> rotations_ls,
+                    double time_s) noexcept;
+  void reset() noexcept;
+
+  std::span<const float> last_features() const { return features_; }
+  const Tracker& tracker() const { return *tracker_; }
+
+ private:
+  FollowSession(const DuetLibrary& library, FeatureExtractor extractor,
+                std::unique_ptr<Tracker> tracker);
+
+  const DuetLibrary* library_;
+  FeatureExtractor extractor_;
+  FeatureExtractor::Context context_;
+  std::unique_ptr<Tracker> tracker_;
+  std::vector<float> features_;
+  double previous_time_s_ = 0.0;
+  bool has_previous_ = false;
+};
+
+}  // namespace duet

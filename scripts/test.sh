@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Runs every test: the Release build, the AddressSanitizer + UBSan build, and a bounded fuzz run
+# of each file reader. Usage: scripts/test.sh [DATA_DIR]   (FUZZ_SECONDS=N to change the fuzz time)
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+scripts/install-deps.sh
+data_dir=$(scripts/get-data.sh "${1:-}")
+jobs=$(nproc)
+
+echo "== Release build and tests" >&2
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DDUET_DATA_DIR="$data_dir" >/dev/null
+cmake --build build -j"$jobs"
+ctest --test-dir build --output-on-failure -j"$jobs"
+
+echo "== Sanitizer build (ASan + UBSan) and tests" >&2
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DDUET_SANITIZE=ON \
+  -DDUET_BUILD_BENCHMARKS=OFF -DDUET_DATA_DIR="$data_dir" >/dev/null
+cmake --build build-asan -j"$jobs"
+ctest --test-dir build-asan --output-on-failure -j"$jobs"
+
+echo "== Fuzzing each reader for ${FUZZ_SECONDS:-30} s" >&2
+CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DDUET_BUILD_FUZZERS=ON -DDUET_BUILD_TESTS=OFF -DDUET_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build build-fuzz -j"$jobs"
+for fuzzer in build-fuzz/fuzz/*_fuzz; do
+  name=$(basename "$fuzzer" _fuzz)
+  corpus=$(mktemp -d)
+  cp -r fuzz/corpus/"$name"/. "$corpus"/ 2>/dev/null || true
+  "$fuzzer" -max_total_time="${FUZZ_SECONDS:-30}" -max_len=65536 -rss_limit_mb=2048 "$corpus" \
+    2> "build-fuzz/$name.log" || { tail -40 "build-fuzz/$name.log"; exit 1; }
+  echo "fuzz $name: $(grep -c . "build-fuzz/$name.log") log lines, no crash" >&2
+  rm -rf "$corpus"
+done
+echo "== all tests passed" >&2

@@ -1,0 +1,192 @@
+#include "duet/features/feature_extractor.h"
+
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+#include "duet/math/rotation.h"
+#include "duet/motion/forward_kinematics.h"
+
+namespace duet {
+
+namespace {
+
+bool all_finite(std::span<const Vec3> values) {
+  for (const Vec3& v : values) {
+    if (!v.allFinite()) return false;
+  }
+  return true;
+}
+
+bool all_finite(std::span<const Quat> values) {
+  for (const Quat& q : values) {
+    if (!q.coeffs().allFinite()) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void FeatureExtractor::Context::reset() noexcept {
+  newest_ = -1;
+  count_ = 0;
+}
+
+Result<FeatureExtractor> FeatureExtractor::create(std::shared_ptr<const Skeleton> skeleton,
+                                                  const JointRoles& roles,
+                                                  const FeatureSpec& spec) {
+  if (!skeleton) return Error{"feature extractor: no skeleton"};
+  if (!(spec.velocity_window_s > 0.0)) {
+    return Error{"feature extractor: velocity window must be positive"};
+  }
+  FeatureExtractor extractor;
+  extractor.spec_ = spec;
+  auto joint_of = [&](Role role) { return roles[role]; };
+  for (Role role : spec.posture_roles) {
+    const int joint = joint_of(role);
+    if (joint < 0 || joint >= skeleton->joint_count()) {
+      return Error{"feature extractor: the skeleton has no joint for role " +
+                   std::string(role_name(role))};
+    }
+    extractor.posture_joints_.push_back(joint);
+  }
+  const std::array<Role, 5> needed = {Role::kHips, Role::kLeftWrist, Role::kRightWrist,
+                                      Role::kLeftAnkle, Role::kRightAnkle};
+  for (Role role : needed) {
+    const int joint = joint_of(role);
+    if (joint < 0 || joint >= skeleton->joint_count()) {
+      return Error{"feature extractor: the skeleton has no joint for role " +
+                   std::string(role_name(role))};
+    }
+  }
+  extractor.root_joint_ = joint_of(Role::kHips);
+  extractor.effector_joints_ = {joint_of(Role::kLeftWrist), joint_of(Role::kRightWrist),
+                                joint_of(Role::kLeftAnkle), joint_of(Role::kRightAnkle)};
+  extractor.skeleton_ = std::move(skeleton);
+  return extractor;
+}
+
+FeatureExtractor::Context FeatureExtractor::make_context() const {
+  Context context;
+  context.positions_ws_.resize(static_cast<std::size_t>(skeleton_->joint_count()));
+  context.rotations_ws_.resize(static_cast<std::size_t>(skeleton_->joint_count()));
+  return context;
+}
+
+void FeatureExtractor::extract(Context& context, std::span<const Vec3> translations_ls,
+                               std::span<const Quat> rotations_ls, double time_s,
+                               std::span<float> out) const noexcept {
+  assert(out.size() == static_cast<std::size_t>(dimension()));
+  assert(translations_ls.size() == context.positions_ws_.size());
+  if (!std::isfinite(time_s) || !all_finite(translations_ls) || !all_finite(rotations_ls)) {
+    for (float& v : out) v = std::numeric_limits<float>::quiet_NaN();
+    return;
+  }
+  forward_kinematics(*skeleton_, translations_ls, rotations_ls, context.positions_ws_,
+                     context.rotations_ws_);
+
+  // Posture: rotation vectors of the local rotations (the BVH rest pose has zero rotations).
+  std::size_t d = 0;
+  for (int joint : posture_joints_) {
+    const Vec3 v = log_map(rotations_ls[static_cast<std::size_t>(joint)]);
+    for (int k = 0; k < 3; ++k) out[d++] = static_cast<float>(v[k]);
+  }
+
+  Context::Sample now;
+  now.time_s = time_s;
+  now.root = context.positions_ws_[static_cast<std::size_t>(root_joint_)];
+  now.yaw = heading_yaw(context.rotations_ws_[static_cast<std::size_t>(root_joint_)]);
+  for (std::size_t e = 0; e < 4; ++e) {
+    now.effectors[e] = context.positions_ws_[static_cast<std::size_t>(effector_joints_[e])];
+  }
+
+  // The reference sample: the newest one at least velocity_window_s older than now, else the
+  // oldest we have (the first frames of a performance).
+  const Context::Sample* reference = nullptr;
+  for (int age = 0; age < context.count_; ++age) {
+    const int index = (context.newest_ - age + Context::kHistory) % Context::kHistory;
+    const Context::Sample& sample = context.history_[static_cast<std::size_t>(index)];
+    if (sample.time_s >= now.time_s) continue;  // out-of-order timestamps carry no velocity
+    reference = &sample;
+    if (now.time_s - sample.time_s >= spec_.velocity_window_s) break;
+  }
+
+  Vec3 root_velocity_heading = Vec3::Zero();
+  double yaw_rate = 0.0;
+  std::array<double, 4> effector_speed{};
+  if (reference != nullptr) {
+    const double dt = now.time_s - reference->time_s;
+    const Vec3 velocity_ws = (now.root - reference->root) / dt;
+    root_velocity_heading = yaw_rotation(-now.yaw) * velocity_ws;
+    yaw_rate = wrap_angle(now.yaw - reference->yaw) / dt;
+    for (std::size_t e = 0; e < 4; ++e) {
+      effector_speed[e] = (now.effectors[e] - reference->effectors[e]).norm() / dt;
+    }
+  }
+  out[d++] = static_cast<float>(root_velocity_heading.z());  // forward
+  out[d++] = static_cast<float>(root_velocity_heading.x());  // lateral
+  out[d++] = static_cast<float>(root_velocity_heading.y());  // vertical
+  out[d++] = static_cast<float>(yaw_rate);
+  for (double speed : effector_speed) out[d++] = static_cast<float>(speed);
+
+  context.newest_ = (context.newest_ + 1) % Context::kHistory;
+  context.history_[static_cast<std::size_t>(context.newest_)] = now;
+  if (context.count_ < Context::kHistory) ++context.count_;
+}
+
+FeatureMatrix FeatureExtractor::extract_clip(const Clip& clip) const {
+  FeatureMatrix rows(clip.frame_count(), dimension());
+  Context context = make_context();
+  for (int f = 0; f < clip.frame_count(); ++f) {
+    extract(context, clip.translations_ls(f), clip.rotations_ls(f), f / clip.frame_rate(),
+            std::span<float>(rows.row(f).data(), static_cast<std::size_t>(dimension())));
+  }
+  return rows;
+}
+
+FeatureNormalizer FeatureNormalizer::fit(const FeatureMatrix& raw, const FeatureSpec& spec) {
+  const auto dims = raw.cols();
+  FeatureNormalizer normalizer;
+  normalizer.mean_ = Eigen::VectorXf::Zero(dims);
+  normalizer.scale_ = Eigen::VectorXf::Ones(dims);
+  if (raw.rows() == 0) return normalizer;
+  const Eigen::VectorXd mean = raw.cast<double>().colwise().mean().transpose();
+  const Eigen::MatrixXd centred = raw.cast<double>().rowwise() - mean.transpose();
+  const Eigen::VectorXd std_dev =
+      (centred.array().square().colwise().sum() / static_cast<double>(raw.rows()))
+          .sqrt()
+          .transpose();
+  normalizer.mean_ = mean.cast<float>();
+  for (int b = 0; b < kFeatureBlockCount; ++b) {
+    const auto block = static_cast<FeatureBlock>(b);
+    const double weight = block == FeatureBlock::kPosture        ? spec.posture_weight
+                          : block == FeatureBlock::kRootVelocity ? spec.root_velocity_weight
+                                                                 : spec.effector_speed_weight;
+    const int begin = spec.block_begin(block);
+    const int size = spec.block_size(block);
+    for (int d = begin; d < begin + size; ++d) {
+      double floor = spec.speed_std_floor_mps;
+      if (block == FeatureBlock::kPosture) floor = spec.rotation_std_floor_rad;
+      if (block == FeatureBlock::kRootVelocity && d == begin + 3) {
+        floor = spec.yaw_rate_std_floor_radps;
+      }
+      const double deviation = std::max(std_dev[d], floor);
+      normalizer.scale_[d] = static_cast<float>(weight / (std::sqrt(double(size)) * deviation));
+    }
+  }
+  return normalizer;
+}
+
+void FeatureNormalizer::apply(std::span<float> features) const noexcept {
+  assert(features.size() == static_cast<std::size_t>(mean_.size()));
+  for (std::size_t d = 0; d < features.size(); ++d) {
+    const auto i = static_cast<Eigen::Index>(d);
+    features[d] = (features[d] - mean_[i]) * scale_[i];
+  }
+}
+
+void FeatureNormalizer::apply(FeatureMatrix& rows) const {
+  rows = (rows.rowwise() - mean_.transpose()).array().rowwise() * scale_.transpose().array();
+}
+
+}  // namespace duet

@@ -1,0 +1,117 @@
+#include "duet/live/duet_library.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+namespace duet {
+
+bool parse_dancer_role(const std::string& text, DancerRole& role) {
+  if (text == "leader") {
+    role = DancerRole::kLeader;
+    return true;
+  }
+  if (text == "partner") {
+    role = DancerRole::kPartner;
+    return true;
+  }
+  return false;
+}
+
+const char* dancer_role_name(DancerRole role) {
+  return role == DancerRole::kLeader ? "leader" : "partner";
+}
+
+namespace {
+
+Status check_duet(const std::string& what, LoadedMotion& leader, LoadedMotion& partner,
+                  bool trim_to_shorter) {
+  if (std::abs(leader.clip.frame_rate() - partner.clip.frame_rate()) > 1e-9) {
+    return Error{what + ": the two dancers have different frame rates (" +
+                 std::to_string(leader.clip.frame_rate()) + " and " +
+                 std::to_string(partner.clip.frame_rate()) + " fps)"};
+  }
+  const int frames = std::min(leader.clip.frame_count(), partner.clip.frame_count());
+  if (leader.clip.frame_count() != partner.clip.frame_count()) {
+    if (!trim_to_shorter) {
+      return Error{what + ": the two dancers have different frame counts (" +
+                   std::to_string(leader.clip.frame_count()) + " and " +
+                   std::to_string(partner.clip.frame_count()) +
+                   "); a duet is captured together (use --trim to cut to the shorter)"};
+    }
+    for (LoadedMotion* m : {&leader, &partner}) {
+      Clip trimmed(m->clip.skeleton_ptr(), m->clip.frame_rate(), frames);
+      for (int f = 0; f < frames; ++f) {
+        std::ranges::copy(m->clip.translations_ls(f), trimmed.translations_ls(f).begin());
+        std::ranges::copy(m->clip.rotations_ls(f), trimmed.rotations_ls(f).begin());
+      }
+      m->clip = std::move(trimmed);
+    }
+  }
+  if (frames < 3) return Error{what + ": a duet needs at least 3 frames"};
+  return Ok{};
+}
+
+}  // namespace
+
+Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
+                                      const LibraryOptions& options, const Progress& progress) {
+  if (pairs.empty()) return Error{"no duet given (--pair LEADER PARTNER)"};
+  DuetLibrary library;
+  library.options_ = options;
+  std::vector<FeatureMatrix> raw_features;
+  int total_frames = 0;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const PairFiles& pair = pairs[k];
+    if (progress) progress(static_cast<int>(k), static_cast<int>(pairs.size()), pair.leader);
+    Result<LoadedMotion> leader = load_motion({pair.leader}, options.load);
+    if (!leader) return leader.error();
+    Result<LoadedMotion> partner = load_motion({pair.partner}, options.load);
+    if (!partner) return partner.error();
+    const std::string what = "pair " + std::to_string(k + 1) + " (" + pair.leader + ", " +
+                             pair.partner + ")";
+    if (Status ok = check_duet(what, leader.value(), partner.value(), options.trim_to_shorter);
+        !ok) {
+      return ok.error();
+    }
+    DuetTake take;
+    take.name = std::filesystem::path(pair.leader).stem().string();
+    const bool user_leads = options.role == DancerRole::kLeader;
+    take.template_motion = std::move(user_leads ? leader.value() : partner.value());
+    take.response_motion = std::move(user_leads ? partner.value() : leader.value());
+    take.first_state = total_frames;
+    if (!library.takes_.empty() &&
+        std::abs(take.template_motion.clip.frame_rate() - library.takes_[0].template_motion.clip.frame_rate()) > 1e-9) {
+      return Error{what + ": every duet in a library must have the same frame rate"};
+    }
+    Result<FeatureExtractor> extractor = FeatureExtractor::create(
+        take.template_motion.clip.skeleton_ptr(), take.template_motion.roles, options.features);
+    if (!extractor) return Error{what + ": " + extractor.error().message};
+    raw_features.push_back(extractor.value().extract_clip(take.template_motion.clip));
+    total_frames += take.template_motion.clip.frame_count();
+    library.takes_.push_back(std::move(take));
+  }
+  if (progress) progress(static_cast<int>(pairs.size()), static_cast<int>(pairs.size()), "features");
+
+  FeatureMatrix all(total_frames, options.features.dimension());
+  std::vector<int> take_start;
+  for (std::size_t k = 0; k < raw_features.size(); ++k) {
+    const int first = library.takes_[k].first_state;
+    all.middleRows(first, raw_features[k].rows()) = raw_features[k];
+    take_start.push_back(first);
+  }
+  library.normalizer_ = FeatureNormalizer::fit(all, options.features);
+  library.normalizer_.apply(all);
+  Result<TemplateModel> model = TemplateModel::build(
+      std::move(all), std::move(take_start), library.takes_[0].template_motion.clip.frame_rate());
+  if (!model) return model.error();
+  library.model_ = std::make_shared<const TemplateModel>(std::move(model).value());
+  return library;
+}
+
+Result<FeatureExtractor> DuetLibrary::make_extractor(std::shared_ptr<const Skeleton> skeleton,
+                                                     const JointRoles& roles) const {
+  return FeatureExtractor::create(std::move(skeleton), roles, options_.features);
+}
+
+}  // namespace duet

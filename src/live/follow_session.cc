@@ -1,0 +1,43 @@
+#include "duet/live/follow_session.h"
+
+#include <cmath>
+
+namespace duet {
+
+Result<FollowSession> FollowSession::create(const DuetLibrary& library,
+                                            std::shared_ptr<const Skeleton> user_skeleton,
+                                            const JointRoles& user_roles,
+                                            std::unique_ptr<Tracker> tracker) {
+  if (!tracker) return Error{"follow session: no tracker"};
+  Result<FeatureExtractor> extractor = library.make_extractor(std::move(user_skeleton), user_roles);
+  if (!extractor) return Error{"the user's motion: " + extractor.error().message};
+  return FollowSession(library, std::move(extractor).value(), std::move(tracker));
+}
+
+FollowSession::FollowSession(const DuetLibrary& library, FeatureExtractor extractor,
+                             std::unique_ptr<Tracker> tracker)
+    : library_(&library),
+      extractor_(std::move(extractor)),
+      context_(extractor_.make_context()),
+      tracker_(std::move(tracker)),
+      features_(static_cast<std::size_t>(extractor_.dimension())) {}
+
+FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
+                                 std::span<const Quat> rotations_ls, double time_s) noexcept {
+  extractor_.extract(context_, translations_ls, rotations_ls, time_s, features_);
+  library_->normalizer().apply(features_);
+  const double dt_s = has_previous_ ? time_s - previous_time_s_ : 0.0;
+  if (std::isfinite(time_s)) {
+    previous_time_s_ = time_s;
+    has_previous_ = true;
+  }
+  return tracker_->step(features_, dt_s);
+}
+
+void FollowSession::reset() noexcept {
+  context_.reset();
+  tracker_->reset();
+  has_previous_ = false;
+}
+
+}  // namespace duet

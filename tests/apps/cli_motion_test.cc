@@ -1,0 +1,85 @@
+// End-to-end tests of `duet inspect` and `duet convert` on the real CMU files.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "apps/run_command.h"
+
+namespace duet::testing {
+namespace {
+
+const std::string kLeader = data_path("cmu-salsa/bvh/60/60_01_scaled.bvh");
+const std::string kAsf = data_path("cmu-salsa/asf-amc/60.asf");
+const std::string kAmc = data_path("cmu-salsa/asf-amc/60_01.amc");
+
+TEST(CliInspect, PrintsJsonForASalsaBvh) {
+  const CommandResult r = run_duet("inspect --json --fps 60 " + kLeader);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto doc = nlohmann::json::parse(r.output);
+  EXPECT_EQ(doc["frames"], 2242);
+  EXPECT_EQ(doc["fps"], 60.0);
+  EXPECT_NEAR(doc["duration_s"].get<double>(), 2242 / 60.0, 1e-9);
+  EXPECT_EQ(doc["joints"], 43);
+  EXPECT_EQ(doc["channels"], 132);
+  EXPECT_EQ(doc["convention"], "daz");
+  // Standing head height is about 1.14 units = 1.48 m; the dancers stay within a few metres.
+  const double top = doc["bounding_box_m"]["max"][1];
+  EXPECT_GT(top, 1.4);
+  EXPECT_LT(top, 2.2);
+}
+
+TEST(CliInspect, ReadsAsfAmcAndTheHandshakeConvention) {
+  CommandResult r = run_duet("inspect " + kAsf + " " + kAmc);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("cmu-asf"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("frames:      2242"), std::string::npos) << r.output;
+  r = run_duet("inspect --json " + data_path("cmu-handshake/18_01.bvh"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(r.output)["convention"], "cmu-bvh");
+}
+
+TEST(CliInspect, BadInputFailsWithReason) {
+  CommandResult r = run_duet("inspect /nonexistent.bvh");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("/nonexistent.bvh"), std::string::npos) << r.output;
+
+  const auto bad = std::filesystem::temp_directory_path() / "duet_cli_bad.bvh";
+  {
+    std::FILE* f = std::fopen(bad.c_str(), "w");
+    std::fputs("HIERARCHY\nROOT hip\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition Wrong\n}\n",
+               f);
+    std::fclose(f);
+  }
+  r = run_duet("inspect " + bad.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find(bad.string() + ":5:"), std::string::npos) << r.output;
+  std::filesystem::remove(bad);
+
+  r = run_duet("inspect --fps -3 " + kLeader);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = run_duet("frobnicate");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+TEST(CliConvert, AsfAmcToBvhResampledAndBack) {
+  const auto out = std::filesystem::temp_directory_path() / "duet_cli_convert.bvh";
+  CommandResult r = run_duet("convert " + kAsf + " " + kAmc + " --input-fps 60 --fps 30 -o " +
+                             out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_duet("inspect --json --scale 1 " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto doc = nlohmann::json::parse(r.output);
+  EXPECT_EQ(doc["frames"], 1121);  // 2242 frames at 60 Hz span 37.35 s
+  EXPECT_EQ(doc["fps"], 30.0);
+  std::filesystem::remove(out);
+}
+
+TEST(CliConvert, UnwritableOutputLeavesNothingBehind) {
+  const CommandResult r = run_duet("convert " + kLeader + " -o /nonexistent-dir/out.bvh");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("/nonexistent-dir/out.bvh"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace duet::testing
