@@ -49,7 +49,13 @@ Vec3 euler_from_quat(const Quat& q, const EulerOrder& order) {
   double c = 0.0;
   if (cos_b > 1e-12) {
     a = std::atan2(-parity * m(j, k), m(k, k));
-    c = std::atan2(-parity * m(i, j), m(i, i));
+    // c from a and entries of size 1 (M. Day, "Extracting Euler angles from a rotation matrix"):
+    // Ri(-a) * R = Rj(b) * Rk(c), whose row j holds sin c and cos c. Computing c on its own from
+    // m(i, j) and m(i, i), which shrink with cos b, lost up to 3e-16 / cos b radians near gimbal
+    // lock (3e-4 rad at 1e-12 from it); this way an error in a is compensated by c.
+    const double ca = std::cos(a);
+    const double sa = std::sin(a);
+    c = std::atan2(parity * ca * m(j, i) + sa * m(k, i), ca * m(j, j) + parity * sa * m(k, j));
   } else {
     // Gimbal lock: only a + c (or a - c) is determined; put it all in a.
     a = std::atan2(parity * m(k, j), m(j, j));

@@ -12,7 +12,9 @@ namespace duet {
 enum class Axis : int { kX = 0, kY = 1, kZ = 2 };
 
 // The order in which a file lists its rotation channels, e.g. "ZXY" for Zrotation Xrotation
-// Yrotation. BVH and ASF compose intrinsically in listed order: R = R_first * R_second * R_third.
+// Yrotation. BVH composes intrinsically in listed order: R = R_first * R_second * R_third.
+// ASF/AMC is the other way round (`dof rx ry rz` means R = Rz * Ry * Rx): reverse the order
+// before calling quat_from_euler for ASF data.
 using EulerOrder = std::array<Axis, 3>;
 
 // Parses "XYZ", "zxy", ... Returns false if the string is not a permutation of X, Y, Z.
