@@ -1,0 +1,60 @@
+// Spatial alignment (method.md 5.1, paper 5.1): the partner is placed relative to the user, not
+// at its captured place in the room.
+//
+// Offline, for every frame of a duet, the response's root is expressed in the template's
+// heading frame: the template root projected on the floor (y = 0) and turned by its heading
+// (yaw). That gives a horizontal offset, a height above the floor, and the root rotation relative
+// to the template's heading (its yaw is the relative yaw; tilt and roll are the response's own).
+// At run time the same relative transform is applied to the user's current heading frame, so a
+// user who dances elsewhere in the room, faces elsewhere, or jumps to another part of the dance
+// keeps the partner where it belongs relative to them.
+//
+// "Root" is joint 0 of each skeleton (the hips in every convention shipped; its local transform
+// is its world transform). Heading is duet::heading_yaw() of the root's world rotation, so the
+// user's root rotation must follow the template skeleton's axis convention.
+#pragma once
+
+#include <vector>
+
+#include "duet/base/result.h"
+#include "duet/motion/clip.h"
+
+namespace duet {
+
+// A body's heading frame: its root projected on the floor (y = 0), turned about +Y by its heading.
+Transform heading_frame(const Vec3& root_position_ws, const Quat& root_rotation_ws) noexcept;
+
+// The response root relative to the template's heading frame (_hs: heading space).
+struct RootPlacement {
+  // x, z: horizontal offset from the template root; y: height of the response root above the
+  // floor (not relative to the template's height, so a shorter user does not sink the partner).
+  Vec3 position_hs = Vec3::Zero();
+  // The response root's rotation in the template's heading frame.
+  Quat rotation_hs = Quat::Identity();
+
+  // The response's heading minus the template's, wrapped to (-pi, pi].
+  double relative_yaw_rad() const noexcept;
+};
+
+// The partner's root world transform for a user whose root is at `user_root_position_ws` with
+// rotation `user_root_rotation_ws`.
+Transform place_root(const RootPlacement& placement, const Vec3& user_root_position_ws,
+                     const Quat& user_root_rotation_ws) noexcept;
+
+// The placements of one duet, one per frame. Immutable after build().
+class SpatialAlignment {
+ public:
+  SpatialAlignment() = default;
+
+  // The two clips must have the same number of frames (error otherwise) and at least one frame.
+  static Result<SpatialAlignment> build(const Clip& template_clip, const Clip& response_clip);
+
+  int frame_count() const noexcept { return static_cast<int>(placements_.size()); }
+  // frame in [0, frame_count()).
+  const RootPlacement& placement(int frame) const noexcept;
+
+ private:
+  std::vector<RootPlacement> placements_;
+};
+
+}  // namespace duet

@@ -1,0 +1,226 @@
+// The partner's pose, frame by frame (method.md 5 and 6): the response clip's pose at the
+// estimated template frame, then the corrections, each switchable on its own:
+//
+//   response pose at frame f
+//   -> align     root placed relative to the user's heading frame (5.1)
+//   -> blend     inertialization when the follower jumped (5.3)
+//   -> smooth    per-joint exponential smoothing in quaternion space (5.3)
+//   -> footlock  planted feet held by a horizontal root shift (5.3)
+//   -> contact   two-bone IK of each arm whose hand holds the user's (5.2)
+//   -> partner pose, root in the user's world frame
+//
+// Offline: PartnerModel (per duet take; may allocate and fail with a message).
+// Run time: PartnerSynthesisJob with a PartnerContext sized once: allocates nothing, throws
+// nothing, does no I/O. See docs/partner.md for every parameter and its default.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "duet/base/result.h"
+#include "duet/motion/clip.h"
+#include "duet/motion/skeleton_map.h"
+#include "duet/partner/alignment.h"
+#include "duet/partner/foot_lock.h"
+#include "duet/partner/hand_contacts.h"
+#include "duet/partner/smoothing.h"
+
+namespace duet {
+
+// ---------------------------------------------------------------------------------------------
+// Offline
+
+struct PartnerModelOptions {
+  ContactOptions contacts;
+  // The ground height of each foot (its toe joint) is this quantile of the toe's height over the
+  // response clip: robust to a floor that is not at y = 0 and to toe markers above the sole.
+  double ground_quantile = 0.05;
+};
+
+// Everything the corrections need from one captured duet: the response skeleton and roles, the
+// root placements (alignment), the hand contacts and the feet's ground heights. Immutable.
+class PartnerModel {
+ public:
+  PartnerModel() = default;
+
+  // template_clip/template_roles: the dancer the user dances; response_clip/response_roles: the
+  // virtual partner. Same frame count and rate. The response roles must give two arm chains
+  // (shoulder above elbow above wrist, neither arm below the other) and both toes. Errors say
+  // what is missing.
+  static Result<PartnerModel> build(const Clip& template_clip, const JointRoles& template_roles,
+                                    const Clip& response_clip, const JointRoles& response_roles,
+                                    const PartnerModelOptions& options = {});
+
+  int frame_count() const noexcept { return alignment_.frame_count(); }
+  double frame_rate() const noexcept { return contacts_.frame_rate(); }
+  const Skeleton& response_skeleton() const noexcept { return *response_skeleton_; }
+  const std::shared_ptr<const Skeleton>& response_skeleton_ptr() const noexcept {
+    return response_skeleton_;
+  }
+  const JointRoles& response_roles() const noexcept { return response_roles_; }
+  const SpatialAlignment& alignment() const noexcept { return alignment_; }
+  const HandContacts& contacts() const noexcept { return contacts_; }
+  // Height (y, metres) of the response's toe joint when that foot stands on the floor.
+  double foot_ground_height(Side side) const noexcept {
+    return ground_heights_[static_cast<std::size_t>(side)];
+  }
+
+ private:
+  std::shared_ptr<const Skeleton> response_skeleton_;
+  JointRoles response_roles_;
+  SpatialAlignment alignment_;
+  HandContacts contacts_;
+  std::array<double, 2> ground_heights_{0.0, 0.0};
+};
+
+// ---------------------------------------------------------------------------------------------
+// Parameters
+
+// Where the partner's wrist is sent while its hand holds the user's.
+enum class IkTarget {
+  // The captured wrist-to-wrist offset carried by the user's hand (position and rotation):
+  // reproduces the captured grip, which matters when the skeletons only approximately touch.
+  kCapturedOffset,
+  // The user's wrist itself (the paper's target effector).
+  kUserWrist,
+};
+bool parse_ik_target(std::string_view text, IkTarget& target);  // "offset" | "wrist"
+const char* ik_target_name(IkTarget target);
+
+struct PartnerParams {
+  // The switches (method.md 5). All off: the output is the response pose unchanged.
+  bool align = true;
+  bool contact = true;
+  bool smooth = true;
+  bool foot_lock = true;
+  bool blend = true;
+
+  // smooth: half-lives of the per-joint exponential smoothing. The delay for a joint turning
+  // steadily is at most half_life / ln 2 (22 ms at 0.015 s). Chosen on salsa 61_01, see
+  // docs/partner.md: halves the jerk of a +-1 frame jittering estimate for ~1 cm of lag.
+  double smooth_rotation_half_life_s = 0.015;
+  double smooth_translation_half_life_s = 0.015;
+
+  // blend: half-life of the inertialization offset recorded at a jump.
+  double blend_half_life_s = 0.1;
+
+  // contact: IK target and the time the IK weight takes to go from 0 to 1 (and back) when a
+  // contact starts (ends). The weight follows a smoothstep of that linear ramp.
+  IkTarget ik_target = IkTarget::kCapturedOffset;
+  double ik_fade_s = 0.25;
+
+  // footlock thresholds and release.
+  FootLockParams foot;
+
+  // Empty when valid; otherwise which parameter is wrong (negative or non-finite times, ...).
+  std::string validate() const;
+};
+
+// Sets the five switches from a comma-separated list of the corrections to turn on:
+// "align,contact,smooth,footlock,blend", "all" or "none". Unknown names are an error that lists
+// the known ones; params is untouched on error.
+Status parse_corrections(std::string_view list, PartnerParams& params);
+// The switches that are on, as a list parse_corrections() accepts ("none" when all are off).
+std::string corrections_string(const PartnerParams& params);
+
+// ---------------------------------------------------------------------------------------------
+// Run time
+
+// What the corrections read from the user's current world pose. Indexed by Side.
+struct UserPose {
+  Vec3 root_position_ws = Vec3::Zero();
+  Quat root_rotation_ws = Quat::Identity();
+  std::array<Vec3, 2> wrist_positions_ws{Vec3::Zero(), Vec3::Zero()};
+  std::array<Quat, 2> wrist_rotations_ws{Quat::Identity(), Quat::Identity()};
+};
+
+// Reads a UserPose from world transforms of the user's skeleton (forward_kinematics output):
+// root = joint 0, wrists = the wrist roles. The user's skeleton should follow the template's
+// axis conventions (heading and hand frames are compared across them).
+UserPose user_pose_from_world(std::span<const Vec3> positions_ws,
+                              std::span<const Quat> rotations_ws, const JointRoles& roles) noexcept;
+
+// State kept between frames, sized once for a skeleton. One context per partner being
+// synthesised; it may be used with every PartnerModel whose response skeleton has that many
+// joints (e.g. all takes of a library: moving to another take is a jump).
+class PartnerContext {
+ public:
+  PartnerContext() = default;
+  explicit PartnerContext(int joint_count) { resize(joint_count); }
+  void resize(int joint_count);  // allocates; also resets
+  // Forget the past: the next frame starts fresh (no smoothing history, no blend offsets, no
+  // locks, IK weights at 0).
+  void reset() noexcept;
+  int joint_count() const noexcept { return static_cast<int>(blend_rotations_.size()); }
+
+ private:
+  friend struct PartnerSynthesisJob;
+
+  bool primed_ = false;
+  PoseInertializer inertializer_;
+  PoseSmoother smoother_;
+  FootLocker foot_locker_;
+  std::vector<Vec3> blend_translations_;  // output of the blend stage last frame
+  std::vector<Quat> blend_rotations_;
+  std::vector<Vec3> positions_ws_;  // forward kinematics scratch
+  std::vector<Quat> rotations_ws_;
+  Transform user_heading_;                   // last finite user heading frame
+  std::array<double, 2> ik_ramp_{0.0, 0.0};  // per response hand, linear fade state in [0, 1]
+  std::array<int, 2> ik_pair_{-1, -1};       // pair that last drove that hand
+};
+
+// Per-frame diagnostics (optional output).
+struct PartnerFrameInfo {
+  std::uint8_t contact_mask = 0;  // captured contacts at this frame (bit = hand pair)
+  // Per response hand (Side): IK weight after the fade (0: no IK), the target the wrist was sent
+  // to, and the wrist's distance to it after the IK (both meaningful only when weight > 0).
+  std::array<double, 2> ik_weight{0.0, 0.0};
+  std::array<Vec3, 2> ik_target_ws{Vec3::Zero(), Vec3::Zero()};
+  std::array<double, 2> ik_error_m{0.0, 0.0};
+  std::array<bool, 2> foot_locked{false, false};  // per foot (Side)
+  Vec3 foot_lock_offset_ws = Vec3::Zero();        // horizontal root shift applied
+  double blend_offset_rad = 0.0;  // largest joint rotation offset still being blended out
+};
+
+// One frame of partner synthesis. A plain struct in the style of ozz-animation's jobs: set the
+// inputs, call run(). Pointers are not owned.
+struct PartnerSynthesisJob {
+  // ---- Inputs ----
+  const PartnerModel* model = nullptr;
+  const PartnerParams* params = nullptr;
+  // Estimated template frame (FollowResult::frame_in_take), in [0, model->frame_count()).
+  int frame = -1;
+  // The follower jumped this frame (FollowResult::jumped, or a change of take): blend starts.
+  bool jumped = false;
+  // Time since the previous frame, seconds; <= 0 or not finite counts as one model frame.
+  double dt_s = 0.0;
+  // The response clip's local pose at `frame` (or sampled near it), one entry per joint.
+  std::span<const Vec3> translations_ls;
+  std::span<const Quat> rotations_ls;
+  // The user's current world pose; required when params->align or params->contact. Non-finite
+  // values are tolerated: alignment keeps the last finite heading, IK skips that hand.
+  const UserPose* user = nullptr;
+  // State between frames; joint_count() must match the model's response skeleton.
+  PartnerContext* context = nullptr;
+
+  // ---- Outputs (caller-owned; may alias translations_ls / rotations_ls) ----
+  // The partner's local pose; the root's local transform is in the user's world frame (in the
+  // capture's world frame when align is off).
+  std::span<Vec3> translations_ls_out;
+  std::span<Quat> rotations_ls_out;
+  PartnerFrameInfo* info = nullptr;  // optional
+
+  // Empty when the job can run, else what is wrong ("model is null", "frame is outside the
+  // model's frames", ...).
+  std::string_view validate() const noexcept;
+  // Validates, then runs every switched-on correction. Returns false (outputs untouched) when
+  // validate() fails.
+  bool run() const noexcept;
+};
+
+}  // namespace duet

@@ -1,0 +1,421 @@
+#include "duet/partner/partner_synthesis.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "duet/motion/forward_kinematics.h"
+#include "duet/partner/ik_two_bone_job.h"
+
+namespace duet {
+namespace {
+
+struct ArmRoles {
+  Role shoulder, elbow, wrist;
+};
+constexpr std::array<ArmRoles, 2> kArms = {
+    {{Role::kLeftShoulder, Role::kLeftElbow, Role::kLeftWrist},
+     {Role::kRightShoulder, Role::kRightElbow, Role::kRightWrist}}};
+constexpr std::array<Role, 2> kToes = {Role::kLeftToe, Role::kRightToe};
+
+bool is_ancestor(const Skeleton& skeleton, int ancestor, int joint) {
+  for (int j = joint; j >= 0; j = skeleton.joints[static_cast<std::size_t>(j)].parent) {
+    if (j == ancestor) return true;
+  }
+  return false;
+}
+
+bool valid_joint(const Skeleton& skeleton, int j) { return j >= 0 && j < skeleton.joint_count(); }
+
+std::string role_joint(const Skeleton& skeleton, const JointRoles& roles, Role role) {
+  const int j = roles[role];
+  return std::string(role_name(role)) + " ('" +
+         (valid_joint(skeleton, j) ? skeleton.joints[static_cast<std::size_t>(j)].name
+                                   : std::string("none")) +
+         "')";
+}
+
+Status check_response_roles(const Skeleton& skeleton, const JointRoles& roles) {
+  for (const ArmRoles& arm : kArms) {
+    for (const Role role : {arm.shoulder, arm.elbow, arm.wrist}) {
+      if (!valid_joint(skeleton, roles[role])) {
+        return Error{"partner model: the response skeleton has no " + std::string(role_name(role)) +
+                     " joint"};
+      }
+    }
+    if (!is_ancestor(skeleton, roles[arm.shoulder], roles[arm.elbow]) ||
+        !is_ancestor(skeleton, roles[arm.elbow], roles[arm.wrist]) ||
+        roles[arm.shoulder] == roles[arm.elbow] || roles[arm.elbow] == roles[arm.wrist]) {
+      return Error{"partner model: the response arm " + role_joint(skeleton, roles, arm.shoulder) +
+                   " -> " + role_joint(skeleton, roles, arm.elbow) + " -> " +
+                   role_joint(skeleton, roles, arm.wrist) +
+                   " is not a chain (each joint must lie below the previous one)"};
+    }
+  }
+  // IK on one arm must not move the other (both are solved from one forward kinematics pass).
+  for (int side = 0; side < 2; ++side) {
+    const ArmRoles& arm = kArms[static_cast<std::size_t>(side)];
+    const ArmRoles& other = kArms[static_cast<std::size_t>(1 - side)];
+    for (const Role role : {other.shoulder, other.elbow, other.wrist}) {
+      if (is_ancestor(skeleton, roles[arm.shoulder], roles[role])) {
+        return Error{"partner model: the response's " + role_joint(skeleton, roles, role) +
+                     " lies below " + role_joint(skeleton, roles, arm.shoulder) +
+                     "; the two arms must be separate chains"};
+      }
+    }
+  }
+  for (const Role toe : kToes) {
+    if (!valid_joint(skeleton, roles[toe])) {
+      return Error{"partner model: the response skeleton has no " + std::string(role_name(toe)) +
+                   " joint"};
+    }
+  }
+  return Ok{};
+}
+
+bool finite_time(double t) { return t >= 0.0 && std::isfinite(t); }
+
+double smoothstep(double x) { return x * x * (3.0 - 2.0 * x); }
+
+bool finite_pose(const UserPose& user, Side side) {
+  const auto s = static_cast<std::size_t>(side);
+  return user.wrist_positions_ws[s].allFinite() && user.wrist_rotations_ws[s].coeffs().allFinite();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// PartnerModel
+
+Result<PartnerModel> PartnerModel::build(const Clip& template_clip,
+                                         const JointRoles& template_roles,
+                                         const Clip& response_clip,
+                                         const JointRoles& response_roles,
+                                         const PartnerModelOptions& options) {
+  if (response_clip.joint_count() == 0) return Error{"partner model: the response clip is empty"};
+  if (Status s = check_response_roles(response_clip.skeleton(), response_roles); !s) {
+    return s.error();
+  }
+  if (!(options.ground_quantile >= 0.0 && options.ground_quantile <= 1.0)) {
+    return Error{"partner model: ground_quantile must be in [0, 1]"};
+  }
+  Result<SpatialAlignment> alignment = SpatialAlignment::build(template_clip, response_clip);
+  if (!alignment) return alignment.error();
+  Result<HandContacts> contacts = HandContacts::detect(template_clip, template_roles, response_clip,
+                                                       response_roles, options.contacts);
+  if (!contacts) return contacts.error();
+
+  PartnerModel model;
+  model.response_skeleton_ = response_clip.skeleton_ptr();
+  model.response_roles_ = response_roles;
+  model.alignment_ = std::move(alignment).value();
+  model.contacts_ = std::move(contacts).value();
+
+  // Ground height per foot: a low quantile of the toe's height over the clip.
+  const std::vector<Vec3> positions = world_positions(response_clip);
+  const auto joints = static_cast<std::size_t>(response_clip.joint_count());
+  for (std::size_t side = 0; side < 2; ++side) {
+    const auto toe = static_cast<std::size_t>(response_roles[kToes[side]]);
+    std::vector<double> heights(static_cast<std::size_t>(response_clip.frame_count()));
+    for (std::size_t f = 0; f < heights.size(); ++f) heights[f] = positions[f * joints + toe].y();
+    const auto k = static_cast<std::size_t>(
+        std::floor(options.ground_quantile * static_cast<double>(heights.size() - 1)));
+    std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(k),
+                     heights.end());
+    model.ground_heights_[side] = heights[k];
+  }
+  return model;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Parameters
+
+bool parse_ik_target(std::string_view text, IkTarget& target) {
+  if (text == "offset") {
+    target = IkTarget::kCapturedOffset;
+  } else if (text == "wrist") {
+    target = IkTarget::kUserWrist;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+const char* ik_target_name(IkTarget target) {
+  return target == IkTarget::kCapturedOffset ? "offset" : "wrist";
+}
+
+std::string PartnerParams::validate() const {
+  const std::pair<const char*, double> times[] = {
+      {"smooth_rotation_half_life_s", smooth_rotation_half_life_s},
+      {"smooth_translation_half_life_s", smooth_translation_half_life_s},
+      {"blend_half_life_s", blend_half_life_s},
+      {"ik_fade_s", ik_fade_s},
+      {"foot.height_margin_m", foot.height_margin_m},
+      {"foot.speed_threshold_mps", foot.speed_threshold_mps},
+      {"foot.max_offset_m", foot.max_offset_m},
+      {"foot.release_half_life_s", foot.release_half_life_s}};
+  for (const auto& [name, value] : times) {
+    if (!finite_time(value)) {
+      return std::string(name) + " must be finite and >= 0 (got " + std::to_string(value) + ")";
+    }
+  }
+  return {};
+}
+
+Status parse_corrections(std::string_view list, PartnerParams& params) {
+  PartnerParams out = params;
+  out.align = out.contact = out.smooth = out.foot_lock = out.blend = false;
+  while (!list.empty()) {
+    const std::size_t comma = list.find(',');
+    const std::string_view name = list.substr(0, comma);
+    list = comma == std::string_view::npos ? std::string_view() : list.substr(comma + 1);
+    if (name == "align") {
+      out.align = true;
+    } else if (name == "contact") {
+      out.contact = true;
+    } else if (name == "smooth") {
+      out.smooth = true;
+    } else if (name == "footlock") {
+      out.foot_lock = true;
+    } else if (name == "blend") {
+      out.blend = true;
+    } else if (name == "all") {
+      out.align = out.contact = out.smooth = out.foot_lock = out.blend = true;
+    } else if (name == "none") {
+      // nothing on
+    } else {
+      return Error{"unknown correction '" + std::string(name) +
+                   "' (known: align, contact, smooth, footlock, blend, all, none)"};
+    }
+  }
+  params = out;
+  return Ok{};
+}
+
+std::string corrections_string(const PartnerParams& params) {
+  std::string s;
+  const std::pair<bool, const char*> switches[] = {{params.align, "align"},
+                                                   {params.contact, "contact"},
+                                                   {params.smooth, "smooth"},
+                                                   {params.foot_lock, "footlock"},
+                                                   {params.blend, "blend"}};
+  for (const auto& [on, name] : switches) {
+    if (!on) continue;
+    if (!s.empty()) s += ',';
+    s += name;
+  }
+  return s.empty() ? "none" : s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Run time
+
+UserPose user_pose_from_world(std::span<const Vec3> positions_ws,
+                              std::span<const Quat> rotations_ws,
+                              const JointRoles& roles) noexcept {
+  UserPose user;
+  if (positions_ws.empty() || rotations_ws.size() != positions_ws.size()) return user;
+  user.root_position_ws = positions_ws[0];
+  user.root_rotation_ws = rotations_ws[0];
+  for (const Side side : {Side::kLeft, Side::kRight}) {
+    const int j = roles[side == Side::kLeft ? Role::kLeftWrist : Role::kRightWrist];
+    if (j < 0 || static_cast<std::size_t>(j) >= positions_ws.size()) continue;
+    user.wrist_positions_ws[static_cast<std::size_t>(side)] =
+        positions_ws[static_cast<std::size_t>(j)];
+    user.wrist_rotations_ws[static_cast<std::size_t>(side)] =
+        rotations_ws[static_cast<std::size_t>(j)];
+  }
+  return user;
+}
+
+void PartnerContext::resize(int joint_count) {
+  const auto n = static_cast<std::size_t>(std::max(joint_count, 0));
+  inertializer_.resize(joint_count);
+  smoother_.resize(joint_count);
+  blend_translations_.assign(n, Vec3::Zero());
+  blend_rotations_.assign(n, Quat::Identity());
+  positions_ws_.assign(n, Vec3::Zero());
+  rotations_ws_.assign(n, Quat::Identity());
+  reset();
+}
+
+void PartnerContext::reset() noexcept {
+  primed_ = false;
+  inertializer_.reset();
+  smoother_.reset();
+  foot_locker_.reset();
+  user_heading_ = Transform();
+  ik_ramp_ = {0.0, 0.0};
+  ik_pair_ = {-1, -1};
+}
+
+std::string_view PartnerSynthesisJob::validate() const noexcept {
+  if (model == nullptr) return "model is null";
+  if (params == nullptr) return "params is null";
+  if (context == nullptr) return "context is null";
+  if (model->frame_count() <= 0 || !model->response_skeleton_ptr()) {
+    return "model is empty (not built?)";
+  }
+  const auto n = static_cast<std::size_t>(model->response_skeleton().joint_count());
+  if (context->joint_count() != static_cast<int>(n)) {
+    return "context is not sized for the model's response skeleton";
+  }
+  if (frame < 0 || frame >= model->frame_count()) return "frame is outside the model's frames";
+  if (translations_ls.size() != n) return "translations_ls does not have one entry per joint";
+  if (rotations_ls.size() != n) return "rotations_ls does not have one entry per joint";
+  if (translations_ls_out.size() != n)
+    return "translations_ls_out does not have one entry per joint";
+  if (rotations_ls_out.size() != n) return "rotations_ls_out does not have one entry per joint";
+  if ((params->align || params->contact) && user == nullptr) {
+    return "user is null (needed by align and contact)";
+  }
+  return {};
+}
+
+bool PartnerSynthesisJob::run() const noexcept {
+  if (!validate().empty()) return false;
+  const PartnerParams& p = *params;
+  PartnerContext& ctx = *context;
+  const Skeleton& skeleton = model->response_skeleton();
+  const JointRoles& roles = model->response_roles();
+  const double dt = dt_s > 0.0 && std::isfinite(dt_s) ? dt_s : 1.0 / model->frame_rate();
+  const std::span<Vec3> out_t = translations_ls_out;
+  const std::span<Quat> out_r = rotations_ls_out;
+  PartnerFrameInfo diagnostics;
+  diagnostics.contact_mask = model->contacts().mask(frame);
+
+  if (out_t.data() != translations_ls.data()) {
+    std::copy(translations_ls.begin(), translations_ls.end(), out_t.begin());
+  }
+  if (out_r.data() != rotations_ls.data()) {
+    std::copy(rotations_ls.begin(), rotations_ls.end(), out_r.begin());
+  }
+
+  // 1. Align (5.1): the root relative to the user's heading frame; composed into the world after
+  //    blending, so a jump's offset is blended relative to the user.
+  Transform heading;
+  if (p.align) {
+    if (user->root_position_ws.allFinite() && user->root_rotation_ws.coeffs().allFinite() &&
+        user->root_rotation_ws.norm() > 0.0) {
+      ctx.user_heading_ =
+          heading_frame(user->root_position_ws, user->root_rotation_ws.normalized());
+    }
+    heading = ctx.user_heading_;
+    const RootPlacement& placement = model->alignment().placement(frame);
+    out_t[0] = placement.position_hs;
+    out_r[0] = placement.rotation_hs;
+  }
+
+  // 2. Blend (5.3): inertialization. The source of a transition is what the blend stage showed
+  //    last frame; the offset then decays with the half-life.
+  if (p.blend) {
+    if (jumped && ctx.primed_) {
+      ctx.inertializer_.transition(ctx.blend_translations_, ctx.blend_rotations_, out_t, out_r);
+    }
+    ctx.inertializer_.update(out_t, out_r, p.blend_half_life_s, dt, out_t, out_r);
+    diagnostics.blend_offset_rad = ctx.inertializer_.max_rotation_offset();
+  } else {
+    ctx.inertializer_.reset();
+  }
+  std::copy(out_t.begin(), out_t.end(), ctx.blend_translations_.begin());
+  std::copy(out_r.begin(), out_r.end(), ctx.blend_rotations_.begin());
+
+  if (p.align) {
+    const Transform root = heading * Transform{out_r[0], out_t[0]};
+    out_t[0] = root.translation;
+    out_r[0] = root.rotation.normalized();
+  }
+
+  // 3. Smooth (5.3): per joint, in quaternion space.
+  if (p.smooth) {
+    ctx.smoother_.apply(out_t, out_r, p.smooth_rotation_half_life_s,
+                        p.smooth_translation_half_life_s, dt, out_t, out_r);
+  } else {
+    ctx.smoother_.reset();
+  }
+
+  // 4. Foot lock (5.3): shift the root horizontally to hold planted feet.
+  const bool need_world = p.foot_lock || p.contact;
+  if (need_world) {
+    forward_kinematics(skeleton, out_t, out_r, ctx.positions_ws_, ctx.rotations_ws_);
+  }
+  if (p.foot_lock) {
+    const std::array<Vec3, 2> feet = {ctx.positions_ws_[static_cast<std::size_t>(roles[kToes[0]])],
+                                      ctx.positions_ws_[static_cast<std::size_t>(roles[kToes[1]])]};
+    const std::array<double, 2> ground = {model->foot_ground_height(Side::kLeft),
+                                          model->foot_ground_height(Side::kRight)};
+    const Vec3 shift = ctx.foot_locker_.update(feet, ground, p.foot, dt);
+    out_t[0] += shift;
+    for (Vec3& position : ctx.positions_ws_) position += shift;
+    diagnostics.foot_locked = {ctx.foot_locker_.locked(0), ctx.foot_locker_.locked(1)};
+    diagnostics.foot_lock_offset_ws = shift;
+  } else {
+    ctx.foot_locker_.reset();
+  }
+
+  // 5. Contact (5.2): two-bone IK on each arm whose hand holds one of the user's, faded in/out.
+  if (p.contact) {
+    const HandContacts& contacts = model->contacts();
+    const double step = p.ik_fade_s > 0.0 ? dt / p.ik_fade_s : 1.0;
+    for (std::size_t r = 0; r < 2; ++r) {
+      // The template hand in contact with this response hand; the closer one if both are.
+      int pair = -1;
+      for (const Side ts : {Side::kLeft, Side::kRight}) {
+        const int candidate = hand_pair(ts, static_cast<Side>(r));
+        if (contacts.in_contact(frame, candidate) &&
+            (pair < 0 || contacts.box_gap(frame, candidate) < contacts.box_gap(frame, pair))) {
+          pair = candidate;
+        }
+      }
+      if (pair >= 0) ctx.ik_pair_[r] = pair;
+      double ramp = ctx.ik_ramp_[r] + (pair >= 0 ? step : -step);
+      ramp = ramp < 1e-9 ? 0.0 : (ramp > 1.0 - 1e-9 ? 1.0 : ramp);  // land exactly on 0 and 1
+      ctx.ik_ramp_[r] = ramp;
+      const double weight = smoothstep(ctx.ik_ramp_[r]);
+      if (weight <= 0.0 || ctx.ik_pair_[r] < 0) continue;
+      // During a fade-out the last contact's pair keeps driving the target, with the captured
+      // offset of the current frame (stored for every frame), so a hand that lets go follows its
+      // captured path while the weight falls.
+      const Side ts = template_side(ctx.ik_pair_[r]);
+      if (!finite_pose(*user, ts)) continue;
+      const auto t = static_cast<std::size_t>(ts);
+      Vec3 target = user->wrist_positions_ws[t];
+      if (p.ik_target == IkTarget::kCapturedOffset) {
+        target +=
+            user->wrist_rotations_ws[t].normalized() * contacts.offset_ls(frame, ctx.ik_pair_[r]);
+      }
+      const ArmRoles& arm = kArms[r];
+      const auto js = static_cast<std::size_t>(roles[arm.shoulder]);
+      const auto jm = static_cast<std::size_t>(roles[arm.elbow]);
+      const auto je = static_cast<std::size_t>(roles[arm.wrist]);
+      const Transform start{ctx.rotations_ws_[js], ctx.positions_ws_[js]};
+      const Transform mid{ctx.rotations_ws_[jm], ctx.positions_ws_[jm]};
+      const Transform end{ctx.rotations_ws_[je], ctx.positions_ws_[je]};
+      Vec3 reached_at = Vec3::Zero();
+      IkTwoBoneJob ik;
+      ik.start_joint_ws = &start;
+      ik.mid_joint_ws = &mid;
+      ik.end_joint_ws = &end;
+      ik.start_rotation_ls = &out_r[js];
+      ik.mid_rotation_ls = &out_r[jm];
+      ik.target_ws = target;
+      ik.weight = weight;
+      ik.start_rotation_ls_out = &out_r[js];
+      ik.mid_rotation_ls_out = &out_r[jm];
+      ik.end_position_ws = &reached_at;
+      if (!ik.run()) continue;
+      diagnostics.ik_weight[r] = weight;
+      diagnostics.ik_target_ws[r] = target;
+      diagnostics.ik_error_m[r] = (reached_at - target).norm();
+    }
+  } else {
+    ctx.ik_ramp_ = {0.0, 0.0};
+    ctx.ik_pair_ = {-1, -1};
+  }
+
+  ctx.primed_ = true;
+  if (info != nullptr) *info = diagnostics;
+  return true;
+}
+
+}  // namespace duet

@@ -1,0 +1,164 @@
+#include "duet/partner/smoothing.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "duet/math/rotation.h"
+
+namespace duet {
+
+double half_life_alpha(double half_life_s, double dt_s) noexcept {
+  if (!(dt_s > 0.0)) return 0.0;  // also catches NaN
+  if (!(half_life_s > 0.0) || !std::isfinite(half_life_s)) return 1.0;
+  if (!std::isfinite(dt_s)) return 1.0;
+  return 1.0 - std::exp2(-dt_s / half_life_s);
+}
+
+Quat smooth_rotation(const Quat& current, const Quat& target, double half_life_s,
+                     double dt_s) noexcept {
+  const double alpha = half_life_alpha(half_life_s, dt_s);
+  if (alpha >= 1.0) return target;
+  if (alpha <= 0.0) return current;
+  // Eigen's slerp takes the shortest arc (it flips the sign of the second quaternion if needed).
+  return current.slerp(alpha, target).normalized();
+}
+
+Vec3 smooth_position(const Vec3& current, const Vec3& target, double half_life_s,
+                     double dt_s) noexcept {
+  const double alpha = half_life_alpha(half_life_s, dt_s);
+  if (alpha >= 1.0) return target;
+  return current + alpha * (target - current);
+}
+
+namespace {
+
+// The constants of one decay step, computed once per frame for all joints.
+struct DecayStep {
+  bool skip = false;     // dt <= 0: nothing happens
+  bool instant = false;  // no half-life: the offset vanishes at once
+  double y = 0.0;
+  double eydt = 1.0;
+  double dt = 0.0;
+
+  DecayStep(double half_life_s, double dt_s) {
+    if (!(dt_s > 0.0)) {
+      skip = true;
+    } else if (!(half_life_s > 0.0) || !std::isfinite(half_life_s) || !std::isfinite(dt_s)) {
+      instant = true;
+    } else {
+      // Holden, spring.h: damping = 4 ln 2 / half_life, y = damping / 2 for a critically damped
+      // spring; the closed form below is exact for any dt.
+      y = 2.0 * std::log(2.0) / half_life_s;
+      eydt = std::exp(-y * dt_s);
+      dt = dt_s;
+    }
+  }
+
+  void apply(Vec3& x, Vec3& v) const {
+    if (skip) return;
+    if (instant) {
+      x.setZero();
+      v.setZero();
+      return;
+    }
+    const Vec3 j1 = v + x * y;
+    x = eydt * (x + j1 * dt);
+    v = eydt * (v - j1 * (y * dt));
+  }
+};
+
+}  // namespace
+
+void decay_spring_damper(Vec3& x, Vec3& v, double half_life_s, double dt_s) noexcept {
+  DecayStep(half_life_s, dt_s).apply(x, v);
+}
+
+void PoseSmoother::resize(int joint_count) {
+  const auto n = static_cast<std::size_t>(std::max(joint_count, 0));
+  translations_.assign(n, Vec3::Zero());
+  rotations_.assign(n, Quat::Identity());
+  primed_ = false;
+}
+
+void PoseSmoother::apply(std::span<const Vec3> translations_ls, std::span<const Quat> rotations_ls,
+                         double rotation_half_life_s, double translation_half_life_s, double dt_s,
+                         std::span<Vec3> translations_out, std::span<Quat> rotations_out) noexcept {
+  const std::size_t n = rotations_.size();
+  assert(translations_ls.size() == n && rotations_ls.size() == n);
+  assert(translations_out.size() == n && rotations_out.size() == n);
+  if (!primed_) {
+    std::copy(translations_ls.begin(), translations_ls.end(), translations_.begin());
+    std::copy(rotations_ls.begin(), rotations_ls.end(), rotations_.begin());
+    primed_ = true;
+  } else {
+    const double ar = half_life_alpha(rotation_half_life_s, dt_s);
+    const double at = half_life_alpha(translation_half_life_s, dt_s);
+    for (std::size_t j = 0; j < n; ++j) {
+      rotations_[j] = ar >= 1.0 ? rotations_ls[j] : rotations_[j].slerp(ar, rotations_ls[j]);
+      rotations_[j].normalize();
+      translations_[j] += at * (translations_ls[j] - translations_[j]);
+    }
+  }
+  std::copy(translations_.begin(), translations_.end(), translations_out.begin());
+  std::copy(rotations_.begin(), rotations_.end(), rotations_out.begin());
+}
+
+void PoseInertializer::resize(int joint_count) {
+  const auto n = static_cast<std::size_t>(std::max(joint_count, 0));
+  rotation_x_.assign(n, Vec3::Zero());
+  rotation_v_.assign(n, Vec3::Zero());
+  translation_x_.assign(n, Vec3::Zero());
+  translation_v_.assign(n, Vec3::Zero());
+}
+
+void PoseInertializer::reset() noexcept {
+  for (auto* buffer : {&rotation_x_, &rotation_v_, &translation_x_, &translation_v_}) {
+    std::fill(buffer->begin(), buffer->end(), Vec3::Zero());
+  }
+}
+
+void PoseInertializer::transition(std::span<const Vec3> source_translations_ls,
+                                  std::span<const Quat> source_rotations_ls,
+                                  std::span<const Vec3> destination_translations_ls,
+                                  std::span<const Quat> destination_rotations_ls) noexcept {
+  const std::size_t n = rotation_x_.size();
+  assert(source_translations_ls.size() == n && source_rotations_ls.size() == n);
+  assert(destination_translations_ls.size() == n && destination_rotations_ls.size() == n);
+  for (std::size_t j = 0; j < n; ++j) {
+    // The source already includes the previous offset, so the new offset replaces it (Holden:
+    // off_x = (src_x + off_x) - dst_x with src_x + off_x being the pose shown).
+    rotation_x_[j] = log_map(source_rotations_ls[j] * destination_rotations_ls[j].conjugate());
+    translation_x_[j] = source_translations_ls[j] - destination_translations_ls[j];
+  }
+}
+
+void PoseInertializer::update(std::span<const Vec3> translations_ls,
+                              std::span<const Quat> rotations_ls, double half_life_s, double dt_s,
+                              std::span<Vec3> translations_out,
+                              std::span<Quat> rotations_out) noexcept {
+  const std::size_t n = rotation_x_.size();
+  assert(translations_ls.size() == n && rotations_ls.size() == n);
+  assert(translations_out.size() == n && rotations_out.size() == n);
+  const DecayStep decay(half_life_s, dt_s);
+  for (std::size_t j = 0; j < n; ++j) {
+    decay.apply(rotation_x_[j], rotation_v_[j]);
+    decay.apply(translation_x_[j], translation_v_[j]);
+    rotations_out[j] = (exp_map(rotation_x_[j]) * rotations_ls[j]).normalized();
+    translations_out[j] = translations_ls[j] + translation_x_[j];
+  }
+}
+
+double PoseInertializer::max_rotation_offset() const noexcept {
+  double m = 0.0;
+  for (const Vec3& x : rotation_x_) m = std::max(m, x.norm());
+  return m;
+}
+
+double PoseInertializer::max_translation_offset() const noexcept {
+  double m = 0.0;
+  for (const Vec3& x : translation_x_) m = std::max(m, x.norm());
+  return m;
+}
+
+}  // namespace duet

@@ -1,0 +1,499 @@
+// The partner synthesizer on synthetic duets: every correction switched on alone does its job and
+// switched off does nothing; validation names the missing input; long random runs stay finite.
+#include "duet/partner/partner_synthesis.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "duet/math/rotation.h"
+#include "partner/synthetic_partner.h"
+
+namespace duet {
+namespace {
+
+constexpr double kFps = 60.0;
+constexpr double kDt = 1.0 / kFps;
+
+// Leader at the origin facing +Z; the follower beside him on his left (+X), facing +Z too. In
+// frames [contact_begin, contact_end) the follower's right wrist sits `grip` from the leader's left
+// wrist; otherwise the follower stands 2 m further left.
+struct Duet {
+  std::shared_ptr<const Skeleton> skeleton = test::make_humanoid();
+  JointRoles roles = test::humanoid_roles(*skeleton);
+  Clip leader;
+  Clip follower;
+  PartnerModel model;
+
+  Duet(int frames, int contact_begin, int contact_end, const Vec3& grip = Vec3::Zero())
+      : leader(test::make_standing_clip(skeleton, frames, kFps)),
+        follower(test::make_standing_clip(skeleton, frames, kFps)) {
+    const test::WorldPose rest = test::world_pose(leader, 0);
+    const Vec3 leader_left = rest.positions[wrist(Role::kLeftWrist)];
+    const Vec3 right_from_root = rest.positions[wrist(Role::kRightWrist)] - rest.positions[0];
+    for (int f = 0; f < frames; ++f) {
+      const bool touching = f >= contact_begin && f < contact_end;
+      follower.translations_ls(f)[0] =
+          leader_left + (touching ? grip : Vec3(2.0, 0, 0)) - right_from_root;
+    }
+    rebuild();
+  }
+  void rebuild() { model = PartnerModel::build(leader, roles, follower, roles).value(); }
+  std::size_t wrist(Role role) const { return static_cast<std::size_t>(roles[role]); }
+};
+
+UserPose user_from(const Clip& clip, int frame, const JointRoles& roles) {
+  const test::WorldPose w = test::world_pose(clip, frame);
+  return user_pose_from_world(w.positions, w.rotations, roles);
+}
+
+PartnerParams only(bool align, bool contact, bool smooth, bool foot_lock, bool blend) {
+  PartnerParams p;
+  p.align = align;
+  p.contact = contact;
+  p.smooth = smooth;
+  p.foot_lock = foot_lock;
+  p.blend = blend;
+  return p;
+}
+const PartnerParams kNone = only(false, false, false, false, false);
+
+struct Runner {
+  const PartnerModel& model;
+  PartnerParams params;
+  PartnerContext context{model.response_skeleton().joint_count()};
+  std::vector<Vec3> t;
+  std::vector<Quat> r;
+  PartnerFrameInfo info;
+
+  Runner(const PartnerModel& m, const PartnerParams& p) : model(m), params(p) {}
+
+  // Synthesises one frame from `pose` (the response pose to correct).
+  void step(int frame, std::span<const Vec3> pose_t, std::span<const Quat> pose_r,
+            const UserPose& user, bool jumped = false, double dt = kDt) {
+    t.resize(pose_t.size());
+    r.resize(pose_r.size());
+    PartnerSynthesisJob job;
+    job.model = &model;
+    job.params = &params;
+    job.frame = frame;
+    job.jumped = jumped;
+    job.dt_s = dt;
+    job.translations_ls = pose_t;
+    job.rotations_ls = pose_r;
+    job.user = &user;
+    job.context = &context;
+    job.translations_ls_out = t;
+    job.rotations_ls_out = r;
+    job.info = &info;
+    ASSERT_EQ(job.validate(), "");
+    ASSERT_TRUE(job.run());
+  }
+  void step(const Clip& response, int frame, const UserPose& user, bool jumped = false) {
+    step(frame, response.translations_ls(frame), response.rotations_ls(frame), user, jumped);
+  }
+  test::WorldPose world() const { return test::world_pose(model.response_skeleton(), t, r); }
+};
+
+TEST(PartnerSynthesis, AllSwitchesOffPassesThePoseThrough) {
+  Duet duet(120, 30, 90);
+  Runner run(duet.model, kNone);
+  std::mt19937 rng(1);
+  std::normal_distribution<double> n(0.0, 0.3);
+  for (int f = 0; f < 120; ++f) {
+    // Jittered input, jumps, a user elsewhere: nothing may change it.
+    Clip& c = duet.follower;
+    for (Quat& q : c.rotations_ls(f)) q = (q * exp_map(Vec3(n(rng), n(rng), n(rng)))).normalized();
+    UserPose user = user_from(duet.leader, f, duet.roles);
+    user.root_position_ws += Vec3(3, 0, 1);
+    run.step(c, f, user, f % 10 == 0);
+    for (int j = 0; j < c.joint_count(); ++j) {
+      ASSERT_EQ(run.t[static_cast<std::size_t>(j)],
+                c.translations_ls(f)[static_cast<std::size_t>(j)]);
+      ASSERT_EQ(run.r[static_cast<std::size_t>(j)].coeffs(),
+                c.rotations_ls(f)[static_cast<std::size_t>(j)].coeffs());
+    }
+  }
+}
+
+TEST(PartnerSynthesis, ValidateNamesTheMissingInput) {
+  Duet duet(10, 0, 0);
+  const PartnerParams params;
+  PartnerContext context(duet.model.response_skeleton().joint_count());
+  const UserPose user = user_from(duet.leader, 0, duet.roles);
+  std::vector<Vec3> t(duet.follower.translations_ls(0).begin(),
+                      duet.follower.translations_ls(0).end());
+  std::vector<Quat> r(duet.follower.rotations_ls(0).begin(), duet.follower.rotations_ls(0).end());
+  PartnerSynthesisJob full;
+  full.model = &duet.model;
+  full.params = &params;
+  full.frame = 3;
+  full.translations_ls = duet.follower.translations_ls(3);
+  full.rotations_ls = duet.follower.rotations_ls(3);
+  full.user = &user;
+  full.context = &context;
+  full.translations_ls_out = t;
+  full.rotations_ls_out = r;
+  ASSERT_EQ(full.validate(), "");
+
+  const auto expect_fails = [](const PartnerSynthesisJob& job, const char* what) {
+    const std::string_view reason = job.validate();
+    EXPECT_NE(reason.find(what), std::string_view::npos) << "reason: '" << reason << "'";
+    EXPECT_FALSE(job.run());
+  };
+  PartnerSynthesisJob job = full;
+  job.model = nullptr;
+  expect_fails(job, "model");
+  job = full;
+  job.params = nullptr;
+  expect_fails(job, "params");
+  job = full;
+  job.context = nullptr;
+  expect_fails(job, "context");
+  job = full;
+  job.frame = 10;
+  expect_fails(job, "frame");
+  job = full;
+  job.frame = -1;
+  expect_fails(job, "frame");
+  job = full;
+  job.translations_ls = {};
+  expect_fails(job, "translations_ls");
+  job = full;
+  job.rotations_ls = job.rotations_ls.first(3);
+  expect_fails(job, "rotations_ls");
+  job = full;
+  job.translations_ls_out = {};
+  expect_fails(job, "translations_ls_out");
+  job = full;
+  job.rotations_ls_out = {};
+  expect_fails(job, "rotations_ls_out");
+  job = full;
+  job.user = nullptr;
+  expect_fails(job, "user");
+  PartnerContext wrong(5);
+  job = full;
+  job.context = &wrong;
+  expect_fails(job, "context");
+  const PartnerModel empty;
+  job = full;
+  job.model = &empty;
+  expect_fails(job, "model");
+
+  // Without align and contact the user is not needed; the info output is optional.
+  const PartnerParams no_user = only(false, false, true, true, true);
+  job = full;
+  job.params = &no_user;
+  job.user = nullptr;
+  EXPECT_EQ(job.validate(), "");
+  EXPECT_TRUE(job.run());
+}
+
+TEST(PartnerSynthesis, AlignPlacesThePartnerRelativeToTheUser) {
+  Duet duet(60, 0, 0);
+  for (const bool align : {true, false}) {
+    Runner run(duet.model, only(align, false, false, false, false));
+    for (int f = 0; f < 60; ++f) {
+      // The user dances the leader's part 4 m away, turned by 1.1 rad.
+      const double yaw = 1.1;
+      const Vec3 place(4.0, 0.0, -2.0);
+      UserPose user = user_from(duet.leader, f, duet.roles);
+      user.root_position_ws = place + yaw_rotation(yaw) * user.root_position_ws;
+      user.root_rotation_ws = yaw_rotation(yaw) * user.root_rotation_ws;
+      run.step(duet.follower, f, user);
+      const Vec3 captured = duet.follower.translations_ls(f)[0];
+      if (align) {
+        const Vec3 expected = place + yaw_rotation(yaw) * captured;
+        EXPECT_LT((run.t[0] - expected).norm(), 1e-9);
+        EXPECT_NEAR(wrap_angle(heading_yaw(run.r[0]) - yaw), 0.0, 1e-9);
+      } else {
+        EXPECT_EQ(run.t[0], captured);
+      }
+    }
+  }
+}
+
+// The user holds the hand 10 cm higher than the captured leader did; contact IK sends the
+// partner's right wrist after it.
+TEST(PartnerSynthesis, ContactMovesThePartnersWristToTheUsersHand) {
+  const Vec3 grip(0.0, 0.0, 0.04);
+  Duet duet(240, 60, 180, grip);
+  const int left_right = hand_pair(Side::kLeft, Side::kRight);
+  ASSERT_TRUE(duet.model.contacts().in_contact(100, left_right));
+  const std::size_t wrist = duet.wrist(Role::kRightWrist);
+
+  for (const IkTarget target : {IkTarget::kCapturedOffset, IkTarget::kUserWrist}) {
+    for (const bool contact : {true, false}) {
+      SCOPED_TRACE(::testing::Message() << ik_target_name(target) << " contact " << contact);
+      PartnerParams params = only(true, contact, false, false, false);
+      params.ik_target = target;
+      Runner run(duet.model, params);
+      double previous_weight = 0.0;
+      for (int f = 0; f < 240; ++f) {
+        UserPose user = user_from(duet.leader, f, duet.roles);
+        user.wrist_positions_ws[0] += Vec3(0, 0.1, 0);
+        run.step(duet.follower, f, user);
+        const Vec3 goal =
+            user.wrist_positions_ws[0] +
+            (target == IkTarget::kCapturedOffset
+                 ? Vec3(user.wrist_rotations_ws[0] * duet.model.contacts().offset_ls(f, left_right))
+                 : Vec3::Zero());
+        const Vec3 partner_wrist = run.world().positions[wrist];
+        const double w = run.info.ik_weight[1];
+        if (!contact) {
+          EXPECT_EQ(w, 0.0);
+        } else if (f >= 60 && f < 74) {
+          EXPECT_GT(w, previous_weight);  // fading in over ik_fade_s = 0.25 s = 15 frames
+          EXPECT_LT(w, 1.0);
+        } else if (f >= 74 && f < 180) {
+          EXPECT_EQ(w, 1.0);
+          EXPECT_LT((partner_wrist - goal).norm(), 1e-6) << f;
+          EXPECT_LT(run.info.ik_error_m[1], 1e-6);
+        } else if (f >= 180 && f < 195) {
+          EXPECT_LT(w, previous_weight);  // fading out
+        } else {
+          EXPECT_EQ(w, 0.0) << f;
+        }
+        EXPECT_EQ(run.info.ik_weight[0], 0.0);  // the left hand holds nothing
+        if (!contact && f >= 75 && f < 180) {
+          EXPECT_NEAR((partner_wrist - goal).norm(), 0.1, 0.02) << f;  // left where captured
+        }
+        previous_weight = w;
+      }
+    }
+  }
+}
+
+TEST(PartnerSynthesis, SmoothDampsJitter) {
+  Duet duet(120, 0, 0);
+  const std::size_t elbow = static_cast<std::size_t>(duet.roles[Role::kLeftElbow]);
+  for (const bool smooth : {true, false}) {
+    Runner run(duet.model, only(false, false, smooth, false, false));
+    double largest_step = 0.0;
+    Quat previous = Quat::Identity();
+    for (int f = 0; f < 120; ++f) {
+      std::vector<Vec3> t(duet.follower.translations_ls(f).begin(),
+                          duet.follower.translations_ls(f).end());
+      std::vector<Quat> r(duet.follower.rotations_ls(f).begin(),
+                          duet.follower.rotations_ls(f).end());
+      r[elbow] = r[elbow] * quat_from_axis_angle(Vec3::UnitX(), f % 2 ? 0.2 : -0.2);  // flicker
+      run.step(f, t, r, user_from(duet.leader, f, duet.roles));
+      if (f > 60) largest_step = std::max(largest_step, run.r[elbow].angularDistance(previous));
+      previous = run.r[elbow];
+    }
+    if (smooth) {
+      EXPECT_LT(largest_step, 0.2);  // the input steps by 0.4 rad every frame
+    } else {
+      EXPECT_NEAR(largest_step, 0.4, 1e-9);
+    }
+  }
+}
+
+TEST(PartnerSynthesis, BlendHidesAJump) {
+  Duet duet(220, 0, 0);
+  // Frames >= 100 of the response have the arms and root elsewhere (another part of the dance).
+  for (int f = 100; f < 220; ++f) {
+    for (Quat& q : duet.follower.rotations_ls(f)) q = quat_from_axis_angle(Vec3::UnitZ(), 0.9) * q;
+    duet.follower.translations_ls(f)[0] += Vec3(0.3, 0, 0.2);
+  }
+  duet.rebuild();
+  const std::size_t shoulder = static_cast<std::size_t>(duet.roles[Role::kLeftShoulder]);
+  for (const bool blend : {true, false}) {
+    Runner run(duet.model, only(true, false, false, false, blend));
+    Quat previous_r = Quat::Identity();
+    Vec3 previous_t = Vec3::Zero();
+    double largest_turn = 0.0, largest_move = 0.0;
+    // Frames 0..49, then the follower jumps to frame 120.
+    for (int i = 0; i < 140; ++i) {
+      const int frame = i < 50 ? i : 70 + i;
+      const UserPose user = user_from(duet.leader, i, duet.roles);
+      run.step(duet.follower, frame, user, i == 50);
+      if (i > 0) {
+        largest_turn = std::max(largest_turn, run.r[shoulder].angularDistance(previous_r));
+        largest_move = std::max(largest_move, (run.t[0] - previous_t).norm());
+      }
+      previous_r = run.r[shoulder];
+      previous_t = run.t[0];
+    }
+    const Quat expected = duet.follower.rotations_ls(70 + 139)[shoulder];
+    if (blend) {
+      EXPECT_LT(largest_turn, 0.15);  // instead of 0.9 rad in one frame
+      EXPECT_LT(largest_move, 0.06);  // instead of 0.36 m
+      EXPECT_LT(run.r[shoulder].angularDistance(expected), 1e-4);  // converged
+      EXPECT_LT(run.info.blend_offset_rad, 1e-4);
+    } else {
+      EXPECT_NEAR(largest_turn, 0.9, 1e-9);
+    }
+  }
+}
+
+TEST(PartnerSynthesis, FootLockHoldsASlidingFoot) {
+  Duet duet(120, 0, 0);
+  // The captured follower slides sideways at 0.1 m/s with her feet on the floor.
+  for (int f = 0; f < 120; ++f) duet.follower.translations_ls(f)[0] += Vec3(0.1 * f * kDt, 0, 0);
+  duet.rebuild();
+  const std::size_t toe = static_cast<std::size_t>(duet.roles[Role::kLeftToe]);
+  double travel[2] = {0, 0};
+  for (const bool lock : {true, false}) {
+    Runner run(duet.model, only(false, false, false, lock, false));
+    Vec3 first = Vec3::Zero();
+    for (int f = 0; f < 60; ++f) {
+      run.step(duet.follower, f, user_from(duet.leader, f, duet.roles));
+      const Vec3 foot = run.world().positions[toe];
+      if (f == 0) first = foot;
+      travel[lock ? 0 : 1] = (foot - first).norm();
+      if (lock && f > 0) {
+        EXPECT_TRUE(run.info.foot_locked[0]);
+      }
+    }
+  }
+  EXPECT_NEAR(travel[1], 0.1 * 59 * kDt, 1e-9);
+  EXPECT_LT(travel[0], 0.1 * travel[1]);
+}
+
+TEST(PartnerSynthesis, AllCorrectionsOnStayFiniteUnderRandomInput) {
+  Duet duet(300, 50, 150, Vec3(0.02, 0.0, 0.05));
+  Runner run(duet.model, PartnerParams{});
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> frame_of(0, 299);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> n(0.0, 1.0);
+  int frame = 0;
+  for (int i = 0; i < 3000; ++i) {
+    bool jumped = false;
+    if (u(rng) < 0.05) {
+      frame = frame_of(rng);
+      jumped = true;
+    } else {
+      frame = std::min(frame + 1, 299);
+    }
+    UserPose user = user_from(duet.leader, frame, duet.roles);
+    user.root_position_ws += Vec3(n(rng), 0.0, n(rng)) * 0.05;
+    user.wrist_positions_ws[0] += Vec3(n(rng), n(rng), n(rng)) * 0.3;  // sometimes out of reach
+    if (u(rng) < 0.02) user.root_position_ws.x() = std::nan("");       // lost tracking
+    if (u(rng) < 0.02) user.wrist_positions_ws[0].y() = INFINITY;
+    const double dt = u(rng) < 0.05 ? 0.0 : kDt * (0.5 + u(rng));  // late and repeated frames
+    run.step(frame, duet.follower.translations_ls(frame), duet.follower.rotations_ls(frame), user,
+             jumped, dt);
+    for (std::size_t j = 0; j < run.t.size(); ++j) {
+      ASSERT_TRUE(run.t[j].allFinite()) << "frame " << i << " joint " << j;
+      ASSERT_TRUE(run.r[j].coeffs().allFinite()) << "frame " << i << " joint " << j;
+      ASSERT_NEAR(run.r[j].norm(), 1.0, 1e-9);
+    }
+  }
+}
+
+TEST(PartnerSynthesis, OutputMayAliasTheInput) {
+  Duet duet(120, 20, 100, Vec3(0, 0, 0.03));
+  Runner separate(duet.model, PartnerParams{});
+  Runner in_place(duet.model, PartnerParams{});
+  for (int f = 0; f < 120; ++f) {
+    const UserPose user = user_from(duet.leader, f, duet.roles);
+    separate.step(duet.follower, f, user);
+    std::vector<Vec3> t(duet.follower.translations_ls(f).begin(),
+                        duet.follower.translations_ls(f).end());
+    std::vector<Quat> r(duet.follower.rotations_ls(f).begin(), duet.follower.rotations_ls(f).end());
+    PartnerSynthesisJob job;
+    job.model = &duet.model;
+    job.params = &in_place.params;
+    job.frame = f;
+    job.dt_s = kDt;
+    job.translations_ls = t;
+    job.rotations_ls = r;
+    job.user = &user;
+    job.context = &in_place.context;
+    job.translations_ls_out = t;
+    job.rotations_ls_out = r;
+    ASSERT_TRUE(job.run());
+    for (std::size_t j = 0; j < t.size(); ++j) {
+      ASSERT_LT((t[j] - separate.t[j]).norm(), 1e-12);
+      ASSERT_LT(r[j].angularDistance(separate.r[j]), 1e-9);
+    }
+  }
+}
+
+TEST(PartnerSynthesis, ResetForgetsThePast) {
+  Duet duet(60, 0, 60);
+  Runner run(duet.model, PartnerParams{});
+  for (int f = 0; f < 30; ++f) run.step(duet.follower, f, user_from(duet.leader, f, duet.roles));
+  EXPECT_GT(run.info.ik_weight[1], 0.0);
+  run.context.reset();
+  run.step(duet.follower, 30, user_from(duet.leader, 30, duet.roles));
+  EXPECT_LT(run.info.ik_weight[1], 0.1);  // fading in again
+}
+
+TEST(PartnerModel, BuildChecksTheResponseRoles) {
+  Duet duet(10, 0, 0);
+  JointRoles broken = duet.roles;
+  // The right arm chain upside down.
+  broken.joints[static_cast<std::size_t>(Role::kRightShoulder)] = duet.roles[Role::kRightWrist];
+  broken.joints[static_cast<std::size_t>(Role::kRightWrist)] = duet.roles[Role::kRightShoulder];
+  const Result<PartnerModel> r =
+      PartnerModel::build(duet.leader, duet.roles, duet.follower, broken);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("not a chain"), std::string::npos) << r.error().message;
+
+  JointRoles no_toe = duet.roles;
+  no_toe.joints[static_cast<std::size_t>(Role::kLeftToe)] = -1;
+  const Result<PartnerModel> t =
+      PartnerModel::build(duet.leader, duet.roles, duet.follower, no_toe);
+  ASSERT_FALSE(t.ok());
+  EXPECT_NE(t.error().message.find("left_toe"), std::string::npos) << t.error().message;
+
+  const Clip shorter = test::make_standing_clip(duet.skeleton, 9, kFps);
+  EXPECT_FALSE(PartnerModel::build(duet.leader, duet.roles, shorter, duet.roles).ok());
+
+  const PartnerModel& m = duet.model;
+  EXPECT_EQ(m.frame_count(), 10);
+  EXPECT_DOUBLE_EQ(m.frame_rate(), kFps);
+  EXPECT_NEAR(m.foot_ground_height(Side::kLeft), 0.02, 1e-9);  // the standing toe height
+}
+
+TEST(PartnerParams, ValidateAndParse) {
+  PartnerParams p;
+  EXPECT_EQ(p.validate(), "");
+  p.blend_half_life_s = -1.0;
+  EXPECT_NE(p.validate().find("blend_half_life_s"), std::string::npos);
+  p = PartnerParams();
+  p.foot.max_offset_m = NAN;
+  EXPECT_NE(p.validate().find("foot.max_offset_m"), std::string::npos);
+
+  p = PartnerParams();
+  EXPECT_EQ(corrections_string(p), "align,contact,smooth,footlock,blend");
+  ASSERT_TRUE(parse_corrections("align,blend", p).ok());
+  EXPECT_TRUE(p.align && p.blend && !p.contact && !p.smooth && !p.foot_lock);
+  EXPECT_EQ(corrections_string(p), "align,blend");
+  ASSERT_TRUE(parse_corrections("none", p).ok());
+  EXPECT_EQ(corrections_string(p), "none");
+  ASSERT_TRUE(parse_corrections("all", p).ok());
+  EXPECT_EQ(corrections_string(p), "align,contact,smooth,footlock,blend");
+  const Status bad = parse_corrections("align,ik", p);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("'ik'"), std::string::npos);
+  EXPECT_TRUE(p.contact);  // untouched on error
+
+  IkTarget target = IkTarget::kCapturedOffset;
+  EXPECT_TRUE(parse_ik_target("wrist", target));
+  EXPECT_EQ(target, IkTarget::kUserWrist);
+  EXPECT_FALSE(parse_ik_target("elbow", target));
+  EXPECT_STREQ(ik_target_name(IkTarget::kCapturedOffset), "offset");
+}
+
+TEST(UserPose, FromWorld) {
+  const auto skeleton = test::make_humanoid();
+  const JointRoles roles = test::humanoid_roles(*skeleton);
+  Clip clip = test::make_standing_clip(skeleton, 1);
+  test::set_root(clip, 0, Vec3(1, 0.9, 2), 0.5);
+  const test::WorldPose w = test::world_pose(clip, 0);
+  const UserPose user = user_pose_from_world(w.positions, w.rotations, roles);
+  EXPECT_EQ(user.root_position_ws, Vec3(1, 0.9, 2));
+  EXPECT_EQ(user.wrist_positions_ws[1],
+            w.positions[static_cast<std::size_t>(roles[Role::kRightWrist])]);
+  EXPECT_TRUE(user.wrist_rotations_ws[0].isApprox(
+      w.rotations[static_cast<std::size_t>(roles[Role::kLeftWrist])]));
+}
+
+}  // namespace
+}  // namespace duet
