@@ -1,0 +1,126 @@
+// The follower of method.md 4: an HMM over the template frames with a pause state N through which
+// the dancer can jump anywhere in the library, updated by the O(M) forward step of eq. 11.
+//
+// Three pieces, ozz-animation style:
+//   HmmForward      the per-frame algorithm: constants derived once from the model and the
+//                   parameters; step() reads a context and writes a result.
+//   ForwardContext  everything kept between frames (alpha and scratch buffers), sized once.
+//   HmmFollower     both together behind the Tracker interface.
+// The model must outlive every HmmForward / HmmFollower built on it (they keep a pointer).
+#pragma once
+
+#include <span>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "duet/base/result.h"
+#include "duet/follow/follow_params.h"
+#include "duet/follow/template_model.h"
+#include "duet/follow/tracker.h"
+
+namespace duet {
+
+// State between frames. alpha has M + 1 entries: the template states, then the pause state N.
+// Float on purpose: the step streams alpha and the features every frame (memory bandwidth);
+// alpha is renormalised every frame so float's range is never approached. Only the running
+// log-likelihood, a sum over the whole performance, is kept in double.
+class ForwardContext {
+ public:
+  ForwardContext() = default;
+  // Sizes the buffers for num_states template states and resets. Allocates.
+  explicit ForwardContext(int num_states) { resize(num_states); }
+  void resize(int num_states);
+
+  // Initial distribution: uniform over the template states (the dancer may start anywhere in the
+  // library), nothing in the pause state.
+  void reset() noexcept;
+
+  int num_states() const { return num_states_; }
+  // The normalised forward variable after the last step (posterior over M + 1 states).
+  std::span<const float> alpha() const { return alpha_; }
+  double total_log_likelihood() const { return total_log_likelihood_; }
+  long long frames() const { return frames_; }
+
+ private:
+  friend class HmmForward;
+
+  int num_states_ = 0;
+  std::vector<float> alpha_;        // M + 1
+  std::vector<float> scratch_;      // M + 1, the next alpha while a transition is applied
+  std::vector<float> distance_sq_;  // M, ||phi_t - phi_i||^2 of the current frame
+  double total_log_likelihood_ = 0.0;
+  long long frames_ = 0;
+  int previous_state_ = -1;
+  bool previous_lost_ = false;
+};
+
+class HmmForward {
+ public:
+  // Validates params against the model. Allocates (only for non-uniform resume weights).
+  static Result<HmmForward> create(const TemplateModel& model, const FollowParams& params);
+
+  // One input frame (see Tracker::step for features and dt_s). The context must have been sized
+  // for this model. Allocates nothing, throws nothing.
+  FollowResult step(std::span<const float> features, double dt_s,
+                    ForwardContext& context) const noexcept;
+
+  // Template-rate transitions applied for an input frame dt_s after the previous one.
+  int steps_for(double dt_s) const noexcept;
+
+  const TemplateModel& model() const { return *model_; }
+  const FollowParams& params() const { return params_; }
+
+  // Normalised transition probabilities out of template state j (used by tests and docs):
+  // band[d] = B(j -> j + d) for d = 0, 1, 2 (0 where j + d leaves the take) and leave = A(j -> N)
+  // (eq. 4-5, including the band mass that the end of a take sends into the pause state).
+  struct Row {
+    float band[3];
+    float leave;
+  };
+  Row row(int j) const noexcept;
+  // A(N -> N) and A(N -> i) (eq. 6).
+  float pause_stay() const { return pause_stay_; }
+  float resume(int i) const noexcept;
+
+ private:
+  HmmForward() = default;
+  // alpha_{t-1} -> sum_j alpha_{t-1}(j) A(j -> i) for every i, in O(M) (the bracket of eq. 11).
+  void transition(const float* alpha, float* next) const noexcept;
+
+  const TemplateModel* model_ = nullptr;
+  FollowParams params_;
+  float self_ = 0.0f, next_ = 0.0f, skip_ = 0.0f, leave_ = 0.0f;  // normalised, interior rows
+  float pause_stay_ = 0.0f;
+  std::vector<float> resume_;  // R_i, normalised; empty = uniform 1/M
+  float inv_two_sigma_sq_ = 0.0f;
+  float log_pause_emission_ = 0.0f;
+  float lost_distance_sq_ = 0.0f;
+};
+
+// HmmForward + ForwardContext behind the Tracker interface. FollowParams::left_to_right() gives
+// the left-to-right baseline.
+class HmmFollower final : public Tracker {
+ public:
+  static Result<HmmFollower> create(const TemplateModel& model, const FollowParams& params);
+
+  void reset() noexcept override { context_.reset(); }
+  FollowResult step(std::span<const float> features, double dt_s) noexcept override {
+    return forward_.step(features, dt_s, context_);
+  }
+  std::string_view name() const noexcept override {
+    return forward_.params().jump_enabled ? "hmm" : "left_to_right_hmm";
+  }
+
+  const HmmForward& forward() const { return forward_; }
+  const ForwardContext& context() const { return context_; }
+
+ private:
+  HmmFollower(HmmForward forward, ForwardContext context)
+      : forward_(std::move(forward)), context_(std::move(context)) {}
+
+  HmmForward forward_;
+  ForwardContext context_;
+};
+
+}  // namespace duet

@@ -1,0 +1,56 @@
+// The template library the follower matches against: one feature vector per template frame, the
+// take boundaries and the template frame rate. Built offline (may allocate, returns errors);
+// immutable afterwards and shared read-only by every tracker and context.
+//
+// The follow module knows vectors, not skeletons: the features arrive already standardised and
+// weighted (method.md 3) from the features module.
+#pragma once
+
+#include <Eigen/Core>
+#include <span>
+#include <vector>
+
+#include "duet/base/result.h"
+
+namespace duet {
+
+// Row i is the feature vector phi_i of template state i. Row-major float: the per-frame emission
+// streams through every row once, so rows must be contiguous and small (27k x 60 floats = 6.5 MB).
+using FeatureMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+class TemplateModel {
+ public:
+  // features: M x D, one row per template frame, several takes concatenated (a library, method.md
+  //   1 "beyond"). Must be non-empty and finite.
+  // take_start: first state of each take, strictly increasing, starting at 0, each < M; take k
+  //   covers states [take_start[k], take_start[k+1]) and the last take ends at M. Empty means one
+  //   take.
+  // frame_rate_hz: rate of the template frames (the HMM runs at this rate), > 0.
+  static Result<TemplateModel> build(FeatureMatrix features, std::vector<int> take_start,
+                                     double frame_rate_hz);
+  // Same, from a row-major buffer of num_frames * num_dims floats (copied).
+  static Result<TemplateModel> build(std::span<const float> features_row_major, int num_frames,
+                                     int num_dims, std::vector<int> take_start,
+                                     double frame_rate_hz);
+
+  int num_states() const { return static_cast<int>(features_.rows()); }  // M
+  int num_dims() const { return static_cast<int>(features_.cols()); }    // D
+  int num_takes() const { return static_cast<int>(take_start_.size()) - 1; }
+  double frame_rate_hz() const { return frame_rate_hz_; }
+
+  const FeatureMatrix& features() const { return features_; }
+  // First state of take k, and one past its last state.
+  int take_begin(int take) const { return take_start_[static_cast<std::size_t>(take)]; }
+  int take_end(int take) const { return take_start_[static_cast<std::size_t>(take) + 1]; }
+  // The take that contains state (O(log takes)); state must be in [0, M).
+  int take_of(int state) const;
+
+ private:
+  TemplateModel() = default;
+
+  FeatureMatrix features_;
+  std::vector<int> take_start_;  // num_takes + 1 entries; the last one is M
+  double frame_rate_hz_ = 0.0;
+};
+
+}  // namespace duet

@@ -1,0 +1,57 @@
+// The interface every follower implements (the HMM with the jump and the baselines of
+// method.md 7), so the evaluation and the live session can swap them.
+#pragma once
+
+#include <span>
+#include <string_view>
+
+namespace duet {
+
+// What one input frame tells about the dancer's place in the template library.
+struct FollowResult {
+  int state = -1;           // estimated template state (global index in [0, M)); eq. 8-9
+  int take = -1;            // the take that contains state
+  int frame_in_take = -1;   // state - first state of that take
+  float confidence = 0.0f;  // posterior mass within the confidence window around state, [0, 1]
+  // The estimate moved by something other than 0..2n frames forward within its take (n = steps),
+  // or changed take. False on the first frame after reset().
+  bool jumped = false;
+  bool lost = false;      // no template frame explains the input (see FollowParams)
+  bool in_pause = false;  // the pause state holds most of the posterior mass
+  bool missing = false;   // the input held NaN/inf: transition only, no emission
+  int steps = 0;          // template-rate transitions applied for this frame
+  // log p(phi_t | phi_1..t-1), up to the Gaussian's constant normaliser; 0 for missing frames.
+  // Trackers that are not probabilistic report the negative best distance / (2 sigma^2).
+  double log_likelihood = 0.0;
+  // min_i ||phi - phi_i||^2 / D over all states (online DTW: over its window); -1 if missing.
+  float best_distance_per_dim = 0.0f;
+};
+
+// A per-frame follower. step() is the live path: it allocates nothing, throws nothing and does no
+// I/O; all buffers are sized when the tracker is created.
+class Tracker {
+ public:
+  virtual ~Tracker() = default;
+
+  // Forget the past: the next step starts from the initial distribution.
+  virtual void reset() noexcept = 0;
+
+  // features: one input frame, D floats, computed like the template's (method.md 3). A frame
+  //   with NaN or inf is treated as missing. A size other than D is a broken contract (asserts;
+  //   treated as missing in release builds).
+  // dt_s: time since the previous input frame in seconds (the input rate may differ from the
+  //   template's, frames may be late); <= 0 or non-finite counts as one template frame.
+  virtual FollowResult step(std::span<const float> features, double dt_s) noexcept = 0;
+
+  virtual std::string_view name() const noexcept = 0;
+
+ protected:
+  // Copy and move only through concrete trackers (no slicing through a Tracker&).
+  Tracker() = default;
+  Tracker(const Tracker&) = default;
+  Tracker& operator=(const Tracker&) = default;
+  Tracker(Tracker&&) = default;
+  Tracker& operator=(Tracker&&) = default;
+};
+
+}  // namespace duet

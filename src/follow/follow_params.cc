@@ -1,0 +1,86 @@
+#include "duet/follow/follow_params.h"
+
+#include <cmath>
+#include <string>
+
+namespace duet {
+namespace {
+
+Error params_error(const std::string& reason) { return make_error("follow parameters", 0, reason); }
+
+bool is_probability(float p) { return std::isfinite(p) && p >= 0.0f && p <= 1.0f; }
+
+}  // namespace
+
+FollowParams FollowParams::paper() {
+  FollowParams params;
+  params.self_prob = 0.33f;
+  params.next_prob = 0.33f;
+  params.skip_prob = 0.0f;
+  params.leave_prob = 0.165f;
+  params.pause_stay_prob = 1.0f - 0.165f;
+  return params;
+}
+
+FollowParams FollowParams::left_to_right() {
+  FollowParams params;
+  params.jump_enabled = false;
+  return params;
+}
+
+Status FollowParams::validate(int num_states) const {
+  const struct {
+    const char* name;
+    float value;
+  } probabilities[] = {{"self_prob", self_prob},
+                       {"next_prob", next_prob},
+                       {"skip_prob", skip_prob},
+                       {"leave_prob", leave_prob},
+                       {"pause_stay_prob", pause_stay_prob}};
+  for (const auto& p : probabilities) {
+    if (!is_probability(p.value)) {
+      return params_error(std::string(p.name) + " must be in [0, 1], got " +
+                          std::to_string(p.value));
+    }
+  }
+  const float band = self_prob + next_prob + skip_prob;
+  if (band <= 0.0f) return params_error("self_prob + next_prob + skip_prob must be positive");
+  if (!(emission_sigma >= 1e-3f && std::isfinite(emission_sigma))) {
+    return params_error("emission_sigma must be finite and >= 0.001, got " +
+                        std::to_string(emission_sigma));
+  }
+  if (!(pause_distance_per_dim >= 0.0f && std::isfinite(pause_distance_per_dim))) {
+    return params_error("pause_distance_per_dim must be finite and >= 0, got " +
+                        std::to_string(pause_distance_per_dim));
+  }
+  if (!(lost_distance_per_dim >= 0.0f)) {  // +inf allowed: never lost by distance
+    return params_error("lost_distance_per_dim must be >= 0, got " +
+                        std::to_string(lost_distance_per_dim));
+  }
+  if (confidence_window_frames < 0) {
+    return params_error("confidence_window_frames must be >= 0, got " +
+                        std::to_string(confidence_window_frames));
+  }
+  if (max_steps_per_frame < 1 || max_steps_per_frame > 1000) {
+    return params_error("max_steps_per_frame must be in [1, 1000], got " +
+                        std::to_string(max_steps_per_frame));
+  }
+  if (!resume_weights.empty()) {
+    if (static_cast<int>(resume_weights.size()) != num_states) {
+      return params_error("resume_weights has " + std::to_string(resume_weights.size()) +
+                          " entries, the template has " + std::to_string(num_states) + " states");
+    }
+    double sum = 0.0;
+    for (std::size_t i = 0; i < resume_weights.size(); ++i) {
+      if (!(resume_weights[i] >= 0.0f && std::isfinite(resume_weights[i]))) {
+        return params_error("resume_weights[" + std::to_string(i) +
+                            "] must be finite and >= 0, got " + std::to_string(resume_weights[i]));
+      }
+      sum += resume_weights[i];
+    }
+    if (!(sum > 0.0)) return params_error("resume_weights sum to zero");
+  }
+  return Ok{};
+}
+
+}  // namespace duet

@@ -1,0 +1,151 @@
+#include "forward_common.h"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cassert>
+#include <cfloat>
+#include <cmath>
+#include <limits>
+
+namespace duet::follow_detail {
+namespace {
+
+using ArrayMap = Eigen::Map<Eigen::ArrayXf>;
+using ConstArrayMap = Eigen::Map<const Eigen::ArrayXf>;
+
+// Below this the fast path's normaliser has lost too many bits (float normals end at 1.2e-38).
+constexpr double kMinNormaliser = 1e-30;
+
+}  // namespace
+
+bool all_finite(std::span<const float> values) noexcept {
+  // x - x is 0 for finite x and NaN for inf or NaN; one pass, vectorised.
+  float acc = 0.0f;
+  for (const float v : values) acc += v - v;
+  return acc == 0.0f;
+}
+
+int steps_for(double dt_s, double template_fps, int max_steps) noexcept {
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) return 1;
+  const double n = std::round(dt_s * template_fps);
+  if (!(n >= 1.0)) return 1;
+  if (n >= static_cast<double>(max_steps)) return max_steps;
+  return static_cast<int>(n);
+}
+
+float squared_distances(const FeatureMatrix& features, const float* phi, int begin, int end,
+                        float* out) noexcept {
+  const Eigen::Index dims = features.cols();
+  const Eigen::Map<const Eigen::RowVectorXf> query(phi, dims);
+  float best = FLT_MAX;
+  // Rows are contiguous (row-major), so each distance is one vectorised reduction over D floats.
+  for (int i = begin; i < end; ++i) {
+    float d2 = (features.row(i) - query).squaredNorm();
+    d2 = std::min(d2, FLT_MAX);  // inf (overflow) saturates; NaN is impossible for finite input
+    out[i - begin] = d2;
+    best = std::min(best, d2);
+  }
+  return best;
+}
+
+double weigh_and_normalise(const float* predicted, const float* distance_sq, float best_distance_sq,
+                           float inv_two_sigma_sq, int num_states, float log_b_pause,
+                           bool with_pause, float* out) noexcept {
+  const ConstArrayMap pred(predicted, num_states);
+  const ConstArrayMap d2(distance_sq, num_states);
+  ArrayMap post(out, num_states);
+
+  const float max_template = log_emission(best_distance_sq, inv_two_sigma_sq);
+  const float shift = with_pause ? std::max(max_template, log_b_pause) : max_template;
+  // One fused, vectorised pass: log-emission, shift, exp, times the prediction.
+  post = pred * ((d2 * -inv_two_sigma_sq).max(kMinLogEmission) - shift).exp();
+  float pause = with_pause ? predicted[num_states] * std::exp(log_b_pause - shift) : 0.0f;
+  double sum = static_cast<double>(post.sum()) + pause;
+  double log_c = static_cast<double>(shift);
+
+  if (!(sum >= kMinNormaliser)) {
+    // Slow path, rare: shift by the largest log(predicted * b) instead. Relative to
+    // max_template first so that floored log-emissions (-1e30) keep their predicted ratios.
+    auto relative = [&](int i) {
+      return static_cast<double>(log_emission(distance_sq[i], inv_two_sigma_sq) - max_template) +
+             std::log(static_cast<double>(predicted[i]));
+    };
+    double best = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < num_states; ++i) {
+      if (predicted[i] > 0.0f) best = std::max(best, relative(i));
+    }
+    const bool pause_has_mass = with_pause && predicted[num_states] > 0.0f;
+    const double pause_term = pause_has_mass
+                                  ? static_cast<double>(log_b_pause - max_template) +
+                                        std::log(static_cast<double>(predicted[num_states]))
+                                  : -std::numeric_limits<double>::infinity();
+    best = std::max(best, pause_term);
+    if (!std::isfinite(best)) {
+      // No predicted mass anywhere: a broken invariant. Start over from uniform.
+      assert(false && "forward variable lost all its mass");
+      post.setConstant(1.0f / static_cast<float>(num_states));
+      out[num_states] = 0.0f;
+      return static_cast<double>(shift);
+    }
+    sum = 0.0;
+    for (int i = 0; i < num_states; ++i) {
+      const double term = predicted[i] > 0.0f ? std::exp(relative(i) - best) : 0.0;
+      post[i] = static_cast<float>(term);
+      sum += term;
+    }
+    pause = pause_has_mass ? static_cast<float>(std::exp(pause_term - best)) : 0.0f;
+    sum += pause;
+    log_c = best + static_cast<double>(max_template);
+  }
+
+  const float scale = static_cast<float>(1.0 / sum);
+  post *= scale;
+  out[num_states] = pause * scale;
+  return std::log(sum) + log_c;
+}
+
+void normalise(float* mass, int count, int uniform_count) noexcept {
+  ArrayMap m(mass, count);
+  const float sum = m.sum();
+  if (sum > 0.0f && std::isfinite(sum)) {
+    m *= 1.0f / sum;
+    return;
+  }
+  assert(false && "forward variable lost all its mass");
+  m.setZero();
+  m.head(uniform_count).setConstant(1.0f / static_cast<float>(uniform_count));
+}
+
+bool is_jump(const TemplateModel& model, int previous_state, int state, int steps) noexcept {
+  if (previous_state < 0) return false;
+  const int moved = state - previous_state;
+  if (moved < 0 || moved > 2 * steps) return true;
+  return model.take_of(previous_state) != model.take_of(state);
+}
+
+void decide(const TemplateModel& model, const float* posterior, float total, float pause_mass,
+            int previous_state, int steps, int window, FollowResult& result) noexcept {
+  const int num_states = model.num_states();
+  int state = 0;
+  float best = posterior[0];
+  for (int i = 1; i < num_states; ++i) {
+    if (posterior[i] > best) {
+      best = posterior[i];
+      state = i;
+    }
+  }
+  const int take = model.take_of(state);
+  const int begin = std::max(model.take_begin(take), state - window);
+  const int end = std::min(model.take_end(take), state + window + 1);
+  float mass = 0.0f;
+  for (int i = begin; i < end; ++i) mass += posterior[i];
+
+  result.state = state;
+  result.take = take;
+  result.frame_in_take = state - model.take_begin(take);
+  result.confidence = total > 0.0f ? std::clamp(mass / total, 0.0f, 1.0f) : 0.0f;
+  result.in_pause = pause_mass > 0.5f * total;
+  result.jumped = is_jump(model, previous_state, state, steps);
+}
+
+}  // namespace duet::follow_detail

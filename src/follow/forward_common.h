@@ -1,0 +1,82 @@
+// Pieces shared by the HMM follower and its baselines: emissions, normalisation, decisions.
+// All of them are on the per-frame path: no allocation, no exceptions.
+#pragma once
+
+#include <span>
+
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
+#include "duet/follow/template_model.h"
+#include "duet/follow/tracker.h"
+
+namespace duet::follow_detail {
+
+// Floor for log-emissions: keeps -d^2 / (2 sigma^2) finite when d^2 overflows float, so that
+// (log_b - max) never becomes -inf - -inf = NaN.
+inline constexpr float kMinLogEmission = -1e30f;
+
+// Flushes denormal floats to zero (FTZ and DAZ) for the lifetime of the object and restores the
+// caller's floating-point mode afterwards. The emissions of far states are exp(-large), whose
+// denormal results cost ~100 cycles each: this halves the step at 27k states. Mass below
+// 1.2e-38 becomes exactly 0, which the pause state's resume path makes harmless.
+class ScopedFlushDenormals {
+ public:
+#if defined(__SSE2__)
+  ScopedFlushDenormals() noexcept : saved_(_mm_getcsr()) { _mm_setcsr(saved_ | kFtzDaz); }
+  ~ScopedFlushDenormals() { _mm_setcsr(saved_); }
+
+ private:
+  static constexpr unsigned kFtzDaz = 0x8040;  // MXCSR flush-to-zero | denormals-are-zero
+  unsigned saved_;
+#endif
+ public:
+  ScopedFlushDenormals(const ScopedFlushDenormals&) = delete;
+  ScopedFlushDenormals& operator=(const ScopedFlushDenormals&) = delete;
+};
+
+bool all_finite(std::span<const float> values) noexcept;
+
+// n = clamp(round(dt_s * template_fps), 1, max_steps); dt_s <= 0 or non-finite gives 1.
+int steps_for(double dt_s, double template_fps, int max_steps) noexcept;
+
+// out[i - begin] = ||phi - phi_i||^2 for template rows i in [begin, end), saturated at FLT_MAX.
+// Returns the minimum. phi has model.num_dims() finite values.
+float squared_distances(const FeatureMatrix& features, const float* phi, int begin, int end,
+                        float* out) noexcept;
+
+// log b = max(-d^2 * inv_two_sigma_sq, kMinLogEmission) (eq. 7, without its constant).
+inline float log_emission(float distance_sq, float inv_two_sigma_sq) noexcept {
+  const float log_b = -distance_sq * inv_two_sigma_sq;
+  return log_b > kMinLogEmission ? log_b : kMinLogEmission;
+}
+
+// The outer factor of eq. 10/11 and the normalisation:
+//   out_i = predicted_i * b_i / c,   c = sum_i predicted_i * b_i,
+// over num_states template states plus, if with_pause, the pause state at index num_states
+// (predicted and out have num_states + 1 entries; without the pause out[num_states] = 0).
+// distance_sq holds d_i^2 and best_distance_sq their minimum. The exponentials are taken after
+// subtracting the largest log-emission, so the best state's factor is exactly 1. If c still
+// underflows (all the predicted mass sits on states with tiny emissions), the frame is redone
+// with the exact shift max_i(log b_i + log predicted_i), which makes the largest term 1.
+// Returns log c in absolute terms: log p(phi_t | phi_1..t-1) up to the Gaussian's constant.
+double weigh_and_normalise(const float* predicted, const float* distance_sq, float best_distance_sq,
+                           float inv_two_sigma_sq, int num_states, float log_b_pause,
+                           bool with_pause, float* out) noexcept;
+
+// Rescales mass[0..count) to sum to 1; a zero or non-finite sum (a broken invariant) becomes
+// uniform over the first uniform_count entries.
+void normalise(float* mass, int count, int uniform_count) noexcept;
+
+// Fills state (argmax of posterior over the M template states, eq. 8-9), take, frame_in_take,
+// confidence (mass within +/- window frames in the same take, divided by total), in_pause
+// (pause_mass > 0.5) and jumped (relative to previous_state, -1 for none).
+void decide(const TemplateModel& model, const float* posterior, float total, float pause_mass,
+            int previous_state, int steps, int window, FollowResult& result) noexcept;
+
+// True when going from previous_state to state is not a band move: 0..2*steps frames forward in
+// the same take.
+bool is_jump(const TemplateModel& model, int previous_state, int state, int steps) noexcept;
+
+}  // namespace duet::follow_detail

@@ -1,0 +1,227 @@
+#include "duet/follow/hmm_follower.h"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "forward_common.h"
+
+namespace duet {
+
+using follow_detail::kMinLogEmission;
+
+// ---------------------------------------------------------------------------------------------
+// ForwardContext
+
+void ForwardContext::resize(int num_states) {
+  assert(num_states > 0);
+  num_states_ = num_states;
+  const auto size = static_cast<std::size_t>(num_states);
+  alpha_.assign(size + 1, 0.0f);
+  scratch_.assign(size + 1, 0.0f);
+  distance_sq_.assign(size, 0.0f);
+  reset();
+}
+
+void ForwardContext::reset() noexcept {
+  if (num_states_ == 0) return;
+  std::fill(alpha_.begin(), alpha_.end() - 1, 1.0f / static_cast<float>(num_states_));
+  alpha_.back() = 0.0f;
+  total_log_likelihood_ = 0.0;
+  frames_ = 0;
+  previous_state_ = -1;
+  previous_lost_ = false;
+}
+
+// ---------------------------------------------------------------------------------------------
+// HmmForward: set-up
+
+Result<HmmForward> HmmForward::create(const TemplateModel& model, const FollowParams& params) {
+  if (Status status = params.validate(model.num_states()); !status.ok()) return status.error();
+
+  HmmForward forward;
+  forward.model_ = &model;
+  forward.params_ = params;
+  const bool jump = params.jump_enabled;
+  // Rows out of a template state sum to 1 (eq. 4-5); the paper's numbers do not (0.825), so
+  // the four probabilities are normalised together.
+  const float total =
+      params.self_prob + params.next_prob + params.skip_prob + (jump ? params.leave_prob : 0.0f);
+  forward.self_ = params.self_prob / total;
+  forward.next_ = params.next_prob / total;
+  forward.skip_ = params.skip_prob / total;
+  forward.leave_ = jump ? params.leave_prob / total : 0.0f;
+  forward.pause_stay_ = jump ? params.pause_stay_prob : 1.0f;
+  if (jump && !params.resume_weights.empty()) {
+    double sum = 0.0;
+    for (const float w : params.resume_weights) sum += w;
+    forward.resume_.reserve(params.resume_weights.size());
+    for (const float w : params.resume_weights) {
+      forward.resume_.push_back(static_cast<float>(w / sum));
+    }
+  }
+  forward.params_.resume_weights.clear();  // kept once, normalised, in resume_
+
+  const double dims = model.num_dims();
+  const double sigma = params.emission_sigma;
+  const double inv_two_sigma_sq = 1.0 / (2.0 * sigma * sigma);
+  forward.inv_two_sigma_sq_ = static_cast<float>(inv_two_sigma_sq);
+  // Flat pause emission: the likelihood of a frame at pause_distance_per_dim per dimension.
+  forward.log_pause_emission_ = static_cast<float>(
+      std::max(-params.pause_distance_per_dim * dims * inv_two_sigma_sq, double{kMinLogEmission}));
+  forward.lost_distance_sq_ = static_cast<float>(params.lost_distance_per_dim * dims);
+  return forward;
+}
+
+int HmmForward::steps_for(double dt_s) const noexcept {
+  return follow_detail::steps_for(dt_s, model_->frame_rate_hz(), params_.max_steps_per_frame);
+}
+
+HmmForward::Row HmmForward::row(int j) const noexcept {
+  const int end = model_->take_end(model_->take_of(j));
+  const int remaining = end - 1 - j;  // frames after j in its take
+  Row r{{self_, remaining >= 1 ? next_ : 0.0f, remaining >= 2 ? skip_ : 0.0f}, leave_};
+  if (params_.jump_enabled) {
+    // End of a take (library): next/skip lead into the pause state, not into the next take.
+    r.leave += (next_ - r.band[1]) + (skip_ - r.band[2]);
+  } else {
+    // No pause state: renormalise what is left; a state with nothing left keeps its mass.
+    const float sum = r.band[0] + r.band[1] + r.band[2];
+    if (sum > 0.0f) {
+      for (float& p : r.band) p /= sum;
+    } else {
+      r.band[0] = 1.0f;
+    }
+  }
+  return r;
+}
+
+float HmmForward::resume(int i) const noexcept {
+  if (!params_.jump_enabled) return 0.0f;
+  const float r = resume_.empty() ? 1.0f / static_cast<float>(model_->num_states())
+                                  : resume_[static_cast<std::size_t>(i)];
+  return (1.0f - pause_stay_) * r;
+}
+
+// ---------------------------------------------------------------------------------------------
+// HmmForward: per frame
+
+namespace {
+
+// The bracket of eq. 11 for the targets i in [begin, end) of one take whose three band sources
+// i-2..i are interior rows: self * alpha(i) + next * alpha(i-1) + skip * alpha(i-2) + P_t R_i.
+// A plain loop over contiguous floats that the compiler vectorises.
+template <bool kUniformResume>
+void band_interior(const float* alpha, float* next, int begin, int end, float self, float step,
+                   float skip, float pause_out, const float* resume) noexcept {
+  for (int i = begin; i < end; ++i) {
+    const float from_pause = kUniformResume ? pause_out : pause_out * resume[i];
+    next[i] = self * alpha[i] + step * alpha[i - 1] + skip * alpha[i - 2] + from_pause;
+  }
+}
+
+}  // namespace
+
+void HmmForward::transition(const float* alpha, float* next) const noexcept {
+  const TemplateModel& model = *model_;
+  const int num_states = model.num_states();
+  const bool jump = params_.jump_enabled;
+  const float pause_mass = alpha[num_states];
+
+  // P_t (eq. 11): the mass resuming from the pause state, independent of i, so computed once.
+  // Uniform R_i folds 1/M into it.
+  const bool uniform = resume_.empty();
+  const float resume_total = jump ? (1.0f - pause_stay_) * pause_mass : 0.0f;
+  const float pause_out = uniform ? resume_total / static_cast<float>(num_states) : resume_total;
+  const float* resume = uniform ? nullptr : resume_.data();
+
+  // Into the pause state: sum_j alpha(j) L_j + A_NN alpha(N) (eq. 5-6). L_j is leave_ inside a
+  // take; the ends of takes add the band mass that has nowhere to go (below).
+  const float template_mass = Eigen::Map<const Eigen::ArrayXf>(alpha, num_states).sum();
+  float into_pause = jump ? leave_ * template_mass + pause_stay_ * pause_mass : 0.0f;
+
+  for (int take = 0; take < model.num_takes(); ++take) {
+    const int begin = model.take_begin(take);
+    const int end = model.take_end(take);
+    if (uniform) {
+      band_interior<true>(alpha, next, begin + 2, end, self_, next_, skip_, pause_out, resume);
+    } else {
+      band_interior<false>(alpha, next, begin + 2, end, self_, next_, skip_, pause_out, resume);
+    }
+    // The first two targets have fewer sources; the last two have sources whose rows are cut by
+    // the end of the take. Recompute those with the exact rows (O(takes) per frame).
+    const int edges[4] = {begin, begin + 1, end - 2, end - 1};
+    for (const int i : edges) {
+      if (i < begin || i >= end) continue;
+      float value = uniform ? pause_out : pause_out * resume[i];
+      for (int d = 0; d <= 2 && i - d >= begin; ++d) value += alpha[i - d] * row(i - d).band[d];
+      next[i] = value;
+    }
+    if (jump) {
+      into_pause += alpha[end - 1] * (next_ + skip_);
+      if (end - 2 >= begin) into_pause += alpha[end - 2] * skip_;
+    }
+  }
+  next[num_states] = into_pause;
+}
+
+FollowResult HmmForward::step(std::span<const float> features, double dt_s,
+                              ForwardContext& context) const noexcept {
+  const follow_detail::ScopedFlushDenormals flush_denormals;
+  const TemplateModel& model = *model_;
+  const int num_states = model.num_states();
+  FollowResult result;
+  assert(context.num_states_ == num_states && "context sized for another model");
+  if (context.num_states_ != num_states) return result;
+  assert(features.size() == static_cast<std::size_t>(model.num_dims()));
+
+  result.missing = features.size() != static_cast<std::size_t>(model.num_dims()) ||
+                   !follow_detail::all_finite(features);
+  result.steps = steps_for(dt_s);
+
+  // Input slower than the template (or late): the HMM runs at the template rate, so the band is
+  // applied once per elapsed template frame before the emission.
+  for (int s = 0; s < result.steps; ++s) {
+    transition(context.alpha_.data(), context.scratch_.data());
+    context.alpha_.swap(context.scratch_);
+  }
+
+  if (!result.missing) {
+    const float best = follow_detail::squared_distances(model.features(), features.data(), 0,
+                                                        num_states, context.distance_sq_.data());
+    result.log_likelihood = follow_detail::weigh_and_normalise(
+        context.alpha_.data(), context.distance_sq_.data(), best, inv_two_sigma_sq_, num_states,
+        log_pause_emission_, params_.jump_enabled, context.scratch_.data());
+    context.alpha_.swap(context.scratch_);
+    result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
+    // lost is completed below, once in_pause is known.
+    result.lost = best > lost_distance_sq_;
+  } else {
+    // No evidence: the transitions conserve mass; renormalise only to stop float drift.
+    follow_detail::normalise(context.alpha_.data(), num_states + 1, num_states);
+    result.best_distance_per_dim = -1.0f;
+  }
+
+  const float* alpha = context.alpha_.data();
+  follow_detail::decide(model, alpha, 1.0f, alpha[num_states], context.previous_state_,
+                        result.steps, params_.confidence_window_frames, result);
+  result.lost = result.missing ? context.previous_lost_ : (result.lost || result.in_pause);
+
+  context.total_log_likelihood_ += result.log_likelihood;
+  ++context.frames_;
+  context.previous_state_ = result.state;
+  context.previous_lost_ = result.lost;
+  return result;
+}
+
+// ---------------------------------------------------------------------------------------------
+// HmmFollower
+
+Result<HmmFollower> HmmFollower::create(const TemplateModel& model, const FollowParams& params) {
+  Result<HmmForward> forward = HmmForward::create(model, params);
+  if (!forward.ok()) return forward.error();
+  return HmmFollower(std::move(forward).value(), ForwardContext(model.num_states()));
+}
+
+}  // namespace duet

@@ -1,0 +1,141 @@
+#include "duet/follow/naive_hmm.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <string>
+
+#include "forward_common.h"
+
+namespace duet {
+
+Result<NaiveHmmFollower> NaiveHmmFollower::create(const TemplateModel& model,
+                                                  const FollowParams& params) {
+  const int num_states = model.num_states();
+  if (num_states > kMaxStates) {
+    return make_error("naive HMM", 0,
+                      "the dense transition matrix is limited to " + std::to_string(kMaxStates) +
+                          " states, the template has " + std::to_string(num_states));
+  }
+  if (Status status = params.validate(num_states); !status.ok()) return status.error();
+
+  NaiveHmmFollower follower;
+  follower.model_ = &model;
+  follower.params_ = params;
+  const bool jump = params.jump_enabled;
+  const int pause = num_states;  // N = M + 1 in the paper's 1-based numbering
+
+  // Written out from eq. 4-6 pair by pair, independently of HmmForward's factorised step, so
+  // that the tests comparing the two check the factorisation of eq. 11.
+  const float total =
+      params.self_prob + params.next_prob + params.skip_prob + (jump ? params.leave_prob : 0.0f);
+  const float self = params.self_prob / total;
+  const float next = params.next_prob / total;
+  const float skip = params.skip_prob / total;
+  const float leave = jump ? params.leave_prob / total : 0.0f;
+  double resume_sum = 0.0;
+  for (const float w : params.resume_weights) resume_sum += w;
+
+  auto& a = follower.transition_to_from_;
+  a.setZero(num_states + 1, num_states + 1);
+  for (int j = 0; j <= num_states; ++j) {  // from
+    const int end = j < num_states ? model.take_end(model.take_of(j)) : 0;
+    for (int i = 0; i <= num_states; ++i) {  // to
+      float p = 0.0f;
+      if (j == pause) {
+        if (i == pause) {
+          p = jump ? params.pause_stay_prob : 1.0f;  // A_NN (eq. 6)
+        } else if (jump) {                           // (1 - A_NN) R_i (eq. 6)
+          const float r = params.resume_weights.empty()
+                              ? 1.0f / static_cast<float>(num_states)
+                              : static_cast<float>(params.resume_weights[i] / resume_sum);
+          p = (1.0f - params.pause_stay_prob) * r;
+        }
+      } else if (i == pause) {
+        // L_j (eq. 5); at the end of a take, next/skip lead into the pause state.
+        if (jump) p = leave + (j + 1 >= end ? next : 0.0f) + (j + 2 >= end ? skip : 0.0f);
+      } else if (i == j) {
+        p = self;  // B, eq. 4
+      } else if (i == j + 1 && i < end) {
+        p = next;
+      } else if (i == j + 2 && i < end) {
+        p = skip;
+      }
+      a(i, j) = p;
+    }
+    if (!jump && j < num_states) {
+      // Left-to-right: renormalise what stays in the take; nothing left -> keep the mass.
+      const float sum = a.col(j).sum();
+      if (sum > 0.0f) {
+        a.col(j) /= sum;
+      } else {
+        a(j, j) = 1.0f;
+      }
+    }
+  }
+
+  const double dims = model.num_dims();
+  const double sigma = params.emission_sigma;
+  const double inv_two_sigma_sq = 1.0 / (2.0 * sigma * sigma);
+  follower.inv_two_sigma_sq_ = static_cast<float>(inv_two_sigma_sq);
+  follower.log_pause_emission_ =
+      static_cast<float>(std::max(-params.pause_distance_per_dim * dims * inv_two_sigma_sq,
+                                  double{follow_detail::kMinLogEmission}));
+  follower.lost_distance_sq_ = static_cast<float>(params.lost_distance_per_dim * dims);
+  const auto size = static_cast<std::size_t>(num_states);
+  follower.alpha_.assign(size + 1, 0.0f);
+  follower.scratch_.assign(size + 1, 0.0f);
+  follower.distance_sq_.assign(size, 0.0f);
+  follower.reset();
+  return follower;
+}
+
+void NaiveHmmFollower::reset() noexcept {
+  const int num_states = model_->num_states();
+  std::fill(alpha_.begin(), alpha_.end() - 1, 1.0f / static_cast<float>(num_states));
+  alpha_.back() = 0.0f;
+  previous_state_ = -1;
+  previous_lost_ = false;
+}
+
+FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s) noexcept {
+  const follow_detail::ScopedFlushDenormals flush_denormals;
+  const TemplateModel& model = *model_;
+  const int num_states = model.num_states();
+  FollowResult result;
+  assert(features.size() == static_cast<std::size_t>(model.num_dims()));
+  result.missing = features.size() != static_cast<std::size_t>(model.num_dims()) ||
+                   !follow_detail::all_finite(features);
+  result.steps = follow_detail::steps_for(dt_s, model.frame_rate_hz(), params_.max_steps_per_frame);
+
+  const Eigen::Index size = num_states + 1;
+  for (int s = 0; s < result.steps; ++s) {
+    // eq. 10's sum over every pair (j, i): O(M^2).
+    Eigen::Map<Eigen::VectorXf>(scratch_.data(), size).noalias() =
+        transition_to_from_ * Eigen::Map<const Eigen::VectorXf>(alpha_.data(), size);
+    alpha_.swap(scratch_);
+  }
+
+  if (!result.missing) {
+    const float best = follow_detail::squared_distances(model.features(), features.data(), 0,
+                                                        num_states, distance_sq_.data());
+    result.log_likelihood = follow_detail::weigh_and_normalise(
+        alpha_.data(), distance_sq_.data(), best, inv_two_sigma_sq_, num_states,
+        log_pause_emission_, params_.jump_enabled, scratch_.data());
+    alpha_.swap(scratch_);
+    result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
+    result.lost = best > lost_distance_sq_;
+  } else {
+    follow_detail::normalise(alpha_.data(), num_states + 1, num_states);
+    result.best_distance_per_dim = -1.0f;
+  }
+
+  follow_detail::decide(model, alpha_.data(), 1.0f, alpha_[static_cast<std::size_t>(num_states)],
+                        previous_state_, result.steps, params_.confidence_window_frames, result);
+  result.lost = result.missing ? previous_lost_ : (result.lost || result.in_pause);
+  previous_state_ = result.state;
+  previous_lost_ = result.lost;
+  return result;
+}
+
+}  // namespace duet

@@ -1,0 +1,89 @@
+#include "duet/follow/template_model.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <string>
+#include <utility>
+
+namespace duet {
+namespace {
+
+Error model_error(const std::string& reason) { return make_error("template model", 0, reason); }
+
+}  // namespace
+
+Result<TemplateModel> TemplateModel::build(FeatureMatrix features, std::vector<int> take_start,
+                                           double frame_rate_hz) {
+  const Eigen::Index num_frames = features.rows();
+  const Eigen::Index num_dims = features.cols();
+  if (num_frames == 0 || num_dims == 0) {
+    return model_error("no template features (" + std::to_string(num_frames) + " frames x " +
+                       std::to_string(num_dims) + " dimensions)");
+  }
+  if (num_frames >= (Eigen::Index{1} << 30)) {
+    return model_error("too many template frames: " + std::to_string(num_frames));
+  }
+  if (!std::isfinite(frame_rate_hz) || frame_rate_hz <= 0.0) {
+    return model_error("frame rate must be positive, got " + std::to_string(frame_rate_hz));
+  }
+  for (Eigen::Index i = 0; i < num_frames; ++i) {
+    for (Eigen::Index d = 0; d < num_dims; ++d) {
+      if (!std::isfinite(features(i, d))) {
+        return model_error("feature " + std::to_string(d) + " of template frame " +
+                           std::to_string(i) + " is not finite");
+      }
+    }
+  }
+  if (take_start.empty()) take_start.push_back(0);
+  if (take_start.front() != 0) {
+    return model_error("the first take must start at state 0, got " +
+                       std::to_string(take_start.front()));
+  }
+  for (std::size_t k = 0; k < take_start.size(); ++k) {
+    if (take_start[k] >= num_frames) {
+      return model_error("take " + std::to_string(k) + " starts at state " +
+                         std::to_string(take_start[k]) + ", past the last of " +
+                         std::to_string(num_frames) + " template frames");
+    }
+    if (k > 0 && take_start[k] <= take_start[k - 1]) {
+      return model_error("take starts must be strictly increasing: take " + std::to_string(k) +
+                         " starts at " + std::to_string(take_start[k]) + ", take " +
+                         std::to_string(k - 1) + " at " + std::to_string(take_start[k - 1]));
+    }
+  }
+  take_start.push_back(static_cast<int>(num_frames));
+
+  TemplateModel model;
+  model.features_ = std::move(features);
+  model.take_start_ = std::move(take_start);
+  model.frame_rate_hz_ = frame_rate_hz;
+  return model;
+}
+
+Result<TemplateModel> TemplateModel::build(std::span<const float> features_row_major,
+                                           int num_frames, int num_dims,
+                                           std::vector<int> take_start, double frame_rate_hz) {
+  if (num_frames <= 0 || num_dims <= 0) {
+    return model_error("no template features (" + std::to_string(num_frames) + " frames x " +
+                       std::to_string(num_dims) + " dimensions)");
+  }
+  const auto expected = static_cast<std::size_t>(num_frames) * static_cast<std::size_t>(num_dims);
+  if (features_row_major.size() != expected) {
+    return model_error("feature buffer holds " + std::to_string(features_row_major.size()) +
+                       " values, expected " + std::to_string(num_frames) + " frames x " +
+                       std::to_string(num_dims) + " dimensions = " + std::to_string(expected));
+  }
+  FeatureMatrix features =
+      Eigen::Map<const FeatureMatrix>(features_row_major.data(), num_frames, num_dims);
+  return build(std::move(features), std::move(take_start), frame_rate_hz);
+}
+
+int TemplateModel::take_of(int state) const {
+  assert(state >= 0 && state < num_states());
+  // take_start_ is sorted and ends with M: the take is the last start <= state.
+  const auto it = std::upper_bound(take_start_.begin(), take_start_.end(), state);
+  return static_cast<int>(it - take_start_.begin()) - 1;
+}
+
+}  // namespace duet

@@ -1,0 +1,128 @@
+// The O(M) forward step of eq. 11 against the O(M^2) forward of eq. 10 with the full transition
+// matrix: same alpha (within float tolerance), same estimates.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "duet/follow/hmm_follower.h"
+#include "duet/follow/naive_hmm.h"
+#include "follow/synthetic.h"
+
+namespace duet {
+namespace {
+
+// The dense matrix is a proper transition matrix and agrees with HmmForward's rows.
+void expect_same_transitions(const TemplateModel& model, const FollowParams& params) {
+  const HmmForward fast = HmmForward::create(model, params).value();
+  const NaiveHmmFollower naive = NaiveHmmFollower::create(model, params).value();
+  const int pause = model.num_states();
+  for (int j = 0; j <= pause; ++j) {
+    double sum = 0.0;
+    for (int i = 0; i <= pause; ++i) sum += naive.transition(j, i);
+    EXPECT_NEAR(sum, 1.0, 1e-5) << "row " << j;
+  }
+  for (int j = 0; j < pause; ++j) {
+    const HmmForward::Row row = fast.row(j);
+    for (int d = 0; d <= 2; ++d) {
+      const float dense = j + d < pause ? naive.transition(j, j + d) : 0.0f;
+      EXPECT_NEAR(row.band[d], dense, 1e-6f) << j << " +" << d;
+    }
+    EXPECT_NEAR(row.leave, naive.transition(j, pause), 1e-6f) << j;
+  }
+  if (params.jump_enabled) {
+    EXPECT_NEAR(fast.pause_stay(), naive.transition(pause, pause), 1e-6f);
+    for (int i = 0; i < pause; ++i) EXPECT_NEAR(fast.resume(i), naive.transition(pause, i), 1e-7f);
+  }
+}
+
+struct Scenario {
+  const char* name;
+  std::vector<int> takes;
+  FollowParams params;
+};
+
+std::vector<Scenario> scenarios() {
+  std::vector<Scenario> out;
+  out.push_back({"default, one take", {240}, FollowParams{}});
+  // Short takes exercise every boundary case of the band (1, 2 and 3 frames).
+  out.push_back({"default, library", {90, 1, 2, 3, 60, 84}, FollowParams{}});
+  out.push_back({"paper", {120, 120}, FollowParams::paper()});
+  out.push_back({"left to right", {100, 3, 1, 2, 90}, FollowParams::left_to_right()});
+  FollowParams resume;
+  resume.resume_weights.resize(200);
+  for (std::size_t i = 0; i < resume.resume_weights.size(); ++i) {
+    resume.resume_weights[i] = 1.0f + static_cast<float>(i % 7);
+  }
+  out.push_back({"non-uniform resume", {150, 50}, resume});
+  FollowParams sharp;
+  sharp.emission_sigma = 0.3f;  // exercises the underflow fallback of the emission
+  sharp.leave_prob = 0.01f;
+  out.push_back({"sharp emission", {150, 100}, sharp});
+  return out;
+}
+
+TEST(ForwardEquivalence, TransitionMatricesAgree) {
+  for (const Scenario& s : scenarios()) {
+    SCOPED_TRACE(s.name);
+    const TemplateModel model = test::make_model(s.takes, 12, 5);
+    expect_same_transitions(model, s.params);
+  }
+}
+
+TEST(ForwardEquivalence, SameAlphaAndEstimatesOverJumpsRatesAndMissingFrames) {
+  for (const Scenario& s : scenarios()) {
+    SCOPED_TRACE(s.name);
+    const TemplateModel model = test::make_model(s.takes, 16, 11);
+    HmmFollower fast = HmmFollower::create(model, s.params).value();
+    NaiveHmmFollower naive = NaiveHmmFollower::create(model, s.params).value();
+    std::mt19937 rng(42);
+    std::uniform_int_distribution<int> anywhere(0, model.num_states() - 1);
+    std::uniform_real_distribution<double> speed(0.6, 1.6);
+    const double dts[] = {1.0 / 60, 1.0 / 60, 1.0 / 30, 0.0, 0.1, 1.0 / 120};
+
+    double position = anywhere(rng);
+    int agree = 0;
+    const int frames = 400;
+    for (int t = 0; t < frames; ++t) {
+      if (t % 60 == 59) position = anywhere(rng);  // jump elsewhere (another take, too)
+      const double dt = dts[t % 6];
+      std::vector<float> phi = test::features_at(model, position);
+      test::add_noise(phi, 0.1f, rng);
+      if (t % 97 == 13) phi[3] = std::numeric_limits<float>::quiet_NaN();  // missing frame
+      if (t % 131 == 7) std::fill(phi.begin(), phi.end(), 40.0f);          // far from all
+      position += speed(rng) * std::max(1.0, std::round(dt * 60.0));
+      if (position >= model.num_states() - 1) position = 0;
+
+      const FollowResult a = fast.step(phi, dt);
+      const FollowResult b = naive.step(phi, dt);
+      const auto alpha_fast = fast.context().alpha();
+      const auto alpha_naive = naive.alpha();
+      ASSERT_EQ(alpha_fast.size(), alpha_naive.size());
+      float worst = 0.0f;
+      for (std::size_t i = 0; i < alpha_fast.size(); ++i) {
+        worst = std::max(worst, std::abs(alpha_fast[i] - alpha_naive[i]));
+      }
+      ASSERT_LT(worst, 2e-5f) << "frame " << t;
+      EXPECT_EQ(a.missing, b.missing);
+      EXPECT_EQ(a.steps, b.steps);
+      EXPECT_EQ(a.in_pause, b.in_pause);
+      EXPECT_NEAR(a.log_likelihood, b.log_likelihood, 1e-3 + 1e-5 * std::abs(a.log_likelihood));
+      EXPECT_NEAR(a.confidence, b.confidence, 1e-4f);
+      // Equal estimates, unless two states tie within float noise.
+      if (a.state == b.state) {
+        ++agree;
+      } else {
+        EXPECT_NEAR(alpha_fast[static_cast<std::size_t>(a.state)],
+                    alpha_fast[static_cast<std::size_t>(b.state)], 1e-5f)
+            << "frame " << t;
+      }
+    }
+    EXPECT_GE(agree, frames - 2);
+  }
+}
+
+}  // namespace
+}  // namespace duet

@@ -1,0 +1,194 @@
+// The forward step never underflows to zeros or NaN: long inputs, missing frames, zeros, a frozen
+// user, features far from every template frame, a very sharp emission.
+#include <gtest/gtest.h>
+
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "duet/follow/hmm_follower.h"
+#include "duet/follow/nearest_neighbour.h"
+#include "duet/follow/online_dtw.h"
+#include "follow/synthetic.h"
+
+namespace duet {
+namespace {
+
+constexpr int kDims = 60;
+constexpr double kDt = 1.0 / 60;
+const float kNaN = std::numeric_limits<float>::quiet_NaN();
+const float kInf = std::numeric_limits<float>::infinity();
+
+// alpha is a probability distribution: finite, non-negative, sums to 1.
+void expect_valid_alpha(const HmmFollower& hmm) {
+  double sum = 0.0;
+  for (const float a : hmm.context().alpha()) {
+    ASSERT_TRUE(std::isfinite(a));
+    ASSERT_GE(a, 0.0f);
+    sum += a;
+  }
+  ASSERT_NEAR(sum, 1.0, 1e-4);
+}
+
+void expect_valid_result(const FollowResult& r, const TemplateModel& model) {
+  ASSERT_GE(r.state, 0);
+  ASSERT_LT(r.state, model.num_states());
+  ASSERT_EQ(r.take, model.take_of(r.state));
+  ASSERT_TRUE(std::isfinite(r.confidence));
+  ASSERT_GE(r.confidence, 0.0f);
+  ASSERT_LE(r.confidence, 1.0f);
+  ASSERT_TRUE(std::isfinite(r.log_likelihood));
+  ASSERT_FALSE(std::isnan(r.best_distance_per_dim));
+}
+
+class RobustnessTest : public ::testing::Test {
+ protected:
+  TemplateModel model_ = test::make_model({500, 500}, kDims, 8);
+  std::vector<float> template_frame(int i) { return test::features_at(model_, i); }
+  // Replays frames [from, from + count) and checks they are followed exactly (after 3 frames to
+  // settle), so the tests start from a confident state.
+  void track(HmmFollower& hmm, int from, int count) {
+    for (int i = from; i < from + count; ++i) {
+      const FollowResult r = hmm.step(template_frame(i), kDt);
+      if (i - from >= 3) {
+        ASSERT_EQ(r.state, i);
+      }
+    }
+  }
+};
+
+TEST_F(RobustnessTest, HundredThousandFrames) {
+  HmmFollower hmm = HmmFollower::create(model_, {}).value();
+  std::mt19937 rng(1);
+  std::uniform_int_distribution<int> anywhere(0, model_.num_states() - 1);
+  std::uniform_real_distribution<double> speed(0.7, 1.4);
+  double position = 0.0;
+  for (int t = 0; t < 100000; ++t) {
+    if (t % 500 == 0) position = anywhere(rng);
+    std::vector<float> phi = test::features_at(model_, position);
+    test::add_noise(phi, 0.2f, rng);
+    if (t % 101 == 0) phi.assign(phi.size(), kNaN);
+    if (t % 997 == 0) phi.assign(phi.size(), 0.0f);
+    position += speed(rng);
+    if (position >= model_.num_states() - 1) position = 0.0;
+    const FollowResult r = hmm.step(phi, kDt);
+    expect_valid_result(r, model_);
+    if (t % 1000 == 0) expect_valid_alpha(hmm);
+  }
+  expect_valid_alpha(hmm);
+  EXPECT_TRUE(std::isfinite(hmm.context().total_log_likelihood()));
+  EXPECT_EQ(hmm.context().frames(), 100000);
+}
+
+TEST_F(RobustnessTest, MissingFramesAreFlaggedAndDoNotPoisonTheState) {
+  HmmFollower hmm = HmmFollower::create(model_, {}).value();
+  track(hmm, 0, 100);
+  for (int k = 0; k < 50; ++k) {
+    std::vector<float> phi = template_frame(100 + k);
+    if (k % 2 == 0) {
+      phi.assign(phi.size(), kNaN);
+    } else {
+      phi[static_cast<std::size_t>(k)] = k % 4 == 1 ? kInf : -kInf;
+    }
+    const FollowResult r = hmm.step(phi, kDt);
+    EXPECT_TRUE(r.missing);
+    EXPECT_EQ(r.log_likelihood, 0.0);
+    EXPECT_FALSE(r.lost);
+    expect_valid_result(r, model_);
+    expect_valid_alpha(hmm);
+  }
+  // The band kept moving the mass forward; real frames snap it back at once.
+  const FollowResult r = hmm.step(template_frame(150), kDt);
+  EXPECT_FALSE(r.missing);
+  EXPECT_LE(std::abs(r.state - 150), 1);
+  track(hmm, 151, 20);
+}
+
+TEST_F(RobustnessTest, FramesOfZeros) {
+  HmmFollower hmm = HmmFollower::create(model_, {}).value();
+  track(hmm, 200, 20);
+  const std::vector<float> zeros(kDims, 0.0f);
+  for (int t = 0; t < 2000; ++t) expect_valid_result(hmm.step(zeros, kDt), model_);
+  expect_valid_alpha(hmm);
+  hmm.step(template_frame(700), kDt);
+  hmm.step(template_frame(701), kDt);
+  EXPECT_EQ(hmm.step(template_frame(702), kDt).state, 702);
+}
+
+TEST_F(RobustnessTest, FrozenUser) {
+  HmmFollower hmm = HmmFollower::create(model_, {}).value();
+  track(hmm, 280, 20);
+  const std::vector<float> frozen = template_frame(300);
+  FollowResult r;
+  for (int t = 0; t < 5000; ++t) {
+    r = hmm.step(frozen, kDt);
+    expect_valid_result(r, model_);
+  }
+  expect_valid_alpha(hmm);
+  // The self transition holds the estimate near the frozen frame.
+  EXPECT_LE(std::abs(r.state - 300), 3);
+  EXPECT_FALSE(r.lost);
+  EXPECT_TRUE(std::isfinite(hmm.context().total_log_likelihood()));
+}
+
+TEST_F(RobustnessTest, FeaturesFarFromEveryTemplateFrame) {
+  for (const float far : {30.0f, 1e3f, 1e20f, -1e30f, FLT_MAX, -FLT_MAX}) {
+    SCOPED_TRACE(far);
+    HmmFollower hmm = HmmFollower::create(model_, {}).value();
+    track(hmm, 600, 20);
+    std::vector<float> phi(kDims, far);
+    phi[0] = -far;  // not all equal, so no accidental symmetry
+    for (int t = 0; t < 300; ++t) {
+      const FollowResult r = hmm.step(phi, kDt);
+      expect_valid_result(r, model_);
+      EXPECT_TRUE(r.lost) << t;
+      EXPECT_FALSE(r.missing);
+    }
+    expect_valid_alpha(hmm);
+    // Back to the template: found again within a few frames.
+    FollowResult r;
+    for (int i = 100; i < 106; ++i) r = hmm.step(template_frame(i), kDt);
+    EXPECT_EQ(r.state, 105);
+    EXPECT_FALSE(r.lost);
+  }
+}
+
+TEST_F(RobustnessTest, SharpEmissionAndDistantPauseNeverUnderflow) {
+  // sigma = 0.05 puts log-emissions of other frames around -1e4: exp underflows for everything
+  // but the best frame, and the pause emission underflows entirely.
+  FollowParams params;
+  params.emission_sigma = 0.05f;
+  params.pause_distance_per_dim = 50.0f;
+  HmmFollower hmm = HmmFollower::create(model_, params).value();
+  std::mt19937 rng(3);
+  for (int t = 0; t < 3000; ++t) {
+    // Jumps every 100 frames: the predicted mass sits where the emissions are ~exp(-1e4).
+    std::vector<float> phi = template_frame((t / 100) * 317 % 900 + t % 100);
+    test::add_noise(phi, 0.3f, rng);
+    const FollowResult r = hmm.step(phi, kDt);
+    expect_valid_result(r, model_);
+  }
+  expect_valid_alpha(hmm);
+}
+
+TEST_F(RobustnessTest, BaselinesStayFiniteToo) {
+  NearestNeighbourTracker nn = NearestNeighbourTracker::create(model_, {}).value();
+  OnlineDtwTracker dtw = OnlineDtwTracker::create(model_, {}).value();
+  std::vector<Tracker*> trackers = {&nn, &dtw};
+  for (Tracker* tracker : trackers) {
+    SCOPED_TRACE(tracker->name());
+    for (int t = 0; t < 3000; ++t) {
+      std::vector<float> phi = template_frame(t % 1000);
+      if (t % 7 == 0) phi.assign(phi.size(), kNaN);
+      if (t % 11 == 0) phi.assign(phi.size(), 1e30f);
+      if (t % 13 == 0) phi.assign(phi.size(), 0.0f);
+      const FollowResult r = tracker->step(phi, t % 5 == 0 ? 1.0 / 30 : kDt);
+      if (t > 0) expect_valid_result(r, model_);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace duet

@@ -1,0 +1,173 @@
+#include "duet/follow/template_model.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "duet/follow/follow_params.h"
+#include "duet/follow/hmm_follower.h"
+#include "duet/follow/naive_hmm.h"
+#include "duet/follow/online_dtw.h"
+#include "follow/synthetic.h"
+
+namespace duet {
+namespace {
+
+// The error message of a failed result, or "" if it succeeded.
+template <typename T>
+std::string error_of(const Result<T>& result) {
+  return result.ok() ? std::string() : result.error().message;
+}
+
+FeatureMatrix ones(int rows, int cols) { return FeatureMatrix::Ones(rows, cols); }
+
+TEST(TemplateModel, BuildsAndFindsTakes) {
+  Result<TemplateModel> model = TemplateModel::build(ones(10, 3), {0, 4, 7}, 60.0);
+  ASSERT_TRUE(model.ok()) << error_of(model);
+  const TemplateModel& m = model.value();
+  EXPECT_EQ(m.num_states(), 10);
+  EXPECT_EQ(m.num_dims(), 3);
+  EXPECT_EQ(m.num_takes(), 3);
+  EXPECT_EQ(m.take_begin(1), 4);
+  EXPECT_EQ(m.take_end(1), 7);
+  EXPECT_EQ(m.take_end(2), 10);
+  const int expected_take[10] = {0, 0, 0, 0, 1, 1, 1, 2, 2, 2};
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(m.take_of(i), expected_take[i]) << i;
+}
+
+TEST(TemplateModel, EmptyTakeListIsOneTake) {
+  Result<TemplateModel> model = TemplateModel::build(ones(5, 2), {}, 30.0);
+  ASSERT_TRUE(model.ok());
+  EXPECT_EQ(model.value().num_takes(), 1);
+  EXPECT_EQ(model.value().take_end(0), 5);
+}
+
+TEST(TemplateModel, BuildsFromRowMajorBuffer) {
+  const std::vector<float> buffer = {1, 2, 3, 4, 5, 6};
+  Result<TemplateModel> model = TemplateModel::build(buffer, 2, 3, {0}, 60.0);
+  ASSERT_TRUE(model.ok());
+  EXPECT_EQ(model.value().features()(1, 0), 4.0f);
+  EXPECT_EQ(model.value().features()(0, 2), 3.0f);
+}
+
+TEST(TemplateModel, RejectsBadInputWithClearMessages) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_NE(error_of(TemplateModel::build(FeatureMatrix(0, 3), {}, 60.0)).find("no template"),
+            std::string::npos);
+  EXPECT_NE(error_of(TemplateModel::build(FeatureMatrix(4, 0), {}, 60.0)).find("no template"),
+            std::string::npos);
+
+  FeatureMatrix bad = ones(4, 3);
+  bad(2, 1) = nan;
+  EXPECT_NE(error_of(TemplateModel::build(bad, {}, 60.0))
+                .find("feature 1 of template frame 2 is not finite"),
+            std::string::npos);
+  bad(2, 1) = std::numeric_limits<float>::infinity();
+  EXPECT_FALSE(TemplateModel::build(bad, {}, 60.0).ok());
+
+  EXPECT_NE(error_of(TemplateModel::build(ones(4, 3), {1}, 60.0)).find("start at state 0"),
+            std::string::npos);
+  EXPECT_NE(error_of(TemplateModel::build(ones(4, 3), {0, 2, 2}, 60.0)).find("strictly"),
+            std::string::npos);
+  EXPECT_NE(error_of(TemplateModel::build(ones(4, 3), {0, 3, 1}, 60.0)).find("strictly"),
+            std::string::npos);
+  EXPECT_NE(error_of(TemplateModel::build(ones(4, 3), {0, 4}, 60.0)).find("past the last"),
+            std::string::npos);
+  EXPECT_NE(error_of(TemplateModel::build(ones(4, 3), {}, 0.0)).find("frame rate"),
+            std::string::npos);
+  EXPECT_FALSE(TemplateModel::build(ones(4, 3), {}, -60.0).ok());
+  EXPECT_FALSE(TemplateModel::build(ones(4, 3), {}, std::nan("")).ok());
+
+  const std::vector<float> buffer(11, 0.0f);
+  EXPECT_NE(error_of(TemplateModel::build(buffer, 4, 3, {}, 60.0)).find("expected 4 frames"),
+            std::string::npos);
+  EXPECT_FALSE(TemplateModel::build(buffer, 0, 3, {}, 60.0).ok());
+  // Every message says where it comes from.
+  EXPECT_EQ(error_of(TemplateModel::build(ones(4, 3), {}, 0.0)).rfind("template model: ", 0), 0u);
+}
+
+TEST(FollowParams, DefaultsAndPresetsAreValid) {
+  EXPECT_TRUE(FollowParams{}.validate(10).ok());
+  EXPECT_TRUE(FollowParams::paper().validate(10).ok());
+  EXPECT_TRUE(FollowParams::left_to_right().validate(10).ok());
+  EXPECT_FALSE(FollowParams::left_to_right().jump_enabled);
+}
+
+TEST(FollowParams, RejectsBadValues) {
+  auto check = [](auto change, const char* what) {
+    FollowParams p;
+    change(p);
+    Status status = p.validate(10);
+    ASSERT_FALSE(status.ok()) << what;
+    EXPECT_NE(status.error().message.find(what), std::string::npos) << status.error().message;
+  };
+  check([](FollowParams& p) { p.self_prob = -0.1f; }, "self_prob");
+  check([](FollowParams& p) { p.next_prob = std::nanf(""); }, "next_prob");
+  check([](FollowParams& p) { p.leave_prob = 1.5f; }, "leave_prob");
+  check([](FollowParams& p) { p.pause_stay_prob = -1.0f; }, "pause_stay_prob");
+  check([](FollowParams& p) { p.self_prob = p.next_prob = p.skip_prob = 0.0f; }, "skip_prob");
+  check([](FollowParams& p) { p.emission_sigma = 0.0f; }, "emission_sigma");
+  check([](FollowParams& p) { p.pause_distance_per_dim = -1.0f; }, "pause_distance_per_dim");
+  check([](FollowParams& p) { p.lost_distance_per_dim = std::nanf(""); }, "lost_distance");
+  check([](FollowParams& p) { p.confidence_window_frames = -1; }, "confidence_window");
+  check([](FollowParams& p) { p.max_steps_per_frame = 0; }, "max_steps_per_frame");
+  check([](FollowParams& p) { p.resume_weights.assign(9, 1.0f); }, "resume_weights has 9");
+  check([](FollowParams& p) { p.resume_weights.assign(10, 0.0f); }, "sum to zero");
+  check(
+      [](FollowParams& p) {
+        p.resume_weights.assign(10, 1.0f);
+        p.resume_weights[3] = -1.0f;
+      },
+      "resume_weights[3]");
+}
+
+TEST(FollowParams, TrackersRefuseBadParameters) {
+  const TemplateModel model = test::make_model({20}, 4, 1);
+  FollowParams p;
+  p.emission_sigma = -1.0f;
+  EXPECT_FALSE(HmmFollower::create(model, p).ok());
+  EXPECT_FALSE(NaiveHmmFollower::create(model, p).ok());
+  OnlineDtwParams dtw;
+  dtw.window_back = -1;
+  EXPECT_FALSE(OnlineDtwTracker::create(model, dtw).ok());
+}
+
+TEST(FollowParams, PaperPresetRowsAreNormalised) {
+  const TemplateModel model = test::make_model({10}, 4, 1);
+  Result<HmmForward> forward = HmmForward::create(model, FollowParams::paper());
+  ASSERT_TRUE(forward.ok());
+  const HmmForward::Row row = forward.value().row(3);
+  // self = next = 0.33, leave = 0.165, out of 0.825.
+  EXPECT_NEAR(row.band[0], 0.4f, 1e-6f);
+  EXPECT_NEAR(row.band[1], 0.4f, 1e-6f);
+  EXPECT_EQ(row.band[2], 0.0f);
+  EXPECT_NEAR(row.leave, 0.2f, 1e-6f);
+  EXPECT_NEAR(forward.value().pause_stay(), 0.835f, 1e-6f);
+  EXPECT_NEAR(forward.value().resume(0), 0.165f / 10.0f, 1e-7f);
+}
+
+TEST(FollowParams, EndOfTakeLeadsIntoThePauseState) {
+  const TemplateModel model = test::make_model({5, 5}, 4, 1);
+  const HmmForward forward = HmmForward::create(model, FollowParams{}).value();
+  for (int j = 0; j < model.num_states(); ++j) {
+    const HmmForward::Row r = forward.row(j);
+    EXPECT_NEAR(r.band[0] + r.band[1] + r.band[2] + r.leave, 1.0f, 1e-6f) << j;
+  }
+  // The last frame of take 0 (state 4) cannot move into take 1 (state 5).
+  EXPECT_EQ(forward.row(4).band[1], 0.0f);
+  EXPECT_EQ(forward.row(4).band[2], 0.0f);
+  EXPECT_EQ(forward.row(3).band[2], 0.0f);
+  EXPECT_GT(forward.row(4).leave, forward.row(2).leave);
+
+  // Without the jump the last frame keeps its mass.
+  const HmmForward l2r = HmmForward::create(model, FollowParams::left_to_right()).value();
+  EXPECT_EQ(l2r.row(4).band[0], 1.0f);
+  EXPECT_EQ(l2r.row(4).leave, 0.0f);
+  EXPECT_NEAR(l2r.row(3).band[0] + l2r.row(3).band[1], 1.0f, 1e-6f);
+}
+
+}  // namespace
+}  // namespace duet

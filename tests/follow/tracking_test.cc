@@ -1,0 +1,246 @@
+// The follower (and its baselines) on synthetic performances whose true template position is
+// known: exact replay, tempo changes, jumps within and across takes, a 30 Hz sensor.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "duet/follow/hmm_follower.h"
+#include "duet/follow/naive_hmm.h"
+#include "duet/follow/nearest_neighbour.h"
+#include "duet/follow/online_dtw.h"
+#include "follow/synthetic.h"
+
+namespace duet {
+namespace {
+
+constexpr int kDims = 60;
+
+struct Frame {
+  double position;  // true template position (global state index, fractional)
+  double dt_s;
+  bool jump = false;  // the performance jumped right before this frame
+};
+
+// Replays segments [from, from + length * speed) of the template, each at its own speed.
+struct Segment {
+  int from;
+  int frames;  // input frames
+  double speed = 1.0;
+};
+
+std::vector<Frame> perform(const std::vector<Segment>& segments, double dt_s, double fps = 60.0) {
+  std::vector<Frame> frames;
+  for (const Segment& s : segments) {
+    for (int t = 0; t < s.frames; ++t) {
+      frames.push_back({s.from + t * s.speed * dt_s * fps, dt_s, t == 0 && !frames.empty()});
+    }
+  }
+  return frames;
+}
+
+struct Trace {
+  std::vector<FollowResult> results;
+  std::vector<int> truth;
+};
+
+Trace replay(Tracker& tracker, const TemplateModel& model, const std::vector<Frame>& frames,
+             float noise = 0.0f, unsigned seed = 1) {
+  std::mt19937 rng(seed);
+  Trace out;
+  tracker.reset();
+  for (const Frame& f : frames) {
+    std::vector<float> phi = test::features_at(model, f.position);
+    if (noise > 0.0f) test::add_noise(phi, noise, rng);
+    out.results.push_back(tracker.step(phi, f.dt_s));
+    out.truth.push_back(static_cast<int>(std::lround(f.position)));
+  }
+  return out;
+}
+
+// Frames (after `skip`) whose estimate is more than `tolerance` frames from the truth.
+int misses(const Trace& r, int tolerance, int skip = 3) {
+  int n = 0;
+  for (std::size_t t = static_cast<std::size_t>(skip); t < r.results.size(); ++t) {
+    if (std::abs(r.results[t].state - r.truth[t]) > tolerance) ++n;
+  }
+  return n;
+}
+
+class TrackingTest : public ::testing::Test {
+ protected:
+  TemplateModel model_ = test::make_model({600}, kDims, 3);
+};
+
+TEST_F(TrackingTest, FollowsAnUnperturbedTemplateExactly) {
+  const std::vector<Frame> frames = perform({{0, 599}}, 1.0 / 60);
+  std::vector<std::unique_ptr<Tracker>> trackers;
+  trackers.push_back(std::make_unique<HmmFollower>(HmmFollower::create(model_, {}).value()));
+  trackers.push_back(std::make_unique<HmmFollower>(
+      HmmFollower::create(model_, FollowParams::left_to_right()).value()));
+  trackers.push_back(
+      std::make_unique<NaiveHmmFollower>(NaiveHmmFollower::create(model_, {}).value()));
+  trackers.push_back(std::make_unique<NearestNeighbourTracker>(
+      NearestNeighbourTracker::create(model_, {}).value()));
+  trackers.push_back(
+      std::make_unique<OnlineDtwTracker>(OnlineDtwTracker::create(model_, {}).value()));
+  for (const auto& tracker : trackers) {
+    SCOPED_TRACE(tracker->name());
+    const Trace r = replay(*tracker, model_, frames);
+    EXPECT_EQ(misses(r, 0), 0);
+    for (std::size_t t = 3; t < r.results.size(); ++t) {
+      EXPECT_FALSE(r.results[t].jumped) << t;
+      EXPECT_FALSE(r.results[t].lost) << t;
+      EXPECT_FALSE(r.results[t].in_pause) << t;
+      EXPECT_EQ(r.results[t].take, 0);
+      EXPECT_EQ(r.results[t].frame_in_take, r.truth[t]);
+    }
+  }
+}
+
+TEST_F(TrackingTest, PaperPresetLagsByAtMostOneFrame) {
+  // self = next and no skip: the band's prior advances half a frame per step, so at template
+  // tempo the estimate may trail by one frame.
+  HmmFollower paper = HmmFollower::create(model_, FollowParams::paper()).value();
+  const Trace r = replay(paper, model_, perform({{0, 599}}, 1.0 / 60));
+  EXPECT_EQ(misses(r, 1), 0);
+}
+
+TEST_F(TrackingTest, HmmIsConfidentOnAnExactReplay) {
+  HmmFollower hmm = HmmFollower::create(model_, {}).value();
+  const Trace r = replay(hmm, model_, perform({{0, 300}}, 1.0 / 60));
+  for (std::size_t t = 3; t < r.results.size(); ++t) {
+    EXPECT_GT(r.results[t].confidence, 0.9f) << t;
+    EXPECT_TRUE(std::isfinite(r.results[t].log_likelihood));
+  }
+  EXPECT_TRUE(std::isfinite(hmm.context().total_log_likelihood()));
+  EXPECT_EQ(hmm.context().frames(), 300);
+}
+
+TEST_F(TrackingTest, FollowsFasterAndSlowerReplaysWithNoise) {
+  for (const double speed : {1.5, 0.7, 1.2}) {
+    SCOPED_TRACE(speed);
+    const int input_frames = static_cast<int>(590 / speed);
+    const std::vector<Frame> frames = perform({{0, input_frames, speed}}, 1.0 / 60);
+    HmmFollower hmm = HmmFollower::create(model_, {}).value();
+    const Trace r = replay(hmm, model_, frames, 0.1f);
+    EXPECT_EQ(misses(r, 1), 0);
+    OnlineDtwTracker dtw = OnlineDtwTracker::create(model_, {}).value();
+    EXPECT_LE(misses(replay(dtw, model_, frames, 0.1f), 2), input_frames / 50);
+  }
+}
+
+TEST_F(TrackingTest, ThirtyHertzInputAgainstSixtyHertzTemplate) {
+  // dt = 1/30 applies the band twice per input frame; the dancer moves 2 template frames.
+  for (const double speed : {1.0, 0.8, 1.3}) {
+    SCOPED_TRACE(speed);
+    const std::vector<Frame> frames =
+        perform({{0, static_cast<int>(290 / speed), speed}}, 1.0 / 30);
+    HmmFollower hmm = HmmFollower::create(model_, {}).value();
+    const Trace r = replay(hmm, model_, frames, 0.1f);
+    EXPECT_EQ(misses(r, 1), 0);
+    for (std::size_t t = 1; t < r.results.size(); ++t) {
+      EXPECT_EQ(r.results[t].steps, 2);
+      if (t > 3) {
+        EXPECT_FALSE(r.results[t].jumped) << t;
+      }
+    }
+  }
+}
+
+TEST_F(TrackingTest, LateAndIrregularFrames) {
+  // Input frames arrive with jittered intervals, some late by several template frames.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> jitter(0.5, 1.5);
+  std::vector<Frame> frames;
+  double position = 0.0;
+  for (int t = 0; t < 300 && position < 590; ++t) {
+    const double dt = (t % 40 == 39 ? 5.0 : jitter(rng)) / 60.0;
+    position += dt * 60.0;
+    frames.push_back({position, dt});
+  }
+  HmmFollower hmm = HmmFollower::create(model_, {}).value();
+  EXPECT_EQ(misses(replay(hmm, model_, frames, 0.05f), 1), 0);
+}
+
+class LibraryTest : public ::testing::Test {
+ protected:
+  TemplateModel model_ = test::make_model({400, 300, 500}, kDims, 4);
+  // Take 0 from its start, a jump into take 2, a jump back to another part of take 0, a jump to
+  // take 1 at 1.3x, then a jump within take 1 backwards.
+  std::vector<Frame> frames_ = perform(
+      {{0, 120}, {700 + 250, 100}, {200, 90}, {400 + 20, 100, 1.3}, {400 + 60, 80}}, 1.0 / 60);
+};
+
+TEST_F(LibraryTest, RecoversAfterJumpsWithinAndAcrossTakes) {
+  HmmFollower hmm = HmmFollower::create(model_, {}).value();
+  const Trace r = replay(hmm, model_, frames_, 0.1f);
+  int jumps = 0;
+  for (std::size_t t = 0; t < frames_.size(); ++t) {
+    if (!frames_[t].jump) continue;
+    ++jumps;
+    // Back on the right frame within 4 input frames, and it stays there.
+    int recovered = -1;
+    for (std::size_t k = t; k < t + 8 && k < frames_.size(); ++k) {
+      if (std::abs(r.results[k].state - r.truth[k]) <= 1) {
+        recovered = static_cast<int>(k - t);
+        break;
+      }
+    }
+    EXPECT_GE(recovered, 0) << "jump at frame " << t;
+    EXPECT_LE(recovered, 4) << "jump at frame " << t;
+    bool flagged = false;
+    for (std::size_t k = t; k < t + 6; ++k) flagged = flagged || r.results[k].jumped;
+    EXPECT_TRUE(flagged) << "jump at frame " << t;
+    for (std::size_t k = t + 6; k < t + 60; ++k) {
+      EXPECT_LE(std::abs(r.results[k].state - r.truth[k]), 1) << k;
+      EXPECT_FALSE(r.results[k].jumped) << k;
+      EXPECT_EQ(r.results[k].take, model_.take_of(r.truth[k])) << k;
+    }
+  }
+  EXPECT_EQ(jumps, 4);
+}
+
+TEST_F(LibraryTest, PaperPresetAlsoRecovers) {
+  HmmFollower hmm = HmmFollower::create(model_, FollowParams::paper()).value();
+  const Trace r = replay(hmm, model_, frames_, 0.1f);
+  // The paper has no skip transition, so the 1.3x segment is followed through self/next and
+  // the jump; count frames far off rather than requiring +-1 everywhere.
+  EXPECT_LE(misses(r, 3), 30);
+}
+
+TEST_F(LibraryTest, WithoutTheJumpTheLeftToRightHmmStaysInItsTake) {
+  HmmFollower l2r = HmmFollower::create(model_, FollowParams::left_to_right()).value();
+  const Trace r = replay(l2r, model_, frames_, 0.1f);
+  // Tracks take 0 at first, then cannot reach take 2 after the jump.
+  EXPECT_EQ(r.results[100].state, r.truth[100]);
+  EXPECT_EQ(r.results[150].take, 0);
+  EXPECT_FALSE(r.results[150].in_pause);
+  // The naive O(M^2) forward without the jump behaves the same.
+  NaiveHmmFollower naive = NaiveHmmFollower::create(model_, FollowParams::left_to_right()).value();
+  const Trace n = replay(naive, model_, frames_, 0.1f);
+  for (std::size_t t = 0; t < frames_.size(); ++t)
+    EXPECT_EQ(n.results[t].state, r.results[t].state);
+}
+
+TEST_F(LibraryTest, NearestNeighbourFollowsJumpsWithoutMemory) {
+  NearestNeighbourTracker nn = NearestNeighbourTracker::create(model_, {}).value();
+  const Trace r = replay(nn, model_, frames_, 0.02f);
+  EXPECT_LE(misses(r, 1, 0), 5);
+}
+
+TEST_F(LibraryTest, ResetForgetsThePast) {
+  HmmFollower hmm = HmmFollower::create(model_, {}).value();
+  const Trace first = replay(hmm, model_, frames_, 0.1f);
+  const Trace second = replay(hmm, model_, frames_, 0.1f);  // replay() resets first
+  for (std::size_t t = 0; t < frames_.size(); ++t) {
+    EXPECT_EQ(first.results[t].state, second.results[t].state);
+    EXPECT_EQ(first.results[t].log_likelihood, second.results[t].log_likelihood);
+  }
+}
+
+}  // namespace
+}  // namespace duet
