@@ -1,15 +1,18 @@
 // duet follow --pair LEADER PARTNER [...] --input USER.bvh [--trace T.csv] [-o PARTNER.bvh]
+// Runs the run-time loop of method.md 6 over a recorded performance: features, follower, partner
+// synthesis with the corrections that are switched on.
 #include <fmt/format.h>
 
 #include "commands.h"
-#include "duet/follow/hmm_follower.h"
 #include "duet/io/atomic_write.h"
 #include "duet/io/bvh.h"
-#include "duet/live/follow_session.h"
+#include "duet/live/live_loop.h"
 #include "library_options.h"
 #include "motion_options.h"
+#include "partner_options.h"
 #include "progress.h"
 #include "tracker_options.h"
+#include "truth_summary.h"
 
 namespace duet::app {
 
@@ -20,30 +23,40 @@ struct FollowArgs {
   std::string input;
   MotionFileOptions input_motion;
   TrackerArgs tracker;
+  PartnerArgs partner;
   std::string trace_path;
   std::string output_path;
+  std::string user_output_path;
+  std::string truth_path;
 };
 
-// The response clips must share one skeleton to be written into one output file.
-bool responses_share_skeleton(const DuetLibrary& library) {
-  const Skeleton& first = library.takes()[0].response_motion.clip.skeleton();
-  for (const DuetTake& take : library.takes()) {
-    const Skeleton& s = take.response_motion.clip.skeleton();
-    if (s.joint_count() != first.joint_count()) return false;
-    for (int j = 0; j < s.joint_count(); ++j) {
-      if (s.joints[static_cast<std::size_t>(j)].name != first.joints[static_cast<std::size_t>(j)].name)
-        return false;
-    }
+Status write_outputs(const FollowArgs& args, const std::string& trace, const Clip& partner,
+                     const Clip& user) {
+  if (!args.trace_path.empty()) {
+    if (Status s = write_file_atomically(args.trace_path, trace); !s) return s;
   }
-  return true;
+  if (!args.output_path.empty()) {
+    if (Status s = write_bvh(partner, args.output_path); !s) return s;
+  }
+  if (!args.user_output_path.empty()) {
+    if (Status s = write_bvh(user, args.user_output_path); !s) return s;
+  }
+  return Ok{};
 }
 
 int run_follow(const FollowArgs& args) {
-  std::optional<DuetLibrary> library = load_library(args.library, "follow");
-  if (!library) return kExitFailure;
-  if (!args.output_path.empty() && !responses_share_skeleton(*library)) {
-    fmt::print(stderr, "duet follow: -o needs every partner file to share one skeleton\n");
-    return kExitFailure;
+  std::optional<DuetLibrary> loaded = load_library(args.library, "follow");
+  if (!loaded) return kExitFailure;
+  auto library = std::make_shared<const DuetLibrary>(std::move(*loaded));
+
+  std::optional<GroundTruth> truth;
+  if (!args.truth_path.empty()) {
+    Result<GroundTruth> read = read_ground_truth(args.truth_path);
+    if (!read) {
+      fmt::print(stderr, "duet follow: {}\n", read.error().message);
+      return kExitFailure;
+    }
+    truth = std::move(read).value();
   }
 
   MotionLoadOptions load_options;
@@ -54,61 +67,65 @@ int run_follow(const FollowArgs& args) {
     return kExitFailure;
   }
   const Clip& user = input.value().clip;
+  if (truth && truth->rows.size() != static_cast<std::size_t>(user.frame_count())) {
+    fmt::print(stderr, "duet follow: {}: {} rows of ground truth for {} input frames\n",
+               args.truth_path, truth->rows.size(), user.frame_count());
+    return kExitFailure;
+  }
 
   Result<std::unique_ptr<Tracker>> tracker = make_tracker(args.tracker, library->model());
   if (!tracker) {
     fmt::print(stderr, "duet follow: {}\n", tracker.error().message);
     return kExitFailure;
   }
-  Result<FollowSession> session = FollowSession::create(
-      *library, user.skeleton_ptr(), input.value().roles, std::move(tracker).value());
-  if (!session) {
-    fmt::print(stderr, "duet follow: {}\n", session.error().message);
+  SourceSkeleton user_skeleton{user.skeleton_ptr(), input.value().roles,
+                               input.value().metres_per_unit, user.frame_rate()};
+  Result<LiveLoop> loop = LiveLoop::create(library, user_skeleton, std::move(tracker).value(),
+                                           make_partner_params(args.partner));
+  if (!loop) {
+    fmt::print(stderr, "duet follow: {}\n", loop.error().message);
     return kExitFailure;
   }
 
-  const Clip& first_response = library->takes()[0].response_motion.clip;
-  Clip partner(first_response.skeleton_ptr(), user.frame_rate(), user.frame_count());
+  Clip partner(loop.value().partner_skeleton(), user.frame_rate(), user.frame_count());
   std::string trace = "frame,time_s,take,template_frame,confidence,jumped,lost\n";
+  std::vector<FollowResult> results;
+  results.reserve(static_cast<std::size_t>(user.frame_count()));
+  SourceFrame frame;
+  frame.resize(user.joint_count());
   ProgressBar bar("following");
-  int jumps = 0, lost = 0;
-  double confidence_sum = 0.0;
   for (int f = 0; f < user.frame_count(); ++f) {
-    const double time_s = f / user.frame_rate();
-    const FollowResult r =
-        session.value().step(user.translations_ls(f), user.rotations_ls(f), time_s);
-    jumps += r.jumped ? 1 : 0;
-    lost += r.lost ? 1 : 0;
-    confidence_sum += r.confidence;
-    fmt::format_to(std::back_inserter(trace), "{},{:.6f},{},{},{:.4f},{},{}\n", f, time_s, r.take,
-                   r.frame_in_take, r.confidence, r.jumped ? 1 : 0, r.lost ? 1 : 0);
-    if (!args.output_path.empty() && r.take >= 0) {
-      const Clip& response = library->takes()[static_cast<std::size_t>(r.take)].response_motion.clip;
-      std::ranges::copy(response.translations_ls(r.frame_in_take), partner.translations_ls(f).begin());
-      std::ranges::copy(response.rotations_ls(r.frame_in_take), partner.rotations_ls(f).begin());
-    }
+    frame.time_s = f / user.frame_rate();
+    frame.arrival = SteadyClock::now();
+    std::ranges::copy(user.translations_ls(f), frame.translations_ls.begin());
+    std::ranges::copy(user.rotations_ls(f), frame.rotations_ls.begin());
+    const LiveOutput& out = loop.value().step(frame);
+    const FollowResult& r = out.follow;
+    results.push_back(r);
+    fmt::format_to(std::back_inserter(trace), "{},{:.6f},{},{},{:.4f},{},{}\n", f, frame.time_s,
+                   r.take, r.frame_in_take, r.confidence, r.jumped ? 1 : 0, r.lost ? 1 : 0);
+    std::ranges::copy(out.partner_translations_ls, partner.translations_ls(f).begin());
+    std::ranges::copy(out.partner_rotations_ls, partner.rotations_ls(f).begin());
     if (f % 64 == 0) bar.update(f, user.frame_count());
   }
   bar.update(user.frame_count(), user.frame_count());
   bar.finish();
 
-  if (!args.trace_path.empty()) {
-    if (Status s = write_file_atomically(args.trace_path, trace); !s) {
-      fmt::print(stderr, "duet follow: {}\n", s.error().message);
-      return kExitFailure;
-    }
+  if (Status s = write_outputs(args, trace, partner, user); !s) {
+    fmt::print(stderr, "duet follow: {}\n", s.error().message);
+    return kExitFailure;
   }
-  if (!args.output_path.empty()) {
-    if (Status s = write_bvh(partner, args.output_path); !s) {
-      fmt::print(stderr, "duet follow: {}\n", s.error().message);
-      return kExitFailure;
-    }
+  int jumps = 0, lost = 0;
+  for (const FollowResult& r : results) {
+    jumps += r.jumped ? 1 : 0;
+    lost += r.lost ? 1 : 0;
   }
   fmt::print("followed {} frames ({:.1f} s) against {} take(s), {} states: {} jumps, {} lost "
-             "frames, mean confidence {:.3f}\n",
+             "frames; corrections: {}\n",
              user.frame_count(), user.duration(), library->takes().size(),
              library->model().num_states(), jumps, lost,
-             user.frame_count() ? confidence_sum / user.frame_count() : 0.0);
+             corrections_string(loop.value().params()));
+  if (truth) print_accuracy_summary(*truth, results, library->frame_rate());
   return kExitOk;
 }
 
@@ -122,11 +139,19 @@ Command register_follow(CLI::App& app) {
       ->check(CLI::ExistingFile);
   add_motion_file_options(app, args->input_motion, "input-");
   add_tracker_options(app, args->tracker);
+  add_partner_options(app, args->partner);
   app.add_option("--trace", args->trace_path,
                  "Write one CSV row per input frame: "
                  "frame,time_s,take,template_frame,confidence,jumped,lost");
   app.add_option("-o,--output", args->output_path,
-                 "Write the partner's motion (BVH, metres, the input's rate and frame count)");
+                 "Write the partner's motion: BVH in metres, in the user's world frame, at the "
+                 "input's rate and frame count");
+  app.add_option("--user-output", args->user_output_path,
+                 "Also write the user's motion in metres, sharing the partner file's world frame "
+                 "(open both together to see the duet)");
+  app.add_option("--truth", args->truth_path,
+                 "Ground truth CSV from `duet improvise`: print the follower's accuracy")
+      ->check(CLI::ExistingFile);
   return [args] { return run_follow(*args); };
 }
 

@@ -16,5 +16,9 @@ using Command = std::function<int()>;
 Command register_inspect(CLI::App& app);
 Command register_convert(CLI::App& app);
 Command register_follow(CLI::App& app);
+Command register_serve(CLI::App& app);
+Command register_eval(CLI::App& app);
+Command register_improvise(CLI::App& app);
+Command register_contacts(CLI::App& app);
 
 }  // namespace duet::app

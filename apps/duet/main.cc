@@ -21,6 +21,14 @@ int main(int argc, char** argv) {
   add("convert", "Convert ASF+AMC or BVH to BVH (rescaled, resampled)", duet::app::register_convert);
   add("follow", "Follow a dancer through a library of duets and answer with the partner",
       duet::app::register_follow);
+  add("serve", "Follow a live dancer (file replay, mocap stream, WebSocket) and serve the viewer",
+      duet::app::register_serve);
+  add("eval", "Measure followers on synthetic performances with ground truth from the takes",
+      duet::app::register_eval);
+  add("improvise", "Write a synthetic performance of a take (BVH) and its ground truth (CSV)",
+      duet::app::register_improvise);
+  add("contacts", "Print the hand-contact intervals of a captured duet, per hand pair",
+      duet::app::register_contacts);
 
   try {
     app.parse(argc, argv);

@@ -1,13 +1,28 @@
 #include "tracker_options.h"
 
 #include "duet/follow/hmm_follower.h"
+#include "duet/follow/naive_hmm.h"
+#include "duet/follow/nearest_neighbour.h"
+#include "duet/follow/online_dtw.h"
 
 namespace duet::app {
 
+namespace {
+
+template <typename T>
+Result<std::unique_ptr<Tracker>> boxed(Result<T> tracker) {
+  if (!tracker) return tracker.error();
+  return std::unique_ptr<Tracker>(std::make_unique<T>(std::move(tracker).value()));
+}
+
+}  // namespace
+
 void add_tracker_options(CLI::App& app, TrackerArgs& args) {
   app.add_option("--tracker", args.kind,
-                 "Follower: hmm (the jump HMM, default) or left-to-right (no jump)")
-      ->check(CLI::IsMember({"hmm", "left-to-right"}));
+                 "Follower: hmm (the jump HMM, default), left-to-right (no jump), nearest "
+                 "(per-frame nearest neighbour), dtw (online DTW), naive (the O(M^2) forward of "
+                 "eq. 10; at most 8192 states)")
+      ->check(CLI::IsMember({"hmm", "left-to-right", "nearest", "dtw", "naive"}));
   app.add_option("--preset", args.preset,
                  "HMM probabilities: default (chosen by measurement) or paper (Mousas 2018)")
       ->check(CLI::IsMember({"default", "paper"}));
@@ -18,11 +33,12 @@ void add_tracker_options(CLI::App& app, TrackerArgs& args) {
 Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args,
                                               const TemplateModel& model) {
   FollowParams params = args.preset == "paper" ? FollowParams::paper() : FollowParams{};
-  if (args.kind == "left-to-right") params.jump_enabled = false;
   if (args.sigma) params.emission_sigma = *args.sigma;
-  Result<HmmFollower> follower = HmmFollower::create(model, params);
-  if (!follower) return follower.error();
-  return std::unique_ptr<Tracker>(std::make_unique<HmmFollower>(std::move(follower).value()));
+  if (args.kind == "nearest") return boxed(NearestNeighbourTracker::create(model, params));
+  if (args.kind == "dtw") return boxed(OnlineDtwTracker::create(model, OnlineDtwParams{}));
+  if (args.kind == "naive") return boxed(NaiveHmmFollower::create(model, params));
+  if (args.kind == "left-to-right") params.jump_enabled = false;
+  return boxed(HmmFollower::create(model, params));
 }
 
 }  // namespace duet::app

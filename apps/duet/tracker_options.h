@@ -13,7 +13,7 @@
 namespace duet::app {
 
 struct TrackerArgs {
-  std::string kind = "hmm";        // hmm | left-to-right
+  std::string kind = "hmm";        // hmm | left-to-right | nearest | dtw | naive
   std::string preset = "default";  // default | paper
   std::optional<float> sigma;      // emission sigma override
 };

@@ -1,0 +1,29 @@
+#include "partner_options.h"
+
+namespace duet::app {
+
+void add_partner_options(CLI::App& app, PartnerArgs& args) {
+  app.add_flag("--no-align", args.no_align,
+               "Do not place the partner relative to the user (keep the capture's place)");
+  app.add_flag("--no-contact", args.no_contact, "No hand-contact IK");
+  app.add_flag("--no-smooth", args.no_smooth, "No per-joint rotation smoothing");
+  app.add_flag("--no-footlock", args.no_footlock, "Do not keep planted feet in place");
+  app.add_flag("--no-blend", args.no_blend, "Cut instead of blending when the follower jumps");
+  app.add_option("--ik-target", args.ik_target,
+                 "Where a held hand goes: offset (the captured grip relative to the user's hand, "
+                 "default) or wrist (the user's wrist, as in the paper)")
+      ->check(CLI::IsMember({"offset", "wrist"}));
+}
+
+PartnerParams make_partner_params(const PartnerArgs& args) {
+  PartnerParams params;
+  params.align = !args.no_align;
+  params.contact = !args.no_contact;
+  params.smooth = !args.no_smooth;
+  params.foot_lock = !args.no_footlock;
+  params.blend = !args.no_blend;
+  parse_ik_target(args.ik_target, params.ik_target);
+  return params;
+}
+
+}  // namespace duet::app

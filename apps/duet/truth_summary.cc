@@ -1,0 +1,80 @@
+#include "truth_summary.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "duet/eval/metrics.h"
+
+namespace duet::app {
+
+namespace {
+
+constexpr const char* kHeader = "frame,time_s,take,template_frame,in_pause,jump";
+
+bool parse_row(const std::string& line, double (&fields)[6]) {
+  std::istringstream in(line);
+  std::string cell;
+  for (double& field : fields) {
+    if (!std::getline(in, cell, ',')) return false;
+    try {
+      std::size_t used = 0;
+      field = std::stod(cell, &used);
+      if (used != cell.size() || !std::isfinite(field)) return false;
+    } catch (const std::exception&) {
+      return false;
+    }
+  }
+  return !std::getline(in, cell, ',');
+}
+
+}  // namespace
+
+Result<GroundTruth> read_ground_truth(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return make_error(path, 0, "cannot open ground truth");
+  std::string line;
+  if (!std::getline(in, line) || line != kHeader) {
+    return make_error(path, 1, std::string("expected the header '") + kHeader + "'");
+  }
+  GroundTruth truth;
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty()) continue;
+    double f[6];
+    if (!parse_row(line, f)) {
+      return make_error(path, line_number, "expected six numbers: " + std::string(kHeader));
+    }
+    if (f[0] != static_cast<double>(truth.rows.size())) {
+      return make_error(path, line_number, "frames must count up from 0");
+    }
+    truth.times_s.push_back(f[1]);
+    truth.rows.push_back(TruthFrame{static_cast<int>(f[2]), f[3], f[4] != 0.0, f[5] != 0.0});
+  }
+  return truth;
+}
+
+void print_accuracy_summary(const GroundTruth& truth, std::span<const FollowResult> results,
+                            double template_rate_hz) {
+  std::vector<FrameEstimate> estimates;
+  estimates.reserve(results.size());
+  for (const FollowResult& r : results) {
+    estimates.push_back(FrameEstimate{r.take, r.frame_in_take, r.lost, r.jumped, 0.0});
+  }
+  MetricsAccumulator accumulator;
+  accumulator.add(truth.rows, truth.times_s, estimates, template_rate_hz);
+  const Metrics m = accumulator.summary();
+  fmt::print("accuracy against the ground truth ({} frames scored, {} pause frames left out):\n",
+             m.scored_frames, m.pause_frames);
+  fmt::print("  within 50 / 100 / 300 ms: {:.1f}% / {:.1f}% / {:.1f}%\n", 100 * m.within_50ms,
+             100 * m.within_100ms, 100 * m.within_300ms);
+  fmt::print("  mean error {:.0f} ms, median {:.0f} ms; wrong take {:.1f}%\n", m.mean_error_ms,
+             m.median_error_ms, 100 * m.miss_fraction);
+  fmt::print("  jumps recovered {}/{}, median recovery {:.2f} s\n", m.recovered_jumps, m.jumps,
+             m.median_recovery_s);
+}
+
+}  // namespace duet::app
