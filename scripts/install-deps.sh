@@ -5,6 +5,7 @@ packages=(
   build-essential cmake ninja-build clang git curl ca-certificates
   libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox libboost1.81-dev
+  chromium fonts-liberation
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,332 @@
+// duet eval --pair LEADER PARTNER [...] [--takes 0,2] [--cases ...] [--trackers ...] [--csv F]
+//           [--plots DIR] [tuning options]
+// Synthetic performances with ground truth from the real takes, followed by the HMM and the
+// baselines; prints a table (docs/evaluation.md).
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <set>
+
+#include "commands.h"
+#include "duet/eval/report.h"
+#include "duet/eval/runner.h"
+#include "duet/io/atomic_write.h"
+#include "library_options.h"
+#include "progress.h"
+
+namespace duet::app {
+
+namespace {
+
+struct EvalArgs {
+  LibraryArgs library;
+  std::vector<int> takes;
+  std::vector<std::string> cases;
+  std::vector<std::string> trackers;
+  std::uint64_t seed = 1;
+  std::string csv_path;
+  std::string plots_dir;
+  std::string trace_case = "improv-pause";
+  CaseSettings settings;
+  double noise_cm = 1.0;
+  // Tuning of the "hmm" tracker (FollowParams fields); unset keeps the follower's defaults.
+  std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
+      pause_distance, lost_distance;
+  std::optional<int> dtw_back, dtw_ahead;
+  // Feature weights (FeatureSpec); unset keeps the defaults.
+  std::optional<double> posture_weight, root_velocity_weight, effector_speed_weight,
+      velocity_window;
+};
+
+constexpr const char* kCommand = "eval";
+
+int usage_error(const std::string& message) {
+  fmt::print(stderr, "duet eval: {}\n", message);
+  return kExitUsage;
+}
+
+// Case names, plus the group "tempo" (tempo-slow, tempo-fast) and "all".
+bool select_cases(const std::vector<std::string>& names, const std::vector<EvalCase>& standard,
+                  std::vector<EvalCase>& selected, std::string& error) {
+  std::set<std::string> wanted;
+  for (const std::string& name : names) {
+    if (name == "all") {
+      for (const EvalCase& c : standard) wanted.insert(c.name);
+    } else if (name == "tempo") {
+      wanted.insert("tempo-slow");
+      wanted.insert("tempo-fast");
+    } else if (std::ranges::none_of(standard, [&](const EvalCase& c) { return c.name == name; })) {
+      std::string known;
+      for (const EvalCase& c : standard) known += (known.empty() ? "" : ", ") + c.name;
+      error = "unknown case '" + name + "' (known: " + known + ", tempo, all)";
+      return false;
+    } else {
+      wanted.insert(name);
+    }
+  }
+  for (const EvalCase& c : standard) {  // report order
+    if (wanted.contains(c.name)) selected.push_back(c);
+  }
+  return true;
+}
+
+// The gnuplot program on PATH, or empty.
+std::string find_gnuplot() {
+  const char* path = std::getenv("PATH");
+  if (path == nullptr) return {};
+  std::string dirs = path;
+  std::size_t begin = 0;
+  while (begin <= dirs.size()) {
+    const std::size_t end = std::min(dirs.find(':', begin), dirs.size());
+    const std::string dir = dirs.substr(begin, end - begin);
+    const std::string candidate = (dir.empty() ? "." : dir) + "/gnuplot";
+    if (access(candidate.c_str(), X_OK) == 0) return candidate;
+    begin = end + 1;
+  }
+  return {};
+}
+
+std::string shell_quote(const std::string& text) {
+  std::string out = "'";
+  for (const char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+int write_plots(const EvalReport& report, const std::string& dir, const std::string& gnuplot) {
+  const std::string quiet = " >/dev/null 2>&1";
+  const bool cairo =
+      std::system((shell_quote(gnuplot) + " -e 'set terminal pngcairo'" + quiet).c_str()) == 0;
+  for (const PlotFile& file : make_eval_plots(report, cairo ? "pngcairo" : "png")) {
+    if (Status s =
+            write_file_atomically((std::filesystem::path(dir) / file.name).string(), file.content);
+        !s) {
+      fmt::print(stderr, "duet eval: {}\n", s.error().message);
+      return kExitFailure;
+    }
+  }
+  const std::string command =
+      "cd " + shell_quote(dir) + " && " + shell_quote(gnuplot) + " plots.gp 2>&1";
+  if (std::system(command.c_str()) != 0) {
+    fmt::print(stderr, "duet eval: gnuplot failed on {}/plots.gp\n", dir);
+    return kExitFailure;
+  }
+  fmt::print("plots: {}/accuracy.png{}\n", dir,
+             report.traces.empty() ? "" : fmt::format(", {}/trace.png", dir));
+  return kExitOk;
+}
+
+int run_eval(EvalArgs& args) {
+  // Everything that can be checked before loading the library.
+  const int pair_count = static_cast<int>(args.library.pair_files.size() / 2);
+  args.settings.noise_position_m = args.noise_cm / 100.0;
+  const std::vector<EvalCase> standard = standard_cases(args.settings);
+  EvalOptions options;
+  std::string error;
+  if (args.cases.empty()) args.cases = {"all"};
+  if (!select_cases(args.cases, standard, options.cases, error)) return usage_error(error);
+  if (args.trackers.empty()) {
+    options.trackers = all_tracker_kinds();
+  } else {
+    for (const std::string& name : args.trackers) {
+      TrackerKind kind;
+      if (!parse_tracker_kind(name, kind)) {
+        return usage_error("unknown tracker '" + name +
+                           "' (known: hmm, hmm-paper, left-to-right, nearest, online-dtw, "
+                           "naive-hmm)");
+      }
+      options.trackers.push_back(kind);
+    }
+  }
+  if (args.takes.empty()) {  // the first, middle and last take
+    for (const int k : {0, (pair_count - 1) / 2, pair_count - 1}) {
+      if (std::ranges::find(args.takes, k) == args.takes.end()) args.takes.push_back(k);
+    }
+  }
+  for (const int k : args.takes) {
+    if (k < 0 || k >= pair_count) {
+      return usage_error(fmt::format("--takes {}: there are {} pairs (takes 0..{})", k, pair_count,
+                                     pair_count - 1));
+    }
+  }
+  if (std::ranges::none_of(standard,
+                           [&](const EvalCase& c) { return c.name == args.trace_case; })) {
+    return usage_error("--trace-case: unknown case '" + args.trace_case + "'");
+  }
+  options.takes = args.takes;
+  options.seed = args.seed;
+  options.trace_case = args.plots_dir.empty() ? "" : args.trace_case;
+
+  FollowParams& hmm = options.hmm;
+  if (args.sigma) hmm.emission_sigma = *args.sigma;
+  if (args.self_prob) hmm.self_prob = *args.self_prob;
+  if (args.next_prob) hmm.next_prob = *args.next_prob;
+  if (args.skip_prob) hmm.skip_prob = *args.skip_prob;
+  if (args.leave_prob) hmm.leave_prob = *args.leave_prob;
+  if (args.pause_stay) hmm.pause_stay_prob = *args.pause_stay;
+  if (args.pause_distance) hmm.pause_distance_per_dim = *args.pause_distance;
+  if (args.lost_distance) hmm.lost_distance_per_dim = *args.lost_distance;
+  if (Status s = hmm.validate(1); !s) return usage_error(s.error().message);
+  if (args.dtw_back) options.dtw.window_back = *args.dtw_back;
+  if (args.dtw_ahead) options.dtw.window_ahead = *args.dtw_ahead;
+
+  FeatureSpec features;
+  if (args.posture_weight) features.posture_weight = *args.posture_weight;
+  if (args.root_velocity_weight) features.root_velocity_weight = *args.root_velocity_weight;
+  if (args.effector_speed_weight) features.effector_speed_weight = *args.effector_speed_weight;
+  if (args.velocity_window) features.velocity_window_s = *args.velocity_window;
+
+  std::string gnuplot;
+  if (!args.plots_dir.empty()) {
+    gnuplot = find_gnuplot();
+    if (gnuplot.empty()) {
+      fmt::print(stderr,
+                 "duet eval: --plots needs gnuplot, which is not on PATH (install it, e.g. "
+                 "`apt-get install gnuplot-nox`, or leave out --plots)\n");
+      return kExitFailure;
+    }
+    std::error_code ec;
+    std::filesystem::create_directories(args.plots_dir, ec);
+    if (ec) {
+      fmt::print(stderr, "duet eval: cannot create the plot directory {}: {}\n", args.plots_dir,
+                 ec.message());
+      return kExitFailure;
+    }
+  }
+
+  // The libraries: the user's role, and role=partner for the partner-role case.
+  std::optional<DuetLibrary> library = load_library(args.library, kCommand, features);
+  if (!library) return kExitFailure;
+  const bool need_partner =
+      std::ranges::any_of(options.cases, [](const EvalCase& c) { return c.partner_role; });
+  std::optional<DuetLibrary> partner_library;
+  const DuetLibrary* partner = nullptr;
+  if (need_partner) {
+    if (args.library.role == "partner") {
+      partner = &*library;
+    } else {
+      LibraryArgs partner_args = args.library;
+      partner_args.role = "partner";
+      partner_library = load_library(partner_args, kCommand, features);
+      if (!partner_library) return kExitFailure;
+      partner = &*partner_library;
+    }
+  }
+
+  ProgressBar bar("evaluating");
+  Result<EvalReport> report = run_evaluation(
+      *library, partner, options,
+      [&](long long done, long long total, const std::string&) { bar.update(done, total); });
+  bar.finish();
+  if (!report) {
+    fmt::print(stderr, "duet eval: {}\n", report.error().message);
+    return kExitFailure;
+  }
+
+  std::string takes;
+  for (const int k : options.takes) {
+    takes += fmt::format("{}{} ({})", takes.empty() ? "" : ", ", k,
+                         library->takes()[static_cast<std::size_t>(k)].name);
+  }
+  fmt::print(
+      "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
+      "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
+      "lost_distance {}\n\n",
+      library->takes().size(), library->model().num_states(), library->frame_rate(),
+      args.library.role, takes, options.seed, hmm.self_prob, hmm.next_prob, hmm.skip_prob,
+      hmm.leave_prob, hmm.pause_stay_prob, hmm.emission_sigma, hmm.pause_distance_per_dim,
+      hmm.lost_distance_per_dim);
+  fmt::print("{}", format_eval_table(report.value()));
+  std::fflush(stdout);
+
+  if (!args.csv_path.empty()) {
+    if (Status s = write_file_atomically(args.csv_path, format_eval_csv(report.value())); !s) {
+      fmt::print(stderr, "duet eval: {}\n", s.error().message);
+      return kExitFailure;
+    }
+  }
+  if (!args.plots_dir.empty()) return write_plots(report.value(), args.plots_dir, gnuplot);
+  return kExitOk;
+}
+
+}  // namespace
+
+Command register_eval(CLI::App& app) {
+  auto args = std::make_shared<EvalArgs>();
+  add_library_options(app, args->library);
+  app.add_option("--takes", args->takes,
+                 "Takes to perform from, as indices of the --pair list, e.g. 0,2 (default: the "
+                 "first, middle and last)")
+      ->delimiter(',');
+  app.add_option("--cases", args->cases,
+                 "Cases to run, comma-separated (default all): clean, tempo-slow, tempo-fast "
+                 "(or tempo), drift, improv, improv-pause, improv-library, noise, 30hz-noisy, "
+                 "late-frames, body-size, room-place, partner-role, improv-30hz-noisy")
+      ->delimiter(',');
+  app.add_option("--trackers", args->trackers,
+                 "Followers, comma-separated (default all): hmm, hmm-paper, left-to-right, "
+                 "nearest, online-dtw, naive-hmm (O(M^2), run on the first take alone)")
+      ->delimiter(',');
+  app.add_option("--seed", args->seed, "Seed of every random choice (same seed, same numbers)");
+  app.add_option("--csv", args->csv_path, "Write the metrics per case, tracker and take as CSV");
+  app.add_option("--plots", args->plots_dir,
+                 "Write PNG plots (needs gnuplot) into this directory: accuracy.png, trace.png");
+  app.add_option("--trace-case", args->trace_case,
+                 "Case whose per-frame estimates trace.png shows (default improv-pause)");
+
+  auto* cases = app.add_option_group("case magnitudes");
+  cases
+      ->add_option("--noise-deg", args->settings.noise_rotation_deg,
+                   "Rotation noise, RMS angle per joint per frame (default 3)")
+      ->check(CLI::NonNegativeNumber);
+  cases->add_option("--noise-cm", args->noise_cm, "Root position noise per axis (default 1)")
+      ->check(CLI::NonNegativeNumber);
+  cases
+      ->add_option("--low-rate", args->settings.low_rate_hz,
+                   "Sensor rate of the 30hz cases (default 30)")
+      ->check(CLI::PositiveNumber);
+  cases
+      ->add_option("--body-scale", args->settings.body_scale,
+                   "Body size factor of the body-size case (default 1.15)")
+      ->check(CLI::PositiveNumber);
+  cases
+      ->add_option("--improv-duration", args->settings.improvise_duration_s,
+                   "Length of the improvised performances in s (default: the take's length)")
+      ->check(CLI::NonNegativeNumber);
+
+  auto* tuning = app.add_option_group("follower tuning (the hmm tracker; see FollowParams)");
+  tuning->add_option("--sigma", args->sigma, "Emission sigma (all HMM variants)")
+      ->check(CLI::PositiveNumber);
+  tuning->add_option("--self", args->self_prob, "self_prob")->check(CLI::Range(0.0, 1.0));
+  tuning->add_option("--next", args->next_prob, "next_prob")->check(CLI::Range(0.0, 1.0));
+  tuning->add_option("--skip", args->skip_prob, "skip_prob")->check(CLI::Range(0.0, 1.0));
+  tuning->add_option("--leave", args->leave_prob, "leave_prob")->check(CLI::Range(0.0, 1.0));
+  tuning->add_option("--pause-stay", args->pause_stay, "pause_stay_prob (A_NN)")
+      ->check(CLI::Range(0.0, 1.0));
+  tuning
+      ->add_option("--pause-distance", args->pause_distance,
+                   "pause_distance_per_dim (all HMM variants)")
+      ->check(CLI::NonNegativeNumber);
+  tuning->add_option("--lost-distance", args->lost_distance, "lost_distance_per_dim (all trackers)")
+      ->check(CLI::NonNegativeNumber);
+  tuning->add_option("--dtw-back", args->dtw_back, "online DTW window behind the estimate")
+      ->check(CLI::NonNegativeNumber);
+  tuning->add_option("--dtw-ahead", args->dtw_ahead, "online DTW window ahead of the estimate")
+      ->check(CLI::NonNegativeNumber);
+  tuning->add_option("--posture-weight", args->posture_weight, "FeatureSpec posture_weight")
+      ->check(CLI::NonNegativeNumber);
+  tuning
+      ->add_option("--root-velocity-weight", args->root_velocity_weight,
+                   "FeatureSpec root_velocity_weight")
+      ->check(CLI::NonNegativeNumber);
+  tuning
+      ->add_option("--effector-speed-weight", args->effector_speed_weight,
+                   "FeatureSpec effector_speed_weight")
+      ->check(CLI::NonNegativeNumber);
+  tuning->add_option("--velocity-window", args->velocity_window, "FeatureSpec velocity_window_s")
+      ->check(CLI::PositiveNumber);
+  return [args] { return run_eval(*args); };
+}
+
+}  // namespace duet::app

@@ -1,0 +1,364 @@
+// duet serve --pair LEADER PARTNER [...] --source SPEC [--http ADDR:PORT] [--web DIR] [--record
+// DIR] Runs the live loop at the rate frames arrive and serves the viewer. See docs/serve.md.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <charconv>
+#include <filesystem>
+
+#include "commands.h"
+#include "duet/live/live_loop.h"
+#include "duet/live/source_neuron.h"
+#include "duet/live/source_pose.h"
+#include "duet/live/source_replay.h"
+#include "duet/live/source_spec.h"
+#include "duet/net/live_server.h"
+#include "library_options.h"
+#include "tracker_options.h"
+
+namespace duet::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ServeArgs {
+  LibraryArgs library;
+  TrackerArgs tracker;
+  bool no_align = false, no_contact = false, no_smooth = false, no_footlock = false,
+       no_blend = false;
+  std::string source = "ws";
+  std::string source_skeleton;
+  std::optional<double> source_fps;
+  std::optional<double> source_scale;
+  std::string source_map;
+  std::string http = "127.0.0.1:8080";
+  std::string web;
+  std::string record = "recordings";
+  bool no_record = false;
+  bool exit_at_end = false;
+  double log_interval_s = 5.0;
+  int queue_frames = 2;
+  std::string priority = "realtime";
+};
+
+void fail(const std::string& message) { fmt::print(stderr, "duet serve: {}\n", message); }
+
+double milliseconds(std::int64_t us) { return static_cast<double>(us) / 1000.0; }
+
+// "ADDR:PORT", "PORT", ":PORT" or "[V6]:PORT".
+bool parse_http(const std::string& text, std::string& address, std::uint16_t& port) {
+  std::string_view port_text = text;
+  address = "127.0.0.1";
+  if (!text.empty() && text.front() == '[') {
+    const std::size_t close = text.find(']');
+    if (close == std::string::npos || close + 1 >= text.size() || text[close + 1] != ':') {
+      return false;
+    }
+    address = text.substr(1, close - 1);
+    port_text = std::string_view(text).substr(close + 2);
+  } else if (const std::size_t colon = text.rfind(':'); colon != std::string::npos) {
+    if (colon > 0) address = text.substr(0, colon);
+    port_text = std::string_view(text).substr(colon + 1);
+  }
+  unsigned value = 0;
+  const auto [ptr, ec] =
+      std::from_chars(port_text.data(), port_text.data() + port_text.size(), value);
+  if (ec != std::errc() || ptr != port_text.data() + port_text.size() || value > 65535)
+    return false;
+  port = static_cast<std::uint16_t>(value);
+  return true;
+}
+
+bool is_loopback(const std::string& address) {
+  return address == "localhost" || address == "::1" || address.starts_with("127.");
+}
+
+// --web, else web/dist in the working directory, else web/dist in the source tree this binary
+// was built from.
+fs::path find_web_dir(const std::string& arg) {
+  if (!arg.empty()) return arg;
+  std::error_code ec;
+  const fs::path here = "web/dist";
+  if (fs::is_regular_file(here / "index.html", ec)) return here;
+  const fs::path source_tree = fs::path(__FILE__).parent_path().parent_path().parent_path();
+  const fs::path built = source_tree / "web" / "dist";
+  if (fs::is_regular_file(built / "index.html", ec)) return built;
+  return {};
+}
+
+MotionLoadOptions source_load_options(const ServeArgs& args, std::optional<double> fps, bool& ok) {
+  MotionLoadOptions options;
+  options.frame_rate = fps;
+  options.metres_per_unit = args.source_scale;
+  ok = true;
+  if (!args.source_map.empty()) {
+    SkeletonMap map;
+    std::string error;
+    if (!load_skeleton_map(args.source_map, map, error)) {
+      fail(error);
+      ok = false;
+    }
+    options.map = map;
+  }
+  return options;
+}
+
+Result<SourceSkeleton> load_source_skeleton(const std::string& path, const ServeArgs& args,
+                                            double default_rate) {
+  bool ok = false;
+  const MotionLoadOptions options = source_load_options(args, args.source_fps, ok);
+  if (!ok) return Error{"bad --source-map"};
+  Result<LoadedMotion> motion = load_motion({path}, options);
+  if (!motion) return motion.error();
+  SourceSkeleton skeleton;
+  skeleton.skeleton = motion.value().clip.skeleton_ptr();
+  skeleton.roles = motion.value().roles;
+  skeleton.metres_per_unit = motion.value().metres_per_unit;
+  const double file_rate = motion.value().clip.frame_rate();
+  skeleton.frame_rate = args.source_fps                                 ? *args.source_fps
+                        : (file_rate > 0.0 && std::isfinite(file_rate)) ? file_rate
+                                                                        : default_rate;
+  return skeleton;
+}
+
+Result<std::unique_ptr<FrameSource>> make_source(const SourceSpec& spec, const ServeArgs& args,
+                                                 const DuetLibrary& library) {
+  switch (spec.kind) {
+    case SourceKind::kReplay: {
+      // A replayed file is usually a take of the same capture: --fps applies unless
+      // --source-fps says otherwise.
+      bool ok = false;
+      const MotionLoadOptions options =
+          source_load_options(args, args.source_fps ? args.source_fps : args.library.fps, ok);
+      if (!ok) return Error{"bad --source-map"};
+      Result<LoadedMotion> motion = load_motion({spec.path}, options);
+      if (!motion) return motion.error();
+      Result<ReplaySource> replay = ReplaySource::create(std::move(motion).value(), spec.replay,
+                                                         fs::path(spec.path).filename().string());
+      if (!replay) return replay.error();
+      return std::unique_ptr<FrameSource>(
+          std::make_unique<ReplaySource>(std::move(replay).value()));
+    }
+    case SourceKind::kNeuronTcp:
+    case SourceKind::kNeuronUdp: {
+      if (args.source_skeleton.empty()) {
+        return Error{
+            "a Perception Neuron source needs --source-skeleton HEADER.bvh (a BVH "
+            "exported by Axis for the same skeleton; its motion is ignored)"};
+      }
+      Result<SourceSkeleton> skeleton = load_source_skeleton(args.source_skeleton, args, 60.0);
+      if (!skeleton) return skeleton.error();
+      NeuronStreamOptions options;
+      options.reference = spec.reference;
+      const std::string name =
+          fmt::format("Perception Neuron BVH over {} {} {}:{}",
+                      spec.kind == SourceKind::kNeuronTcp ? "TCP" : "UDP",
+                      spec.kind == SourceKind::kNeuronTcp ? "from" : "on", spec.host, spec.port);
+      return std::unique_ptr<FrameSource>(
+          std::make_unique<NeuronSource>(std::move(skeleton).value(), options, name));
+    }
+    case SourceKind::kWebSocket: {
+      const std::string path = !spec.path.empty() ? spec.path : args.source_skeleton;
+      SourceSkeleton skeleton;
+      std::string which;
+      if (!path.empty()) {
+        Result<SourceSkeleton> loaded = load_source_skeleton(path, args, library.frame_rate());
+        if (!loaded) return loaded.error();
+        skeleton = std::move(loaded).value();
+        which = fs::path(path).filename().string();
+      } else {
+        // Poses in the template's own skeleton (the first take of the user's role).
+        const LoadedMotion& t = library.takes()[0].template_motion;
+        skeleton.skeleton = t.clip.skeleton_ptr();
+        skeleton.roles = t.roles;
+        skeleton.metres_per_unit = 1.0;
+        skeleton.frame_rate = args.source_fps ? *args.source_fps : library.frame_rate();
+        which = "the skeleton of " + library.takes()[0].name;
+      }
+      return std::unique_ptr<FrameSource>(
+          std::make_unique<PoseSource>(std::move(skeleton), PoseSourceOptions{},
+                                       "poses from WebSocket clients (" + which + ")"));
+    }
+  }
+  return Error{"unknown source"};
+}
+
+Result<std::unique_ptr<LiveLoop>> make_loop(std::shared_ptr<const DuetLibrary> library,
+                                            const TrackerArgs& tracker_args,
+                                            const SourceSkeleton& user,
+                                            const PartnerParams& params) {
+  Result<std::unique_ptr<Tracker>> tracker = make_tracker(tracker_args, library->model());
+  if (!tracker) return tracker.error();
+  Result<LiveLoop> loop =
+      LiveLoop::create(std::move(library), user, std::move(tracker).value(), params);
+  if (!loop) return loop.error();
+  return std::make_unique<LiveLoop>(std::move(loop).value());
+}
+
+int run_serve(const ServeArgs& args) {
+  Result<SourceSpec> spec = parse_source_spec(args.source);
+  if (!spec) {
+    fail(spec.error().message);
+    return kExitUsage;
+  }
+  net::LiveServerOptions options;
+  if (!parse_http(args.http, options.server.address, options.server.port)) {
+    fail("--http '" + args.http + "': expected ADDR:PORT (e.g. 127.0.0.1:8080)");
+    return kExitUsage;
+  }
+
+  std::optional<DuetLibrary> loaded = load_library(args.library, "serve");
+  if (!loaded) return kExitFailure;
+  auto library = std::make_shared<const DuetLibrary>(std::move(*loaded));
+
+  Result<std::unique_ptr<FrameSource>> source = make_source(spec.value(), args, *library);
+  if (!source) {
+    fail(source.error().message);
+    return kExitFailure;
+  }
+  const SourceSkeleton user = source.value()->source_skeleton();
+
+  PartnerParams params;
+  params.align = !args.no_align;
+  params.contact = !args.no_contact;
+  params.smooth = !args.no_smooth;
+  params.foot_lock = !args.no_footlock;
+  params.blend = !args.no_blend;
+  Result<std::unique_ptr<LiveLoop>> loop = make_loop(library, args.tracker, user, params);
+  if (!loop) {
+    fail(loop.error().message);
+    return kExitFailure;
+  }
+
+  // The other role is built on demand (a `role` message), on a background thread.
+  net::LoopFactory factory =
+      [args, user](DancerRole role, const PartnerParams& p) -> Result<std::unique_ptr<LiveLoop>> {
+    LibraryOptions library_options;
+    library_options.role = role;
+    library_options.load.frame_rate = args.library.fps;
+    library_options.load.metres_per_unit = args.library.scale;
+    library_options.trim_to_shorter = args.library.trim;
+    std::vector<PairFiles> pairs;
+    for (std::size_t k = 0; k + 1 < args.library.pair_files.size(); k += 2) {
+      pairs.push_back({args.library.pair_files[k], args.library.pair_files[k + 1]});
+    }
+    Result<DuetLibrary> other = DuetLibrary::load(pairs, library_options);
+    if (!other) return other.error();
+    return make_loop(std::make_shared<const DuetLibrary>(std::move(other).value()), args.tracker,
+                     user, p);
+  };
+
+  options.server.web_dir = find_web_dir(args.web);
+  options.server.max_queued_frames = args.queue_frames;
+  options.record_dir = args.no_record ? std::string() : args.record;
+  options.exit_at_end = args.exit_at_end;
+  options.log_interval_s = args.log_interval_s;
+  options.realtime = args.priority == "realtime";
+
+  const std::string description = source.value()->describe();
+  net::LiveServer server(options, spec.value(), std::move(source).value(), std::move(loop).value(),
+                         factory);
+  if (Status s = server.start(); !s) {
+    fail(s.error().message);
+    return kExitFailure;
+  }
+  if (!is_loopback(options.server.address)) {
+    fail("warning: listening on " + options.server.address +
+         ": anyone who can reach this machine can connect");
+  }
+  if (server.web_root() == nullptr) {
+    fail(args.web.empty()
+             ? "no viewer found (web/dist): build it with `cd web && npm ci && npm run build` or "
+               "pass --web DIR; serving a placeholder page"
+             : "--web " + args.web + " is not a directory; serving a placeholder page");
+  }
+  const std::string host = options.server.address.find(':') != std::string::npos
+                               ? "[" + options.server.address + "]"
+                               : options.server.address;
+  fmt::print(stderr, "duet serve: source: {}\n", description);
+  if (server.web_root() != nullptr) {
+    fmt::print(stderr, "duet serve: viewer files from {}\n", server.web_root()->string());
+  }
+  // The one line on stdout, for people and for scripts that start the server on port 0.
+  fmt::print("duet serve: viewer at http://{}:{}/ (WebSocket ws://{}:{}/ws)\n", host, server.port(),
+             host, server.port());
+  std::fflush(stdout);
+
+  const Status status = server.run();
+  const net::ServeSummary& summary = server.summary();
+  fmt::print(
+      stderr,
+      "duet serve: served {} frames to {} client(s); arrival->sent p50 {:.2f} ms, p99 {:.2f} "
+      "ms, max {:.2f} ms; {} dropped for slow clients, {} messages rejected\n",
+      summary.frames, summary.clients_seen, milliseconds(summary.latency_total.p50),
+      milliseconds(summary.latency_total.p99), milliseconds(summary.latency_total.max),
+      summary.dropped, summary.rejected);
+  if (!summary.recordings.empty()) {
+    fmt::print(stderr, "duet serve: recorded {} frames{}: {}\n", summary.recorded,
+               summary.record_lost ? fmt::format(" ({} lost)", summary.record_lost) : "",
+               fmt::join(summary.recordings, ", "));
+  }
+  if (!status) {
+    fail(status.error().message);
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+Command register_serve(CLI::App& app) {
+  auto args = std::make_shared<ServeArgs>();
+  add_library_options(app, args->library);
+  add_tracker_options(app, args->tracker);
+  app.add_flag("--no-align", args->no_align, "Do not place the partner relative to the user");
+  app.add_flag("--no-contact", args->no_contact, "No hand-contact IK");
+  app.add_flag("--no-smooth", args->no_smooth, "No temporal smoothing of the partner");
+  app.add_flag("--no-footlock", args->no_footlock, "No foot locking");
+  app.add_flag("--no-blend", args->no_blend, "No blending at jumps (cut instead)");
+  app.add_option("--source", args->source,
+                 "Where the user's motion comes from: replay:FILE.bvh[?speed=S&loop=1&start=SEC], "
+                 "neuron-tcp:HOST:PORT, neuron-udp:[ADDR:]PORT, ws[:SKELETON.bvh]")
+      ->capture_default_str();
+  app.add_option("--source-skeleton", args->source_skeleton,
+                 "BVH whose hierarchy describes the live stream (neuron; ws without a skeleton)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--source-fps", args->source_fps,
+                 "Frame rate of the source (replay: default --fps, else the file's; live: the "
+                 "rate recordings are written at)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--source-scale", args->source_scale,
+                 "Metres per unit of the source (default: known per skeleton convention)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--source-map", args->source_map,
+                 "Skeleton map JSON for the source's joint names (docs/skeleton-maps.md)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--http", args->http,
+                 "Address and port to serve on; 0 as port picks a free one. Loopback unless "
+                 "told otherwise")
+      ->capture_default_str();
+  app.add_option("--web", args->web,
+                 "Directory of the viewer's files (default: web/dist here, else in the source "
+                 "tree)");
+  app.add_option("--record", args->record, "Directory for the session's recordings")
+      ->capture_default_str();
+  app.add_flag("--no-record", args->no_record, "Do not record the session");
+  app.add_flag("--exit-at-end", args->exit_at_end, "Stop when a replay without loop ends");
+  app.add_option("--log-interval", args->log_interval_s,
+                 "Seconds between latency log lines (0: none)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--queue-frames", args->queue_frames,
+                 "Frames queued per viewer before the oldest is dropped")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  app.add_option("--priority", args->priority,
+                 "Scheduling of the loop's thread: realtime (SCHED_FIFO when permitted, else a "
+                 "higher nice value) or normal")
+      ->check(CLI::IsMember({"realtime", "normal"}))
+      ->capture_default_str();
+  return [args] { return run_serve(*args); };
+}
+
+}  // namespace duet::app

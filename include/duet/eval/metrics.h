@@ -1,0 +1,90 @@
+// Following metrics against ground truth (method.md 7). Exact definitions in docs/evaluation.md.
+//
+// Per frame, the error is |estimated - true template time| in milliseconds of template time. An
+// estimate in the wrong take, or no estimate, is a miss: its error is miss_error_ms. Errors above
+// miss_error_ms are capped there too, so one lost stretch cannot dominate the mean and the mean
+// stays comparable between trackers. Pause frames (the user holds still before a jump) have no
+// single right answer and are left out of every accuracy and error number.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "duet/eval/performance.h"
+
+namespace duet {
+
+// What a tracker said about one input frame (a FollowResult reduced to what is scored).
+struct FrameEstimate {
+  int take = -1;           // -1: no estimate
+  int frame_in_take = -1;  // template frame within take
+  bool lost = false;
+  bool jumped = false;
+  double step_us = 0.0;  // wall-clock time of the session step for this frame, microseconds
+};
+
+struct MetricsOptions {
+  double miss_error_ms = 1000.0;         // error of a miss, and cap of every error
+  double recovery_tolerance_ms = 100.0;  // recovered: within this of the truth ...
+  double recovery_hold_s = 0.1;          // ... for this long (at least 3 frames)
+};
+
+// Error of one frame in ms of template time, capped at options.miss_error_ms (a wrong take or no
+// estimate is a miss).
+double frame_error_ms(const TruthFrame& truth, const FrameEstimate& estimate,
+                      double template_rate_hz, const MetricsOptions& options);
+
+struct Metrics {
+  long long frames = 0;         // all input frames
+  long long scored_frames = 0;  // frames not in a pause
+  long long pause_frames = 0;
+  // Fractions of the scored frames whose error is within 50 / 100 / 300 ms.
+  double within_50ms = 0.0;
+  double within_100ms = 0.0;
+  double within_300ms = 0.0;
+  double miss_fraction = 0.0;  // scored frames in the wrong take or without estimate
+  double mean_error_ms = 0.0;  // over scored frames, each capped at miss_error_ms
+  double median_error_ms = 0.0;
+  // Jumps: true jumps (TruthFrame::jump), except one less than 1 s before the end of its
+  // performance. A jump is recovered at the first frame from which the error stays within
+  // recovery_tolerance_ms for recovery_hold_s (and at least 3 frames), with that whole hold before
+  // the next pause or jump; the recovery time is that frame's timestamp minus the jump frame's.
+  // Unrecovered jumps count as infinitely slow in the median.
+  long long jumps = 0;
+  long long recovered_jumps = 0;
+  double median_recovery_s = 0.0;  // +inf when half or more are unrecovered; 0 without jumps
+  double mean_recovery_s = 0.0;    // over the recovered jumps only
+  double lost_fraction = 0.0;      // scored frames the tracker flagged as lost
+  double mean_step_us = 0.0;       // mean wall-clock time per session step (measured)
+};
+
+// Collects per-frame errors of several performances and summarises them (pooled over frames and
+// jumps, so longer performances weigh more).
+class MetricsAccumulator {
+ public:
+  explicit MetricsAccumulator(MetricsOptions options = {}) : options_(options) {}
+
+  // truth, times_s and estimates have one entry per frame.
+  void add(std::span<const TruthFrame> truth, std::span<const double> times_s,
+           std::span<const FrameEstimate> estimates, double template_rate_hz);
+  void add(const Performance& performance, std::span<const FrameEstimate> estimates) {
+    add(performance.truth, performance.times_s, estimates, performance.template_rate_hz);
+  }
+  void merge(const MetricsAccumulator& other);
+
+  Metrics summary() const;
+  const MetricsOptions& options() const { return options_; }
+
+ private:
+  MetricsOptions options_;
+  std::vector<double> errors_ms_;   // scored frames
+  std::vector<double> recovery_s_;  // one per jump, +inf when unrecovered
+  long long frames_ = 0, pause_frames_ = 0, lost_ = 0, misses_ = 0;
+  double step_us_sum_ = 0.0;
+};
+
+// Summary of one performance.
+Metrics compute_metrics(const Performance& performance, std::span<const FrameEstimate> estimates,
+                        const MetricsOptions& options = {});
+
+}  // namespace duet

@@ -1,0 +1,163 @@
+// Synthetic performances with ground truth (method.md 7).
+//
+// A performance is what a user would send to the follower: one pose per input frame with the
+// sensor's timestamp. It is synthesised from a real take of the library, so the true template
+// position of every frame is known. Generators:
+//   play()       the whole take at a steady or smoothly drifting tempo;
+//   improvise()  the take (or several takes) cut into segments of a few seconds, replayed in
+//                another order with repeats and skips, optionally with a short pause before each
+//                jump; every segment is moved and turned about the vertical axis so the root path
+//                stays continuous (the user does not teleport);
+// and perturbations of a finished performance: sensor noise, dropped and late frames, a
+// different body size, a different place and facing in the room. A lower sensor rate is a
+// parameter of the generators (the take is sampled at that rate). make_performance() composes
+// all of them from a PerformanceRecipe.
+//
+// Every function is pure: same inputs and seed, same performance. Offline code: allocates,
+// never on the per-frame path.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "duet/base/result.h"
+#include "duet/math/types.h"
+#include "duet/motion/clip.h"
+#include "duet/motion/skeleton_map.h"
+
+namespace duet {
+
+// The truth about one input frame.
+struct TruthFrame {
+  int take = -1;                // library index of the take the user dances (SourceTake::take)
+  double template_frame = 0.0;  // position in that take's template, in template frames (real)
+  bool in_pause = false;        // the user holds still before a jump; excluded from accuracy
+  bool jump = false;  // the first frame after a jump: the user moved elsewhere in the dance
+};
+
+struct Performance {
+  // The user's poses, one frame per input frame. motion.frame_rate() is the nominal sensor rate;
+  // the real timing is times_s (frames may be missing or late).
+  Clip motion;
+  JointRoles roles;               // joint roles of motion's skeleton
+  std::vector<double> times_s;    // sensor timestamp of each frame, strictly increasing, seconds
+  std::vector<TruthFrame> truth;  // one per frame
+  double template_rate_hz = 0.0;  // rate of the template frames that truth refers to
+
+  int frame_count() const { return motion.frame_count(); }
+};
+
+// A take to perform from. The clip must outlive the generator call (the result copies poses).
+struct SourceTake {
+  int take = 0;                // library index, reported in TruthFrame::take
+  const Clip* clip = nullptr;  // the take's template clip (the user's role), metres
+  JointRoles roles;            // joint roles of clip's skeleton
+};
+
+// How fast the user dances: template seconds per performance second (1.4 = 40% faster).
+struct TempoOptions {
+  double factor = 1.0;  // steady tempo
+  // Drifting tempo: when drift_high > drift_low the factor moves smoothly between the two,
+  // factor(t) = mid + amp * sin(2 pi t / drift_period_s + phase), phase from the seed; `factor`
+  // is then ignored.
+  double drift_low = 1.0;
+  double drift_high = 1.0;
+  double drift_period_s = 12.0;
+
+  bool drifting() const { return drift_high > drift_low; }
+};
+
+struct PlayOptions {
+  TempoOptions tempo;
+  double rate_hz = 0.0;  // sensor rate; 0 = the take's rate
+  std::uint64_t seed = 1;
+};
+
+// The whole take (first to last frame) at the given tempo and sensor rate. No pauses, no jumps.
+// source.clip must have at least 2 frames.
+Performance play(const SourceTake& source, const PlayOptions& options);
+
+struct ImproviseOptions {
+  TempoOptions tempo;
+  double rate_hz = 0.0;     // sensor rate; 0 = the takes' rate
+  double duration_s = 0.0;  // length of the performance; 0 = the first source's duration
+  // Every source is cut into consecutive segments of [segment_min_s, segment_max_s] template
+  // seconds. After a segment the dancer goes on into the next one with continue_prob, otherwise
+  // jumps to the start of a random segment of any source (a repeat, a skip ahead or back).
+  double segment_min_s = 2.0;
+  double segment_max_s = 5.0;
+  double continue_prob = 0.2;
+  // Before a jump, with pause_prob, the dancer holds the last pose for
+  // [pause_min_s, pause_max_s] seconds with a tiny sway (root sway_m, spine sway_deg).
+  double pause_prob = 0.0;
+  double pause_min_s = 0.3;
+  double pause_max_s = 0.8;
+  double sway_m = 0.005;
+  double sway_deg = 1.0;
+  std::uint64_t seed = 1;
+};
+
+// Segments of the sources replayed in another order. The sources must share one skeleton layout
+// and frame rate, and every clip must have at least 2 frames (else an error). The performance
+// uses sources[0]'s skeleton and roles.
+Result<Performance> improvise(std::span<const SourceTake> sources, const ImproviseOptions& options);
+
+// Per-frame sensor noise: every joint's local rotation is multiplied by a random rotation whose
+// rotation vector has independent normal components (RMS angle rotation_deg), and the position
+// channels get independent normal noise (per-axis standard deviation position_m).
+struct SensorNoiseOptions {
+  double rotation_deg = 0.0;
+  double position_m = 0.0;
+  std::uint64_t seed = 1;
+
+  bool active() const { return rotation_deg > 0.0 || position_m > 0.0; }
+};
+Performance with_sensor_noise(Performance performance, const SensorNoiseOptions& options);
+
+// A network or sensor that drops and delays frames. Frames are dropped in bursts of 1..3 (about
+// drop_fraction of all frames; the first frame is kept); late_fraction of the kept frames carry a
+// timestamp up to late_max_frames sensor periods late; every timestamp gets uniform jitter in
+// [0, jitter_s]. Timestamps stay strictly increasing. A jump flag on a dropped frame moves to the
+// next kept frame.
+struct FrameLossOptions {
+  double drop_fraction = 0.0;
+  double late_fraction = 0.0;
+  double late_max_frames = 1.5;
+  double jitter_s = 0.0;
+  std::uint64_t seed = 1;
+
+  bool active() const { return drop_fraction > 0.0 || late_fraction > 0.0 || jitter_s > 0.0; }
+};
+Performance with_frame_loss(Performance performance, const FrameLossOptions& options);
+
+// A bigger or smaller dancer: skeleton offsets and every translation (root path included) times
+// factor.
+Performance with_body_scale(Performance performance, double factor);
+
+// Another place and facing in the room: the root is turned by yaw_rad about the vertical axis
+// through the world origin, then moved by offset_m.
+Performance with_room_placement(Performance performance, double yaw_rad, const Vec3& offset_m);
+
+// A composition of the above, applied in this order: play or improvise (at rate_hz), body scale,
+// room placement, sensor noise, frame loss. Each stage's seed is derived from `seed`.
+struct PerformanceRecipe {
+  bool improvise = false;
+  PlayOptions play;                    // when !improvise (seed ignored)
+  ImproviseOptions improvise_options;  // when improvise (seed ignored)
+  double body_scale = 1.0;
+  double room_yaw_rad = 0.0;
+  Vec3 room_offset_m = Vec3::Zero();
+  SensorNoiseOptions noise;  // seed ignored
+  FrameLossOptions loss;     // seed ignored
+};
+
+// sources[0] is the performed take (play); improvise draws from all of them.
+Result<Performance> make_performance(std::span<const SourceTake> sources,
+                                     const PerformanceRecipe& recipe, std::uint64_t seed);
+
+// A seed for one piece of an experiment (e.g. case index, take) from a base seed (splitmix64).
+std::uint64_t derive_seed(std::uint64_t base, std::uint64_t a, std::uint64_t b = 0);
+
+}  // namespace duet

@@ -1,0 +1,133 @@
+// The evaluation runner (method.md 7): synthetic performances from real takes x followers, scored
+// against ground truth. Builds nothing itself: the caller loads the duet libraries once per role
+// and the runner runs one FollowSession per performance and tracker.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "duet/base/result.h"
+#include "duet/eval/metrics.h"
+#include "duet/eval/performance.h"
+#include "duet/follow/follow_params.h"
+#include "duet/follow/online_dtw.h"
+#include "duet/follow/tracker.h"
+#include "duet/live/duet_library.h"
+
+namespace duet {
+
+// One way of performing a take (see docs/evaluation.md for the list).
+struct EvalCase {
+  std::string name;
+  std::string description;
+  PerformanceRecipe recipe;
+  bool partner_role = false;  // the user dances the partner: the library is built with role=partner
+  bool across_takes = false;  // improvisation draws segments from every take of the library
+};
+
+// Magnitudes shared by the standard cases, so a run can make them harsher or gentler.
+struct CaseSettings {
+  double noise_rotation_deg = 3.0;  // RMS angle per joint per frame
+  double noise_position_m = 0.01;   // per axis, root position
+  double low_rate_hz = 30.0;
+  double body_scale = 1.15;
+  double improvise_duration_s = 0.0;  // 0 = the performed take's duration
+};
+
+// The standard cases, in report order: clean, tempo-slow, tempo-fast, drift, improv,
+// improv-pause, improv-library, noise, 30hz-noisy, late-frames, body-size, room-place,
+// partner-role, improv-30hz-noisy.
+std::vector<EvalCase> standard_cases(const CaseSettings& settings = {});
+
+enum class TrackerKind {
+  kHmm,               // the jump HMM with EvalOptions::hmm (the defaults unless tuned)
+  kHmmPaper,          // FollowParams::paper() transitions, emission settings from EvalOptions::hmm
+  kLeftToRight,       // EvalOptions::hmm without the jump
+  kNearestNeighbour,  // per-frame nearest neighbour
+  kOnlineDtw,         // windowed online DTW
+  kNaiveHmm,          // the O(M^2) forward: only on a one-take library, compared with kHmm
+};
+std::string_view tracker_kind_name(TrackerKind kind);  // "hmm", "hmm-paper", ...
+bool parse_tracker_kind(std::string_view name, TrackerKind& kind);
+std::vector<TrackerKind> all_tracker_kinds();
+
+struct EvalOptions {
+  std::vector<int> takes;  // library indices of the takes to perform from
+  std::vector<EvalCase> cases;
+  std::vector<TrackerKind> trackers;
+  std::uint64_t seed = 1;
+  FollowParams hmm;     // parameters of the "hmm" tracker (defaults + tuning)
+  OnlineDtwParams dtw;  // its emission sigma and lost threshold are taken from hmm
+  MetricsOptions metrics;
+  // Keep per-frame traces of this case on the first performed take (for plots); empty = none.
+  std::string trace_case;
+  // The case the naive O(M^2) forward is compared on (when kNaiveHmm is among the trackers); if
+  // it is not run or not performed from one take in the user's role, the first case that is.
+  std::string naive_case = "improv-pause";
+};
+
+// A case x tracker, pooled over the performed takes, and per take.
+struct EvalRow {
+  std::string case_name;
+  std::string tracker;
+  Metrics metrics;
+  std::vector<std::pair<int, Metrics>> per_take;  // (take index, metrics)
+};
+
+struct EvalTrace {
+  std::string case_name;
+  std::string tracker;
+  int take = 0;  // the performed take
+  double template_rate_hz = 0.0;
+  std::vector<double> times_s;
+  std::vector<TruthFrame> truth;
+  std::vector<FrameEstimate> estimates;
+};
+
+// The naive O(M^2) forward against the O(M) HMM on a one-take library (the first performed take
+// alone; features standardised as in the full library), same parameters, same input.
+struct NaiveCheck {
+  bool ran = false;
+  int take = 0;
+  std::string take_name;
+  std::string case_name;
+  int states = 0;
+  long long frames = 0;
+  long long same_state = 0;  // frames where both estimates agree
+  Metrics naive;             // against the truth (the one-take library)
+  Metrics fast;
+};
+
+struct EvalReport {
+  std::vector<EvalRow> rows;
+  std::vector<EvalTrace> traces;
+  NaiveCheck naive;
+  std::vector<std::string> take_names;  // of the library, by index
+  int library_states = 0;
+};
+
+// done/total count performance x tracker runs; `what` names the current one.
+using EvalProgress = std::function<void(long long done, long long total, const std::string& what)>;
+
+// library: the user's role as given; partner_library: built with role=partner, needed only by
+// partner_role cases (may be the same object as library, or null when no such case runs). Both
+// must hold the same takes in the same order. Errors: bad take indices, a missing partner library,
+// a tracker that cannot be built, a performance that cannot be made or followed.
+Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary* partner_library,
+                                  const EvalOptions& options, const EvalProgress& progress = {});
+
+// Runs one tracker over one performance through a FollowSession, timing every step.
+Result<std::vector<FrameEstimate>> follow_performance(const DuetLibrary& library,
+                                                      const Performance& performance,
+                                                      std::unique_ptr<Tracker> tracker);
+
+// The tracker of a kind on a model (kNaiveHmm is built too, but only fits small models).
+Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const TemplateModel& model,
+                                                   const EvalOptions& options);
+
+}  // namespace duet

@@ -1,0 +1,104 @@
+// The run-time loop of method.md 6, one input frame at a time:
+//
+//   user's local pose -> features -> forward step -> estimated state
+//   -> response pose at that state -> alignment -> blend -> smoothing -> foot lock -> hand IK
+//   -> world transforms of both dancers
+//
+// LiveLoop owns everything the loop needs (follow session, partner models, partner context, output
+// buffers), all sized when it is created. step() allocates nothing, throws nothing and does no
+// I/O. Threads, sockets and files are the caller's (the net layer, the recorder).
+#pragma once
+
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include "duet/base/result.h"
+#include "duet/live/duet_library.h"
+#include "duet/live/follow_session.h"
+#include "duet/live/source_frame.h"
+#include "duet/partner/partner_synthesis.h"
+
+namespace duet {
+
+// The five switchable corrections by their protocol names (docs/protocol.md `set`).
+inline constexpr std::string_view kCorrectionNames[] = {"align", "contact", "smooth", "footlock",
+                                                        "blend"};
+// Sets one switch of `params` by name; false (and params untouched) for an unknown name.
+bool set_correction(PartnerParams& params, std::string_view name, bool enabled) noexcept;
+bool correction_enabled(const PartnerParams& params, std::string_view name) noexcept;
+
+// What one frame of the loop produced. Buffers are sized once and overwritten by every step().
+struct LiveOutput {
+  long long seq = -1;   // frames processed since the loop was created (0 for the first)
+  double time_s = 0.0;  // the input frame's time
+  FollowResult follow;
+  // The user's left / right hand holds the partner's at the estimated template frame, as
+  // captured (whether or not the contact correction is on).
+  bool contact_left = false;
+  bool contact_right = false;
+  PartnerFrameInfo partner_info;
+  int partner_take = 0;              // the take whose response the partner pose comes from
+  bool partner_synthesised = false;  // false: the raw response pose (the job could not run)
+
+  // World transforms of the user's skeleton (the source's) and of the partner's.
+  std::vector<Vec3> user_positions_ws;
+  std::vector<Quat> user_rotations_ws;
+  // The partner's local pose (root in the user's world frame when align is on) and world pose.
+  std::vector<Vec3> partner_translations_ls;
+  std::vector<Quat> partner_rotations_ls;
+  std::vector<Vec3> partner_positions_ws;
+  std::vector<Quat> partner_rotations_ws;
+};
+
+class LiveLoop {
+ public:
+  // Builds the partner model of every take (offline: allocates, may fail) and sizes every buffer.
+  // Every take's response skeleton must have the same joints (names and parents), so the partner
+  // is one skeleton whatever take the follower is in. The library is shared, so a loop can be
+  // handed between threads and kept alive as long as needed.
+  static Result<LiveLoop> create(std::shared_ptr<const DuetLibrary> library,
+                                 const SourceSkeleton& user, std::unique_ptr<Tracker> tracker,
+                                 const PartnerParams& params = {},
+                                 const PartnerModelOptions& model_options = {});
+
+  // One input frame (buffers sized to the user's joint count). Returns the output, which stays
+  // valid until the next step(). Allocates nothing.
+  const LiveOutput& step(const SourceFrame& frame) noexcept;
+
+  // Restart the follower and the corrections' state (the next frame starts fresh).
+  void reset() noexcept;
+  // Switch a correction (protocol name); false for an unknown name.
+  bool set_correction(std::string_view name, bool enabled) noexcept;
+  void set_params(const PartnerParams& params) noexcept { params_ = params; }
+  const PartnerParams& params() const noexcept { return params_; }
+
+  const DuetLibrary& library() const noexcept { return *library_; }
+  DancerRole role() const noexcept { return library_->options().role; }
+  const SourceSkeleton& user() const noexcept { return user_; }
+  // The partner's skeleton as sent to viewers and recorded (take 0's response skeleton).
+  std::shared_ptr<const Skeleton> partner_skeleton() const noexcept;
+  const PartnerModel& partner_model(int take) const noexcept {
+    return models_[static_cast<std::size_t>(take)];
+  }
+  const LiveOutput& output() const noexcept { return out_; }
+
+ private:
+  LiveLoop(std::shared_ptr<const DuetLibrary> library, const SourceSkeleton& user,
+           FollowSession session, std::vector<PartnerModel> models, const PartnerParams& params);
+
+  std::shared_ptr<const DuetLibrary> library_;
+  SourceSkeleton user_;
+  FollowSession session_;
+  std::vector<PartnerModel> models_;  // one per take
+  PartnerParams params_;
+  PartnerContext context_;
+  LiveOutput out_;
+  UserPose user_pose_;
+  int previous_take_ = -1;
+  int previous_frame_ = 0;
+  double previous_time_s_ = 0.0;
+  bool has_previous_ = false;
+};
+
+}  // namespace duet

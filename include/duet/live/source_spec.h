@@ -1,0 +1,35 @@
+// The text that picks a source on the command line (`duet serve --source SPEC`):
+//
+//   replay:FILE.bvh[?speed=S&loop=0|1&start=SECONDS]   a file played in real time
+//   neuron-tcp:[HOST:]PORT[?reference=0|1]             connect to Axis Neuron's BVH TCP server
+//   neuron-udp:[ADDR:]PORT[?reference=0|1]             receive Axis Neuron's BVH UDP broadcast
+//   ws[:SKELETON.bvh]                                  poses from WebSocket clients
+//
+// HOST defaults to 127.0.0.1; ADDR (the local address to bind) too. IPv6 addresses go in
+// brackets: neuron-tcp:[::1]:7001.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "duet/base/result.h"
+#include "duet/live/source_replay.h"
+
+namespace duet {
+
+enum class SourceKind { kReplay, kNeuronTcp, kNeuronUdp, kWebSocket };
+const char* source_kind_name(SourceKind kind);
+
+struct SourceSpec {
+  SourceKind kind = SourceKind::kWebSocket;
+  std::string path;  // replay: the file; ws: the skeleton file (empty: the template's skeleton)
+  std::string host;  // neuron-tcp: the server; neuron-udp: the local address to bind
+  std::uint16_t port = 0;
+  ReplayOptions replay;
+  bool reference = false;  // neuron: records start with a reference bone's 6 values
+};
+
+Result<SourceSpec> parse_source_spec(std::string_view text);
+
+}  // namespace duet

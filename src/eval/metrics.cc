@@ -1,0 +1,136 @@
+#include "duet/eval/metrics.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+namespace duet {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kLastJumpMargin_s = 1.0;
+
+// Median of values (sorted copy); the mean of the two middle values for an even count.
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::ranges::sort(values);
+  const std::size_t n = values.size();
+  if (n % 2 == 1) return values[n / 2];
+  const double a = values[n / 2 - 1], b = values[n / 2];
+  return std::isinf(a) || std::isinf(b) ? kInf : 0.5 * (a + b);
+}
+
+}  // namespace
+
+double frame_error_ms(const TruthFrame& truth, const FrameEstimate& estimate,
+                      double template_rate_hz, const MetricsOptions& options) {
+  if (estimate.take < 0 || estimate.take != truth.take) return options.miss_error_ms;
+  const double error =
+      std::abs(estimate.frame_in_take - truth.template_frame) / template_rate_hz * 1000.0;
+  return std::min(error, options.miss_error_ms);
+}
+
+void MetricsAccumulator::add(std::span<const TruthFrame> truth, std::span<const double> times_s,
+                             std::span<const FrameEstimate> estimates, double template_rate_hz) {
+  assert(truth.size() == times_s.size() && truth.size() == estimates.size());
+  const std::size_t n = std::min({truth.size(), times_s.size(), estimates.size()});
+  std::vector<double> errors(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    ++frames_;
+    step_us_sum_ += estimates[i].step_us;
+    if (truth[i].in_pause) {
+      ++pause_frames_;
+      continue;
+    }
+    errors[i] = frame_error_ms(truth[i], estimates[i], template_rate_hz, options_);
+    errors_ms_.push_back(errors[i]);
+    if (estimates[i].take < 0 || estimates[i].take != truth[i].take) ++misses_;
+    if (estimates[i].lost) ++lost_;
+  }
+
+  // Jump recovery: first frame after the jump from which the error stays within tolerance for
+  // the hold time (and at least 3 frames), before the next pause or jump.
+  const double tolerance = options_.recovery_tolerance_ms;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!truth[k].jump || truth[k].in_pause) continue;
+    std::size_t end = k + 1;
+    while (end < n && !truth[end].jump && !truth[end].in_pause) ++end;
+    // A jump too close to the end of the performance has no time to be recovered: not counted.
+    if (end == n && times_s[n - 1] - times_s[k] < kLastJumpMargin_s) continue;
+    double recovery = kInf;
+    for (std::size_t j = k; j < end; ++j) {
+      if (errors[j] > tolerance) continue;
+      const auto in_hold = [&](std::size_t i) {
+        return i - j < 3 || times_s[i] - times_s[j] < options_.recovery_hold_s;
+      };
+      std::size_t i = j;
+      while (i < end && in_hold(i) && errors[i] <= tolerance) ++i;
+      if (i >= end) break;  // the hold does not fit before the next pause or jump
+      if (in_hold(i)) {     // frame i broke the hold; no start before it can pass it
+        j = i;
+        continue;
+      }
+      recovery = times_s[j] - times_s[k];
+      break;
+    }
+    recovery_s_.push_back(recovery);
+  }
+}
+
+void MetricsAccumulator::merge(const MetricsAccumulator& other) {
+  errors_ms_.insert(errors_ms_.end(), other.errors_ms_.begin(), other.errors_ms_.end());
+  recovery_s_.insert(recovery_s_.end(), other.recovery_s_.begin(), other.recovery_s_.end());
+  frames_ += other.frames_;
+  pause_frames_ += other.pause_frames_;
+  lost_ += other.lost_;
+  misses_ += other.misses_;
+  step_us_sum_ += other.step_us_sum_;
+}
+
+Metrics MetricsAccumulator::summary() const {
+  Metrics m;
+  m.frames = frames_;
+  m.pause_frames = pause_frames_;
+  m.scored_frames = static_cast<long long>(errors_ms_.size());
+  if (m.scored_frames > 0) {
+    long long w50 = 0, w100 = 0, w300 = 0;
+    double sum = 0.0;
+    for (const double e : errors_ms_) {
+      w50 += e <= 50.0 ? 1 : 0;
+      w100 += e <= 100.0 ? 1 : 0;
+      w300 += e <= 300.0 ? 1 : 0;
+      sum += e;
+    }
+    const auto scored = static_cast<double>(m.scored_frames);
+    m.within_50ms = static_cast<double>(w50) / scored;
+    m.within_100ms = static_cast<double>(w100) / scored;
+    m.within_300ms = static_cast<double>(w300) / scored;
+    m.miss_fraction = static_cast<double>(misses_) / scored;
+    m.mean_error_ms = sum / scored;
+    m.median_error_ms = median(errors_ms_);
+    m.lost_fraction = static_cast<double>(lost_) / scored;
+  }
+  m.jumps = static_cast<long long>(recovery_s_.size());
+  double recovered_sum = 0.0;
+  for (const double r : recovery_s_) {
+    if (std::isinf(r)) continue;
+    ++m.recovered_jumps;
+    recovered_sum += r;
+  }
+  m.median_recovery_s = median(recovery_s_);
+  m.mean_recovery_s =
+      m.recovered_jumps > 0 ? recovered_sum / static_cast<double>(m.recovered_jumps) : 0.0;
+  m.mean_step_us = frames_ > 0 ? step_us_sum_ / static_cast<double>(frames_) : 0.0;
+  return m;
+}
+
+Metrics compute_metrics(const Performance& performance, std::span<const FrameEstimate> estimates,
+                        const MetricsOptions& options) {
+  MetricsAccumulator accumulator(options);
+  accumulator.add(performance, estimates);
+  return accumulator.summary();
+}
+
+}  // namespace duet

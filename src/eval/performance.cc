@@ -1,0 +1,449 @@
+#include "duet/eval/performance.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <random>
+
+#include "duet/math/rotation.h"
+
+namespace duet {
+
+std::uint64_t derive_seed(std::uint64_t base, std::uint64_t a, std::uint64_t b) {
+  // splitmix64 over a mix of the three, so neighbouring indices give unrelated streams.
+  std::uint64_t z = base ^ (a * 0x9E3779B97F4A7C15ull) ^ (b * 0xC2B2AE3D27D4EB4Full);
+  z += 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+namespace {
+
+using Rng = std::mt19937_64;
+
+double uniform(Rng& rng, double low, double high) {
+  return std::uniform_real_distribution<double>(low, high)(rng);
+}
+
+// A rigid move of the whole body about the vertical axis: turn by yaw about the world origin,
+// then translate. Applied to the skeleton root (joint 0), whose local transform is its world one.
+struct Placement {
+  double yaw = 0.0;
+  Vec3 offset = Vec3::Zero();
+
+  void apply(Vec3& root_position, Quat& root_rotation) const {
+    const Quat turn = yaw_rotation(yaw);
+    root_position = turn * root_position + offset;
+    root_rotation = turn * root_rotation;
+  }
+};
+
+// The placement that puts a raw root (position, heading) at a target root: same heading, same
+// horizontal position. The height stays the take's own (it belongs to the pose).
+Placement align_root(const Vec3& target_position, double target_yaw, const Vec3& raw_position,
+                     double raw_yaw) {
+  Placement p;
+  p.yaw = wrap_angle(target_yaw - raw_yaw);
+  p.offset = target_position - yaw_rotation(p.yaw) * raw_position;
+  p.offset.y() = 0.0;
+  return p;
+}
+
+struct RootSample {
+  Vec3 position;
+  double yaw;
+};
+
+RootSample root_at(const Clip& clip, double tau_s, const Placement& placement, Pose& scratch) {
+  clip.sample(tau_s, scratch);
+  Vec3 position = scratch.translations_ls[0];
+  Quat rotation = scratch.rotations_ls[0];
+  placement.apply(position, rotation);
+  return {position, heading_yaw(rotation)};
+}
+
+class TempoCurve {
+ public:
+  TempoCurve(const TempoOptions& options, std::uint64_t seed) : options_(options) {
+    Rng rng(seed);
+    phase_ = uniform(rng, 0.0, 2.0 * kPi);
+  }
+  double factor(double t_s) const {
+    if (!options_.drifting()) return options_.factor;
+    const double mid = 0.5 * (options_.drift_low + options_.drift_high);
+    const double amplitude = 0.5 * (options_.drift_high - options_.drift_low);
+    return mid + amplitude * std::sin(2.0 * kPi * t_s / options_.drift_period_s + phase_);
+  }
+  double fastest() const { return options_.drifting() ? options_.drift_high : options_.factor; }
+
+ private:
+  TempoOptions options_;
+  double phase_ = 0.0;
+};
+
+// One piece of a performance: template time [begin_s, end_s] of a source. jump: the piece does
+// not continue the previous one (it is the same source with begin_s == previous end_s otherwise).
+struct ScriptEntry {
+  int source = 0;
+  double begin_s = 0.0;
+  double end_s = 0.0;
+  double pause_before_s = 0.0;  // a hold before a jump
+  bool jump = false;
+};
+
+struct SwayOptions {
+  double sway_m = 0.0;
+  double sway_deg = 0.0;
+};
+
+// Plays a script at a tempo and sensor rate. duration_s <= 0 plays to the script's end.
+Performance perform_script(std::span<const SourceTake> sources,
+                           const std::vector<ScriptEntry>& script, const TempoCurve& tempo,
+                           double rate_hz, double duration_s, const SwayOptions& sway) {
+  assert(!sources.empty() && !script.empty());
+  const Clip& first_clip = *sources[0].clip;
+  const double template_fps = first_clip.frame_rate();
+  const double rate = rate_hz > 0.0 ? rate_hz : template_fps;
+  const double dt = 1.0 / rate;
+  const int joints = first_clip.joint_count();
+  const int spine = sources[0].roles[Role::kSpine];
+
+  std::vector<Vec3> translations;
+  std::vector<Quat> rotations;
+  Performance out;
+  out.roles = sources[0].roles;
+  out.template_rate_hz = template_fps;
+
+  std::size_t e = 0;
+  double tau = script[0].begin_s;
+  Placement place;  // the first piece stays where the take has it
+  bool pausing = false;
+  double pause_length = 0.0, pause_elapsed = 0.0, hold_tau = 0.0;
+  int hold_source = 0;
+  bool pending_jump = false;
+  Pose pose, scratch;
+
+  for (long long k = 0;; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    if (duration_s > 0.0 && t >= duration_s - 1e-9) break;
+    TruthFrame truth;
+    if (pausing) {
+      const SourceTake& source = sources[static_cast<std::size_t>(hold_source)];
+      source.clip->sample(hold_tau, pose);
+      place.apply(pose.translations_ls[0], pose.rotations_ls[0]);
+      // A tiny sway that fades in and out, so the hold starts and ends on the held pose.
+      const double envelope = std::sin(kPi * std::clamp(pause_elapsed / pause_length, 0.0, 1.0));
+      const double s = pause_elapsed;
+      pose.translations_ls[0] +=
+          envelope * sway.sway_m *
+          Vec3(std::sin(2.0 * kPi * 0.9 * s), 0.0, std::sin(2.0 * kPi * 0.6 * s + 1.0));
+      if (spine > 0 && spine < joints) {
+        const Vec3 v = envelope * deg_to_rad(sway.sway_deg) *
+                       Vec3(std::sin(2.0 * kPi * 0.7 * s), 0.5 * std::sin(2.0 * kPi * 1.1 * s),
+                            std::sin(2.0 * kPi * 0.5 * s + 2.0));
+        const auto j = static_cast<std::size_t>(spine);
+        pose.rotations_ls[j] = (pose.rotations_ls[j] * exp_map(v)).normalized();
+      }
+      truth = {source.take, hold_tau * template_fps, true, false};
+    } else {
+      const SourceTake& source = sources[static_cast<std::size_t>(script[e].source)];
+      source.clip->sample(tau, pose);
+      place.apply(pose.translations_ls[0], pose.rotations_ls[0]);
+      truth = {source.take, tau * template_fps, false, pending_jump};
+      pending_jump = false;
+    }
+    translations.insert(translations.end(), pose.translations_ls.begin(),
+                        pose.translations_ls.end());
+    rotations.insert(rotations.end(), pose.rotations_ls.begin(), pose.rotations_ls.end());
+    out.truth.push_back(truth);
+    out.times_s.push_back(t);
+
+    // Advance to the next input frame.
+    if (pausing) {
+      pause_elapsed += dt;
+      if (pause_elapsed >= pause_length - 1e-9) {
+        pausing = false;
+        const ScriptEntry& next = script[e];
+        tau = next.begin_s;
+        // The new piece starts where the dancer stands and faces after the hold.
+        const RootSample held =
+            root_at(*sources[static_cast<std::size_t>(hold_source)].clip, hold_tau, place, scratch);
+        const RootSample raw =
+            root_at(*sources[static_cast<std::size_t>(next.source)].clip, tau, {}, scratch);
+        place = align_root(held.position, held.yaw, raw.position, raw.yaw);
+        pending_jump = true;
+      }
+      continue;
+    }
+    tau += tempo.factor(t + 0.5 * dt) * dt;
+    bool finished = false;
+    while (tau > script[e].end_s + 1e-9) {
+      const double overflow = tau - script[e].end_s;
+      if (e + 1 == script.size()) {
+        finished = true;
+        break;
+      }
+      const ScriptEntry& previous = script[e];
+      const ScriptEntry& next = script[++e];
+      if (!next.jump) {  // the take goes on: same placement
+        tau = next.begin_s + overflow;
+        continue;
+      }
+      if (next.pause_before_s > 0.0) {
+        pausing = true;
+        pause_length = next.pause_before_s;
+        pause_elapsed = 0.0;
+        hold_source = previous.source;
+        hold_tau = previous.end_s;
+        break;
+      }
+      // A jump in stride: the new piece continues the root path where the old one was going.
+      const RootSample target = root_at(*sources[static_cast<std::size_t>(previous.source)].clip,
+                                        previous.end_s + overflow, place, scratch);
+      tau = next.begin_s + overflow;
+      const RootSample raw =
+          root_at(*sources[static_cast<std::size_t>(next.source)].clip, tau, {}, scratch);
+      place = align_root(target.position, target.yaw, raw.position, raw.yaw);
+      pending_jump = true;
+    }
+    if (finished) break;
+  }
+
+  const int frames = static_cast<int>(out.truth.size());
+  out.motion = Clip(first_clip.skeleton_ptr(), rate, frames);
+  for (int f = 0; f < frames; ++f) {
+    const auto begin = static_cast<std::ptrdiff_t>(f) * joints;
+    std::copy(translations.begin() + begin, translations.begin() + begin + joints,
+              out.motion.translations_ls(f).begin());
+    std::copy(rotations.begin() + begin, rotations.begin() + begin + joints,
+              out.motion.rotations_ls(f).begin());
+  }
+  return out;
+}
+
+double last_time(const Clip& clip) { return (clip.frame_count() - 1) / clip.frame_rate(); }
+
+}  // namespace
+
+Performance play(const SourceTake& source, const PlayOptions& options) {
+  assert(source.clip != nullptr && source.clip->frame_count() >= 2);
+  const std::vector<ScriptEntry> script = {{0, 0.0, last_time(*source.clip), 0.0, false}};
+  const TempoCurve tempo(options.tempo, derive_seed(options.seed, 1));
+  return perform_script(std::span<const SourceTake>(&source, 1), script, tempo, options.rate_hz,
+                        0.0, {});
+}
+
+Result<Performance> improvise(std::span<const SourceTake> sources,
+                              const ImproviseOptions& options) {
+  if (sources.empty()) return Error{"improvise: no take to perform from"};
+  for (const SourceTake& s : sources) {
+    if (s.clip == nullptr || s.clip->frame_count() < 2) {
+      return Error{"improvise: take " + std::to_string(s.take) + " has fewer than 2 frames"};
+    }
+    if (s.clip->joint_count() != sources[0].clip->joint_count()) {
+      return Error{"improvise: takes " + std::to_string(sources[0].take) + " and " +
+                   std::to_string(s.take) + " have different skeletons"};
+    }
+    if (std::abs(s.clip->frame_rate() - sources[0].clip->frame_rate()) > 1e-9) {
+      return Error{"improvise: takes " + std::to_string(sources[0].take) + " and " +
+                   std::to_string(s.take) + " have different frame rates"};
+    }
+  }
+  if (!(options.segment_min_s > 0.0 && options.segment_max_s >= options.segment_min_s)) {
+    return Error{"improvise: need 0 < segment_min_s <= segment_max_s"};
+  }
+  if (!(options.pause_min_s >= 0.0 && options.pause_max_s >= options.pause_min_s)) {
+    return Error{"improvise: need 0 <= pause_min_s <= pause_max_s"};
+  }
+  Rng rng(derive_seed(options.seed, 2));
+
+  // Cut every source into consecutive segments.
+  struct Segment {
+    int source;
+    double begin_s, end_s;
+    int successor;  // index of the segment that continues this one, -1 at the end of a take
+  };
+  std::vector<Segment> segments;
+  for (std::size_t s = 0; s < sources.size(); ++s) {
+    const double end = last_time(*sources[s].clip);
+    double begin = 0.0;
+    while (begin < end - 1e-9) {
+      double cut = begin + uniform(rng, options.segment_min_s, options.segment_max_s);
+      if (end - cut < options.segment_min_s) cut = end;  // no stub at the end of the take
+      segments.push_back({static_cast<int>(s), begin, cut, -1});
+      if (cut < end) segments.back().successor = static_cast<int>(segments.size());
+      begin = cut;
+    }
+  }
+
+  // Replay them in another order until the performance is long enough.
+  const TempoCurve tempo(options.tempo, derive_seed(options.seed, 1));
+  const double duration =
+      options.duration_s > 0.0 ? options.duration_s : last_time(*sources[0].clip);
+  const auto count = static_cast<int>(segments.size());
+  std::vector<ScriptEntry> script;
+  int current = std::uniform_int_distribution<int>(0, count - 1)(rng);
+  double planned_s = 0.0;
+  for (;;) {
+    const Segment& seg = segments[static_cast<std::size_t>(current)];
+    ScriptEntry entry{seg.source, seg.begin_s, seg.end_s, 0.0, !script.empty()};
+    if (!script.empty()) {
+      const ScriptEntry& previous = script.back();
+      entry.jump =
+          !(previous.source == seg.source && std::abs(previous.end_s - seg.begin_s) < 1e-9);
+      if (entry.jump && uniform(rng, 0.0, 1.0) < options.pause_prob) {
+        entry.pause_before_s = uniform(rng, options.pause_min_s, options.pause_max_s);
+      }
+    }
+    script.push_back(entry);
+    // Lower bound of the performance time this piece takes (at the fastest tempo).
+    planned_s += entry.pause_before_s + (seg.end_s - seg.begin_s) / tempo.fastest();
+    if (planned_s > duration + 1.0) break;
+    const int successor = seg.successor;
+    if (successor >= 0 && uniform(rng, 0.0, 1.0) < options.continue_prob) {
+      current = successor;
+    } else if (count == 1) {
+      current = 0;  // a jump back to its own start
+    } else {
+      // Any segment but the successor (that would be no jump): repeats and skips.
+      do {
+        current = std::uniform_int_distribution<int>(0, count - 1)(rng);
+      } while (current == successor);
+    }
+  }
+  return perform_script(sources, script, tempo, options.rate_hz, duration,
+                        {options.sway_m, options.sway_deg});
+}
+
+Performance with_sensor_noise(Performance performance, const SensorNoiseOptions& options) {
+  Rng rng(derive_seed(options.seed, 3));
+  // RMS angle of a rotation vector with three N(0, s^2) components is s * sqrt(3).
+  std::normal_distribution<double> angle(0.0, deg_to_rad(options.rotation_deg) / std::sqrt(3.0));
+  std::normal_distribution<double> position(0.0, options.position_m);
+  Clip& motion = performance.motion;
+  const Skeleton& skeleton = motion.skeleton();
+  for (int f = 0; f < motion.frame_count(); ++f) {
+    auto translations = motion.translations_ls(f);
+    auto rotations = motion.rotations_ls(f);
+    for (int j = 0; j < skeleton.joint_count(); ++j) {
+      const Joint& joint = skeleton.joints[static_cast<std::size_t>(j)];
+      if (joint.end_site) continue;
+      const auto i = static_cast<std::size_t>(j);
+      if (options.rotation_deg > 0.0) {
+        const Vec3 v(angle(rng), angle(rng), angle(rng));
+        rotations[i] = (rotations[i] * exp_map(v)).normalized();
+      }
+      if (options.position_m > 0.0 && joint.has_position_channels()) {
+        translations[i] += Vec3(position(rng), position(rng), position(rng));
+      }
+    }
+  }
+  return performance;
+}
+
+Performance with_frame_loss(Performance performance, const FrameLossOptions& options) {
+  Rng rng(derive_seed(options.seed, 4));
+  const int frames = performance.frame_count();
+  const double period = 1.0 / performance.motion.frame_rate();
+  // Bursts of 1..3 frames (mean 2): a burst starts after a kept frame with probability p, so the
+  // dropped fraction is 2p / (1 + 2p).
+  const double f = std::clamp(options.drop_fraction, 0.0, 0.9);
+  const double burst_start = f / (2.0 * (1.0 - f));
+  std::vector<int> kept;
+  int dropping = 0;
+  for (int k = 0; k < frames; ++k) {
+    if (k > 0 && dropping > 0) {
+      --dropping;
+      continue;
+    }
+    kept.push_back(k);
+    if (uniform(rng, 0.0, 1.0) < burst_start) {
+      dropping = std::uniform_int_distribution<int>(1, 3)(rng);
+    }
+  }
+
+  Performance out;
+  out.roles = performance.roles;
+  out.template_rate_hz = performance.template_rate_hz;
+  const Clip& motion = performance.motion;
+  out.motion = Clip(motion.skeleton_ptr(), motion.frame_rate(), static_cast<int>(kept.size()));
+  bool carry_jump = false;
+  double previous_time = -1e300;
+  std::size_t next_kept = 0;
+  for (int k = 0; k < frames; ++k) {
+    const auto ks = static_cast<std::size_t>(k);
+    if (next_kept >= kept.size() || kept[next_kept] != k) {
+      carry_jump = carry_jump || performance.truth[ks].jump;
+      continue;
+    }
+    const int o = static_cast<int>(next_kept++);
+    std::ranges::copy(motion.translations_ls(k), out.motion.translations_ls(o).begin());
+    std::ranges::copy(motion.rotations_ls(k), out.motion.rotations_ls(o).begin());
+    TruthFrame truth = performance.truth[ks];
+    truth.jump = truth.jump || carry_jump;
+    carry_jump = false;
+    out.truth.push_back(truth);
+    double time = performance.times_s[ks];
+    if (options.jitter_s > 0.0) time += uniform(rng, 0.0, options.jitter_s);
+    if (uniform(rng, 0.0, 1.0) < options.late_fraction) {
+      time += uniform(rng, 0.0, options.late_max_frames) * period;
+    }
+    // Frames arrive in order: a frame after a late one cannot carry an earlier timestamp.
+    time = std::max(time, previous_time + 1e-4);
+    out.times_s.push_back(time);
+    previous_time = time;
+  }
+  return out;
+}
+
+Performance with_body_scale(Performance performance, double factor) {
+  performance.motion.scale_lengths(factor);
+  return performance;
+}
+
+Performance with_room_placement(Performance performance, double yaw_rad, const Vec3& offset_m) {
+  const Placement placement{yaw_rad, offset_m};
+  Clip& motion = performance.motion;
+  for (int f = 0; f < motion.frame_count(); ++f) {
+    placement.apply(motion.translations_ls(f)[0], motion.rotations_ls(f)[0]);
+  }
+  return performance;
+}
+
+Result<Performance> make_performance(std::span<const SourceTake> sources,
+                                     const PerformanceRecipe& recipe, std::uint64_t seed) {
+  if (sources.empty() || sources[0].clip == nullptr) return Error{"no take to perform from"};
+  Performance performance;
+  if (recipe.improvise) {
+    ImproviseOptions options = recipe.improvise_options;
+    options.seed = derive_seed(seed, 10);
+    Result<Performance> improvised = improvise(sources, options);
+    if (!improvised) return improvised.error();
+    performance = std::move(improvised).value();
+  } else {
+    if (sources[0].clip->frame_count() < 2) return Error{"the take has fewer than 2 frames"};
+    PlayOptions options = recipe.play;
+    options.seed = derive_seed(seed, 11);
+    performance = play(sources[0], options);
+  }
+  if (recipe.body_scale != 1.0)
+    performance = with_body_scale(std::move(performance), recipe.body_scale);
+  if (recipe.room_yaw_rad != 0.0 || !recipe.room_offset_m.isZero()) {
+    performance =
+        with_room_placement(std::move(performance), recipe.room_yaw_rad, recipe.room_offset_m);
+  }
+  if (recipe.noise.active()) {
+    SensorNoiseOptions options = recipe.noise;
+    options.seed = derive_seed(seed, 12);
+    performance = with_sensor_noise(std::move(performance), options);
+  }
+  if (recipe.loss.active()) {
+    FrameLossOptions options = recipe.loss;
+    options.seed = derive_seed(seed, 13);
+    performance = with_frame_loss(std::move(performance), options);
+  }
+  return performance;
+}
+
+}  // namespace duet

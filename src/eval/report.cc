@@ -1,0 +1,202 @@
+#include "duet/eval/report.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+
+namespace duet {
+
+namespace {
+
+std::string percent(double fraction) { return fmt::format("{:.1f}%", 100.0 * fraction); }
+
+std::string recovery_text(const Metrics& m) {
+  if (m.jumps == 0) return "-";
+  if (std::isinf(m.median_recovery_s)) return "none";
+  return fmt::format("{:.2f}", m.median_recovery_s);
+}
+
+std::string number_or_empty(double value, int decimals) {
+  if (std::isinf(value)) return "inf";
+  return fmt::format("{:.{}f}", value, decimals);
+}
+
+void append_csv_row(std::string& out, const std::string& case_name, const std::string& tracker,
+                    const std::string& take, const std::string& take_name, const Metrics& m) {
+  fmt::format_to(
+      std::back_inserter(out),
+      "{},{},{},{},{},{},{},{:.5f},{:.5f},{:.5f},{:.5f},{:.2f},{:.2f},{},{},{},{},{:.5f},"
+      "{:.2f}\n",
+      case_name, tracker, take, take_name, m.frames, m.scored_frames, m.pause_frames, m.within_50ms,
+      m.within_100ms, m.within_300ms, m.miss_fraction, m.mean_error_ms, m.median_error_ms, m.jumps,
+      m.recovered_jumps, m.jumps ? number_or_empty(m.median_recovery_s, 4) : "",
+      m.recovered_jumps ? number_or_empty(m.mean_recovery_s, 4) : "", m.lost_fraction,
+      m.mean_step_us);
+}
+
+std::string take_name(const EvalReport& report, int take) {
+  return take >= 0 && take < static_cast<int>(report.take_names.size())
+             ? report.take_names[static_cast<std::size_t>(take)]
+             : std::to_string(take);
+}
+
+}  // namespace
+
+std::string format_eval_table(const EvalReport& report) {
+  std::string out;
+  constexpr const char* kHeader =
+      "{:<18} {:<14} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>7} {:>7} {:>6} {:>8}\n";
+  fmt::format_to(std::back_inserter(out), kHeader, "case", "tracker", "frames", "acc@50", "acc@100",
+                 "acc@300", "mean ms", "med ms", "jumps", "recov s", "lost", "us/frame");
+  std::string previous_case;
+  for (const EvalRow& row : report.rows) {
+    if (!previous_case.empty() && row.case_name != previous_case) out += "\n";
+    previous_case = row.case_name;
+    const Metrics& m = row.metrics;
+    const std::string jumps =
+        m.jumps ? fmt::format("{}/{}", m.recovered_jumps, m.jumps) : std::string("-");
+    fmt::format_to(std::back_inserter(out), kHeader, row.case_name, row.tracker, m.scored_frames,
+                   percent(m.within_50ms), percent(m.within_100ms), percent(m.within_300ms),
+                   fmt::format("{:.1f}", m.mean_error_ms), fmt::format("{:.1f}", m.median_error_ms),
+                   jumps, recovery_text(m), percent(m.lost_fraction),
+                   fmt::format("{:.0f}", m.mean_step_us));
+  }
+  const NaiveCheck& n = report.naive;
+  if (n.ran) {
+    fmt::format_to(
+        std::back_inserter(out),
+        "\nnaive O(M^2) forward vs O(M) hmm, same parameters, on take {} alone ({} states), case "
+        "{}:\n  same state on {}/{} frames ({}); acc@100 naive {} vs hmm {}; {:.0f} vs {:.0f} "
+        "us/frame (tracker step only)\n",
+        n.take_name, n.states, n.case_name, n.same_state, n.frames,
+        percent(n.frames ? static_cast<double>(n.same_state) / static_cast<double>(n.frames) : 0.0),
+        percent(n.naive.within_100ms), percent(n.fast.within_100ms), n.naive.mean_step_us,
+        n.fast.mean_step_us);
+  }
+  return out;
+}
+
+std::string format_eval_csv(const EvalReport& report) {
+  std::string out =
+      "case,tracker,take,take_name,frames,scored_frames,pause_frames,acc_50ms,acc_100ms,acc_300ms,"
+      "miss_fraction,mean_error_ms,median_error_ms,jumps,recovered_jumps,median_recovery_s,"
+      "mean_recovery_s,lost_fraction,mean_step_us\n";
+  for (const EvalRow& row : report.rows) {
+    for (const auto& [take, metrics] : row.per_take) {
+      append_csv_row(out, row.case_name, row.tracker, std::to_string(take), take_name(report, take),
+                     metrics);
+    }
+    append_csv_row(out, row.case_name, row.tracker, "all", "", row.metrics);
+  }
+  const NaiveCheck& n = report.naive;
+  if (n.ran) {
+    append_csv_row(out, n.case_name, "naive-hmm", std::to_string(n.take), n.take_name, n.naive);
+    append_csv_row(out, n.case_name, "hmm-one-take", std::to_string(n.take), n.take_name, n.fast);
+  }
+  return out;
+}
+
+std::vector<PlotFile> make_eval_plots(const EvalReport& report, const std::string& terminal) {
+  std::vector<PlotFile> files;
+  std::vector<std::string> cases, trackers;
+  for (const EvalRow& row : report.rows) {
+    if (std::ranges::find(cases, row.case_name) == cases.end()) cases.push_back(row.case_name);
+    if (std::ranges::find(trackers, row.tracker) == trackers.end()) trackers.push_back(row.tracker);
+  }
+
+  // accuracy.dat: one line per case, one column per tracker (percent within 100 ms).
+  std::string accuracy = "# case";
+  for (const std::string& t : trackers) accuracy += " " + t;
+  accuracy += "\n";
+  for (const std::string& c : cases) {
+    accuracy += c;
+    for (const std::string& t : trackers) {
+      const auto it = std::ranges::find_if(
+          report.rows, [&](const EvalRow& r) { return r.case_name == c && r.tracker == t; });
+      accuracy += it == report.rows.end()
+                      ? " NaN"
+                      : fmt::format(" {:.2f}", 100.0 * it->metrics.within_100ms);
+    }
+    accuracy += "\n";
+  }
+  files.push_back({"accuracy.dat", accuracy});
+
+  std::string script = fmt::format(
+      "# duet eval plots: run `gnuplot plots.gp` in this directory.\n"
+      "set terminal {} size 1400,650 font ',11' noenhanced\n"
+      "set output 'accuracy.png'\n"
+      "set title 'Frames within 100 ms of the true template time (pause frames excluded)'\n"
+      "set style data histograms\n"
+      "set style histogram clustered gap 1\n"
+      "set style fill solid 0.85 border -1\n"
+      "set boxwidth 0.9\n"
+      "set yrange [0:105]\n"
+      "set ylabel 'within 100 ms (%)'\n"
+      "set grid ytics\n"
+      "set xtics rotate by -30 left\n"
+      "set key outside right top\n"
+      "set bmargin 6\n",
+      terminal);
+  script += "plot ";
+  for (std::size_t k = 0; k < trackers.size(); ++k) {
+    script += fmt::format("{}'accuracy.dat' using {}{} title '{}'", k ? ", \\\n     " : "", k + 2,
+                          k == 0 ? ":xtic(1)" : "", trackers[k]);
+  }
+  script += "\n";
+
+  if (!report.traces.empty()) {
+    // trace.dat: time, true frame (NaN in a pause), true frame in a pause, then per tracker the
+    // estimated frame in the performed take (NaN elsewhere) and a marker row for other takes.
+    const EvalTrace& first = report.traces.front();
+    const double other_take_y = -150.0;
+    std::string data = "# time_s truth truth_in_pause";
+    for (const EvalTrace& t : report.traces) data += " " + t.tracker + " " + t.tracker + "_other";
+    data += "\n";
+    for (std::size_t f = 0; f < first.times_s.size(); ++f) {
+      const TruthFrame& truth = first.truth[f];
+      fmt::format_to(std::back_inserter(data), "{:.4f} {} {}", first.times_s[f],
+                     truth.in_pause ? "NaN" : fmt::format("{:.2f}", truth.template_frame),
+                     truth.in_pause ? fmt::format("{:.2f}", truth.template_frame) : "NaN");
+      for (const EvalTrace& t : report.traces) {
+        const FrameEstimate& e = t.estimates[f];
+        const bool same = e.take == truth.take && e.take >= 0;
+        fmt::format_to(std::back_inserter(data), " {} {}",
+                       same ? std::to_string(e.frame_in_take) : "NaN",
+                       same ? "NaN" : fmt::format("{:.0f}", other_take_y));
+      }
+      data += "\n";
+    }
+    files.push_back({"trace.dat", data});
+
+    script += fmt::format(
+        "\nreset\n"
+        "set terminal {} size 1600,700 font ',11' noenhanced\n"
+        "set output 'trace.png'\n"
+        "set title 'case {} on take {}: true vs estimated template frame (points at {:.0f}: "
+        "estimate in another take)'\n"
+        "set xlabel 'performance time (s)'\n"
+        "set ylabel 'template frame in take'\n"
+        "set key outside right top\n"
+        "set grid\n"
+        "plot ",
+        terminal, first.case_name, take_name(report, first.take), other_take_y);
+    // Estimates first, the truth on top of them.
+    for (std::size_t k = 0; k < report.traces.size(); ++k) {
+      const int column = 4 + 2 * static_cast<int>(k);
+      script += fmt::format(
+          "'trace.dat' using 1:(${}) with points pt 7 ps 0.5 lc {} title '{}', \\\n"
+          "     'trace.dat' using 1:(${}) with points pt 2 ps 0.6 lc {} notitle, \\\n     ",
+          column, k + 1, report.traces[k].tracker, column + 1, k + 1);
+    }
+    script +=
+        "'trace.dat' using 1:($2) with lines lw 1.5 lc rgb 'black' title 'truth', \\\n"
+        "     'trace.dat' using 1:($3) with lines lw 4 lc rgb 'red' title 'truth (pause)'";
+    script += "\n";
+  }
+  files.push_back({"plots.gp", script});
+  return files;
+}
+
+}  // namespace duet

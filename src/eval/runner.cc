@@ -1,0 +1,409 @@
+#include "duet/eval/runner.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "duet/follow/hmm_follower.h"
+#include "duet/follow/naive_hmm.h"
+#include "duet/follow/nearest_neighbour.h"
+#include "duet/follow/online_dtw.h"
+#include "duet/live/follow_session.h"
+#include "duet/math/rotation.h"
+
+namespace duet {
+
+std::vector<EvalCase> standard_cases(const CaseSettings& settings) {
+  std::vector<EvalCase> cases;
+  auto add = [&](std::string name, std::string description) -> EvalCase& {
+    EvalCase c;
+    c.name = std::move(name);
+    c.description = std::move(description);
+    c.recipe.improvise_options.duration_s = settings.improvise_duration_s;
+    cases.push_back(std::move(c));
+    return cases.back();
+  };
+  const SensorNoiseOptions noise{settings.noise_rotation_deg, settings.noise_position_m, 0};
+  const FrameLossOptions loss{0.10, 0.20, 1.5, 0.002, 0};
+
+  add("clean", "the take as captured");
+  add("tempo-slow", "the whole take at 0.7x tempo").recipe.play.tempo.factor = 0.7;
+  add("tempo-fast", "the whole take at 1.4x tempo").recipe.play.tempo.factor = 1.4;
+  {
+    EvalCase& c = add("drift", "tempo drifting smoothly between 0.8x and 1.3x (12 s period)");
+    c.recipe.play.tempo.drift_low = 0.8;
+    c.recipe.play.tempo.drift_high = 1.3;
+  }
+  add("improv", "2-5 s segments of the take replayed in another order, no pause").recipe.improvise =
+      true;
+  {
+    EvalCase& c = add("improv-pause", "improv with a 0.3-0.8 s hold (tiny sway) before each jump");
+    c.recipe.improvise = true;
+    c.recipe.improvise_options.pause_prob = 1.0;
+  }
+  {
+    EvalCase& c =
+        add("improv-library", "improv-pause with segments from every take of the library");
+    c.recipe.improvise = true;
+    c.recipe.improvise_options.pause_prob = 1.0;
+    c.across_takes = true;
+  }
+  add("noise", "sensor noise: rotations (RMS per joint) and root position").recipe.noise = noise;
+  {
+    EvalCase& c = add("30hz-noisy", "a 30 Hz sensor with the noise");
+    c.recipe.play.rate_hz = settings.low_rate_hz;
+    c.recipe.noise = noise;
+  }
+  add("late-frames",
+      "10% of frames dropped (bursts of 1-3), 20% late by up to 1.5 periods, "
+      "2 ms jitter")
+      .recipe.loss = loss;
+  add("body-size", "a bigger dancer: skeleton and root path scaled").recipe.body_scale =
+      settings.body_scale;
+  {
+    EvalCase& c =
+        add("room-place", "another place and facing: turned 135 deg, moved (2.5, -1.5) m");
+    c.recipe.room_yaw_rad = deg_to_rad(135.0);
+    c.recipe.room_offset_m = Vec3(2.5, 0.0, -1.5);
+  }
+  add("partner-role", "the user dances the partner (library built with role=partner)")
+      .partner_role = true;
+  {
+    EvalCase& c =
+        add("improv-30hz-noisy", "improv-pause at 30 Hz with the noise and late/dropped frames");
+    c.recipe.improvise = true;
+    c.recipe.improvise_options.pause_prob = 1.0;
+    c.recipe.improvise_options.rate_hz = settings.low_rate_hz;
+    c.recipe.noise = noise;
+    c.recipe.loss = loss;
+  }
+  // Describe the magnitudes actually used.
+  for (EvalCase& c : cases) {
+    if (c.recipe.noise.active()) {
+      c.description += fmt::format(" (noise {:g} deg, {:g} cm)", settings.noise_rotation_deg,
+                                   settings.noise_position_m * 100.0);
+    }
+  }
+  return cases;
+}
+
+namespace {
+
+struct KindName {
+  TrackerKind kind;
+  std::string_view name;
+};
+constexpr KindName kKindNames[] = {{TrackerKind::kHmm, "hmm"},
+                                   {TrackerKind::kHmmPaper, "hmm-paper"},
+                                   {TrackerKind::kLeftToRight, "left-to-right"},
+                                   {TrackerKind::kNearestNeighbour, "nearest"},
+                                   {TrackerKind::kOnlineDtw, "online-dtw"},
+                                   {TrackerKind::kNaiveHmm, "naive-hmm"}};
+
+template <typename T>
+Result<std::unique_ptr<Tracker>> boxed(Result<T> tracker) {
+  if (!tracker) return tracker.error();
+  return std::unique_ptr<Tracker>(std::make_unique<T>(std::move(tracker).value()));
+}
+
+// FNV-1a: a seed per case name that does not depend on which cases run.
+std::uint64_t name_hash(std::string_view name) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const char c : name) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+// A tracker that only lets the session compute features (for the naive comparison, which runs
+// the trackers on a one-take model outside the session).
+class NullTracker final : public Tracker {
+ public:
+  void reset() noexcept override {}
+  FollowResult step(std::span<const float>, double) noexcept override { return {}; }
+  std::string_view name() const noexcept override { return "null"; }
+};
+
+struct Timed {
+  FollowResult result;
+  double us;
+};
+
+template <typename F>
+Timed timed(F&& f) {
+  const auto start = std::chrono::steady_clock::now();
+  FollowResult r = f();
+  const auto stop = std::chrono::steady_clock::now();
+  return {r, std::chrono::duration<double, std::micro>(stop - start).count()};
+}
+
+FrameEstimate to_estimate(const FollowResult& r, double us) {
+  return {r.take, r.frame_in_take, r.lost, r.jumped, us};
+}
+
+std::vector<SourceTake> sources_for(const DuetLibrary& library, int take, bool across_takes) {
+  std::vector<SourceTake> sources;
+  auto add = [&](int k) {
+    const DuetTake& t = library.takes()[static_cast<std::size_t>(k)];
+    sources.push_back({k, &t.template_motion.clip, t.template_motion.roles});
+  };
+  add(take);
+  if (across_takes) {
+    for (int k = 0; k < static_cast<int>(library.takes().size()); ++k) {
+      if (k != take) add(k);
+    }
+  }
+  return sources;
+}
+
+Result<NaiveCheck> run_naive_check(const DuetLibrary& library, const EvalCase& eval_case, int take,
+                                   const EvalOptions& options) {
+  NaiveCheck check;
+  check.take = take;
+  check.take_name = library.takes()[static_cast<std::size_t>(take)].name;
+  check.case_name = eval_case.name;
+  const TemplateModel& full = library.model();
+  const int begin = full.take_begin(take), count = full.take_end(take) - begin;
+  if (count > NaiveHmmFollower::kMaxStates) {
+    return Error{"naive-hmm: take " + check.take_name + " has " + std::to_string(count) +
+                 " states, more than the naive forward's limit " +
+                 std::to_string(NaiveHmmFollower::kMaxStates)};
+  }
+  Result<TemplateModel> one = TemplateModel::build(
+      FeatureMatrix(full.features().middleRows(begin, count)), {}, full.frame_rate_hz());
+  if (!one) return one.error();
+  const TemplateModel& model = one.value();
+  check.states = model.num_states();
+
+  const std::vector<SourceTake> sources = sources_for(library, take, false);
+  Result<Performance> made = make_performance(
+      sources, eval_case.recipe,
+      derive_seed(options.seed, name_hash(eval_case.name), static_cast<std::uint64_t>(take)));
+  if (!made) return made.error();
+  const Performance& performance = made.value();
+
+  Result<FollowSession> session =
+      FollowSession::create(library, performance.motion.skeleton_ptr(), performance.roles,
+                            std::make_unique<NullTracker>());
+  if (!session) return session.error();
+  Result<HmmFollower> fast = HmmFollower::create(model, options.hmm);
+  if (!fast) return fast.error();
+  Result<NaiveHmmFollower> naive = NaiveHmmFollower::create(model, options.hmm);
+  if (!naive) return naive.error();
+
+  std::vector<FrameEstimate> fast_estimates, naive_estimates;
+  std::vector<float> features;
+  for (int f = 0; f < performance.frame_count(); ++f) {
+    const auto fs = static_cast<std::size_t>(f);
+    session.value().step(performance.motion.translations_ls(f), performance.motion.rotations_ls(f),
+                         performance.times_s[fs]);
+    const std::span<const float> phi = session.value().last_features();
+    const double dt = f == 0 ? 0.0 : performance.times_s[fs] - performance.times_s[fs - 1];
+    const Timed a = timed([&] { return fast.value().step(phi, dt); });
+    const Timed b = timed([&] { return naive.value().step(phi, dt); });
+    check.same_state += a.result.state == b.result.state ? 1 : 0;
+    ++check.frames;
+    FrameEstimate ea = to_estimate(a.result, a.us), eb = to_estimate(b.result, b.us);
+    // The one-take model's take 0 is the library's take `take`.
+    if (ea.take == 0) ea.take = take;
+    if (eb.take == 0) eb.take = take;
+    fast_estimates.push_back(ea);
+    naive_estimates.push_back(eb);
+  }
+  check.fast = compute_metrics(performance, fast_estimates, options.metrics);
+  check.naive = compute_metrics(performance, naive_estimates, options.metrics);
+  check.ran = true;
+  return check;
+}
+
+}  // namespace
+
+std::string_view tracker_kind_name(TrackerKind kind) {
+  for (const KindName& k : kKindNames) {
+    if (k.kind == kind) return k.name;
+  }
+  return "?";
+}
+
+bool parse_tracker_kind(std::string_view name, TrackerKind& kind) {
+  for (const KindName& k : kKindNames) {
+    if (k.name == name) {
+      kind = k.kind;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::vector<TrackerKind> all_tracker_kinds() {
+  std::vector<TrackerKind> kinds;
+  for (const KindName& k : kKindNames) kinds.push_back(k.kind);
+  return kinds;
+}
+
+Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const TemplateModel& model,
+                                                   const EvalOptions& options) {
+  switch (kind) {
+    case TrackerKind::kHmm:
+      return boxed(HmmFollower::create(model, options.hmm));
+    case TrackerKind::kHmmPaper: {
+      // The paper's transitions [4.2]; the emission and decision settings are ours.
+      FollowParams params = FollowParams::paper();
+      params.emission_sigma = options.hmm.emission_sigma;
+      params.pause_distance_per_dim = options.hmm.pause_distance_per_dim;
+      params.lost_distance_per_dim = options.hmm.lost_distance_per_dim;
+      params.confidence_window_frames = options.hmm.confidence_window_frames;
+      params.max_steps_per_frame = options.hmm.max_steps_per_frame;
+      return boxed(HmmFollower::create(model, params));
+    }
+    case TrackerKind::kLeftToRight: {
+      FollowParams params = options.hmm;
+      params.jump_enabled = false;
+      params.resume_weights.clear();
+      return boxed(HmmFollower::create(model, params));
+    }
+    case TrackerKind::kNearestNeighbour:
+      return boxed(NearestNeighbourTracker::create(model, options.hmm));
+    case TrackerKind::kOnlineDtw: {
+      OnlineDtwParams params = options.dtw;
+      params.emission_sigma = options.hmm.emission_sigma;
+      params.lost_distance_per_dim = options.hmm.lost_distance_per_dim;
+      params.confidence_window_frames = options.hmm.confidence_window_frames;
+      params.max_steps_per_frame = options.hmm.max_steps_per_frame;
+      return boxed(OnlineDtwTracker::create(model, params));
+    }
+    case TrackerKind::kNaiveHmm:
+      return boxed(NaiveHmmFollower::create(model, options.hmm));
+  }
+  return Error{"unknown tracker"};
+}
+
+Result<std::vector<FrameEstimate>> follow_performance(const DuetLibrary& library,
+                                                      const Performance& performance,
+                                                      std::unique_ptr<Tracker> tracker) {
+  Result<FollowSession> created = FollowSession::create(library, performance.motion.skeleton_ptr(),
+                                                        performance.roles, std::move(tracker));
+  if (!created) return created.error();
+  FollowSession& session = created.value();
+  std::vector<FrameEstimate> estimates;
+  estimates.reserve(static_cast<std::size_t>(performance.frame_count()));
+  for (int f = 0; f < performance.frame_count(); ++f) {
+    const Timed t = timed([&] {
+      return session.step(performance.motion.translations_ls(f), performance.motion.rotations_ls(f),
+                          performance.times_s[static_cast<std::size_t>(f)]);
+    });
+    estimates.push_back(to_estimate(t.result, t.us));
+  }
+  return estimates;
+}
+
+Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary* partner_library,
+                                  const EvalOptions& options, const EvalProgress& progress) {
+  const int take_count = static_cast<int>(library.takes().size());
+  for (const int take : options.takes) {
+    if (take < 0 || take >= take_count) {
+      return Error{"take " + std::to_string(take) + " does not exist: the library has " +
+                   std::to_string(take_count) + " takes (0.." + std::to_string(take_count - 1) +
+                   ")"};
+    }
+  }
+  if (options.takes.empty()) return Error{"no take to perform from"};
+  if (options.cases.empty()) return Error{"no case to run"};
+  for (const EvalCase& c : options.cases) {
+    if (!c.partner_role) continue;
+    if (partner_library == nullptr) {
+      return Error{"case " + c.name + " needs a library built with role=partner"};
+    }
+    if (static_cast<int>(partner_library->takes().size()) != take_count) {
+      return Error{"the partner-role library holds another set of takes"};
+    }
+  }
+
+  std::vector<TrackerKind> trackers;
+  bool naive = false;
+  for (const TrackerKind kind : options.trackers) {
+    if (kind == TrackerKind::kNaiveHmm) {
+      naive = true;
+    } else {
+      trackers.push_back(kind);
+    }
+  }
+
+  EvalReport report;
+  report.library_states = library.model().num_states();
+  for (const DuetTake& t : library.takes()) report.take_names.push_back(t.name);
+
+  const long long total =
+      static_cast<long long>(options.cases.size() * options.takes.size() * trackers.size()) +
+      (naive ? 1 : 0);
+  long long done = 0;
+
+  for (const EvalCase& eval_case : options.cases) {
+    const DuetLibrary& lib = eval_case.partner_role ? *partner_library : library;
+    std::vector<MetricsAccumulator> pooled(trackers.size(), MetricsAccumulator(options.metrics));
+    std::vector<std::vector<std::pair<int, Metrics>>> per_take(trackers.size());
+    for (std::size_t ti = 0; ti < options.takes.size(); ++ti) {
+      const int take = options.takes[ti];
+      const std::vector<SourceTake> sources = sources_for(lib, take, eval_case.across_takes);
+      Result<Performance> made = make_performance(
+          sources, eval_case.recipe,
+          derive_seed(options.seed, name_hash(eval_case.name), static_cast<std::uint64_t>(take)));
+      if (!made) return Error{"case " + eval_case.name + ": " + made.error().message};
+      const Performance& performance = made.value();
+      for (std::size_t k = 0; k < trackers.size(); ++k) {
+        const std::string label = eval_case.name + " / " +
+                                  lib.takes()[static_cast<std::size_t>(take)].name + " / " +
+                                  std::string(tracker_kind_name(trackers[k]));
+        if (progress) progress(done, total, label);
+        Result<std::unique_ptr<Tracker>> tracker =
+            make_eval_tracker(trackers[k], lib.model(), options);
+        if (!tracker) return Error{label + ": " + tracker.error().message};
+        Result<std::vector<FrameEstimate>> estimates =
+            follow_performance(lib, performance, std::move(tracker).value());
+        if (!estimates) return Error{label + ": " + estimates.error().message};
+        MetricsAccumulator one(options.metrics);
+        one.add(performance, estimates.value());
+        per_take[k].emplace_back(take, one.summary());
+        pooled[k].merge(one);
+        if (eval_case.name == options.trace_case && ti == 0) {
+          report.traces.push_back({eval_case.name, std::string(tracker_kind_name(trackers[k])),
+                                   take, performance.template_rate_hz, performance.times_s,
+                                   performance.truth, std::move(estimates).value()});
+        }
+        ++done;
+      }
+    }
+    for (std::size_t k = 0; k < trackers.size(); ++k) {
+      report.rows.push_back({eval_case.name, std::string(tracker_kind_name(trackers[k])),
+                             pooled[k].summary(), std::move(per_take[k])});
+    }
+  }
+
+  if (naive) {
+    // On naive_case if it performs in the user's role from one take, else on the first case that
+    // does.
+    const auto eligible = [](const EvalCase& c) { return !c.partner_role && !c.across_takes; };
+    const EvalCase* chosen = nullptr;
+    for (const EvalCase& c : options.cases) {
+      if (c.name == options.naive_case && eligible(c)) chosen = &c;
+    }
+    for (const EvalCase& c : options.cases) {
+      if (chosen == nullptr && eligible(c)) chosen = &c;
+    }
+    if (chosen != nullptr) {
+      if (progress) progress(done, total, "naive-hmm on one take");
+      Result<NaiveCheck> check = run_naive_check(library, *chosen, options.takes[0], options);
+      if (!check) return Error{"naive-hmm: " + check.error().message};
+      report.naive = std::move(check).value();
+    }
+    ++done;
+  }
+  if (progress) progress(done, total, "done");
+  return report;
+}
+
+}  // namespace duet

@@ -1,0 +1,185 @@
+#include "duet/live/live_loop.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "duet/motion/forward_kinematics.h"
+
+namespace duet {
+
+namespace {
+
+bool* correction_switch(PartnerParams& params, std::string_view name) noexcept {
+  if (name == "align") return &params.align;
+  if (name == "contact") return &params.contact;
+  if (name == "smooth") return &params.smooth;
+  if (name == "footlock") return &params.foot_lock;
+  if (name == "blend") return &params.blend;
+  return nullptr;
+}
+
+// Same joints (names and parents) in the same order.
+bool same_joints(const Skeleton& a, const Skeleton& b) {
+  if (a.joint_count() != b.joint_count()) return false;
+  for (std::size_t j = 0; j < a.joints.size(); ++j) {
+    if (a.joints[j].name != b.joints[j].name || a.joints[j].parent != b.joints[j].parent) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool set_correction(PartnerParams& params, std::string_view name, bool enabled) noexcept {
+  bool* value = correction_switch(params, name);
+  if (value == nullptr) return false;
+  *value = enabled;
+  return true;
+}
+
+bool correction_enabled(const PartnerParams& params, std::string_view name) noexcept {
+  PartnerParams copy = params;
+  const bool* value = correction_switch(copy, name);
+  return value != nullptr && *value;
+}
+
+Result<LiveLoop> LiveLoop::create(std::shared_ptr<const DuetLibrary> library,
+                                  const SourceSkeleton& user, std::unique_ptr<Tracker> tracker,
+                                  const PartnerParams& params,
+                                  const PartnerModelOptions& model_options) {
+  if (!library || library->takes().empty()) return Error{"live loop: no duet library"};
+  if (!user.skeleton || user.skeleton->joint_count() == 0) {
+    return Error{"live loop: the source has no skeleton"};
+  }
+  if (const std::string problem = params.validate(); !problem.empty()) {
+    return Error{"live loop: " + problem};
+  }
+  const Skeleton& first = library->takes()[0].response_motion.clip.skeleton();
+  std::vector<PartnerModel> models;
+  models.reserve(library->takes().size());
+  for (const DuetTake& take : library->takes()) {
+    const Clip& response = take.response_motion.clip;
+    if (!same_joints(response.skeleton(), first)) {
+      return Error{"live loop: take " + take.name +
+                   ": the partner's skeleton differs from the first take's; every partner file of "
+                   "a library must share one skeleton"};
+    }
+    Result<PartnerModel> model =
+        PartnerModel::build(take.template_motion.clip, take.template_motion.roles, response,
+                            take.response_motion.roles, model_options);
+    if (!model) return Error{"take " + take.name + ": " + model.error().message};
+    models.push_back(std::move(model).value());
+  }
+  Result<FollowSession> session =
+      FollowSession::create(*library, user.skeleton, user.roles, std::move(tracker));
+  if (!session) return session.error();
+  return LiveLoop(std::move(library), user, std::move(session).value(), std::move(models), params);
+}
+
+LiveLoop::LiveLoop(std::shared_ptr<const DuetLibrary> library, const SourceSkeleton& user,
+                   FollowSession session, std::vector<PartnerModel> models,
+                   const PartnerParams& params)
+    : library_(std::move(library)),
+      user_(user),
+      session_(std::move(session)),
+      models_(std::move(models)),
+      params_(params) {
+  const auto user_joints = static_cast<std::size_t>(user_.joint_count());
+  const int partner_joints = models_[0].response_skeleton().joint_count();
+  const auto partner_n = static_cast<std::size_t>(partner_joints);
+  context_.resize(partner_joints);
+  out_.user_positions_ws.assign(user_joints, Vec3::Zero());
+  out_.user_rotations_ws.assign(user_joints, Quat::Identity());
+  out_.partner_translations_ls.assign(partner_n, Vec3::Zero());
+  out_.partner_rotations_ls.assign(partner_n, Quat::Identity());
+  out_.partner_positions_ws.assign(partner_n, Vec3::Zero());
+  out_.partner_rotations_ws.assign(partner_n, Quat::Identity());
+  // Until the first frame, the partner stands in its first captured pose.
+  const Clip& response = library_->takes()[0].response_motion.clip;
+  std::ranges::copy(response.translations_ls(0), out_.partner_translations_ls.begin());
+  std::ranges::copy(response.rotations_ls(0), out_.partner_rotations_ls.begin());
+  forward_kinematics(response.skeleton(), out_.partner_translations_ls, out_.partner_rotations_ls,
+                     out_.partner_positions_ws, out_.partner_rotations_ws);
+}
+
+std::shared_ptr<const Skeleton> LiveLoop::partner_skeleton() const noexcept {
+  return models_[0].response_skeleton_ptr();
+}
+
+bool LiveLoop::set_correction(std::string_view name, bool enabled) noexcept {
+  return duet::set_correction(params_, name, enabled);
+}
+
+void LiveLoop::reset() noexcept {
+  session_.reset();
+  context_.reset();
+  previous_take_ = -1;
+  previous_frame_ = 0;
+  has_previous_ = false;
+}
+
+const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
+  const FollowResult result =
+      session_.step(frame.translations_ls, frame.rotations_ls, frame.time_s);
+  ++out_.seq;
+  out_.time_s = frame.time_s;
+  out_.follow = result;
+
+  forward_kinematics(*user_.skeleton, frame.translations_ls, frame.rotations_ls,
+                     out_.user_positions_ws, out_.user_rotations_ws);
+  user_pose_ = user_pose_from_world(out_.user_positions_ws, out_.user_rotations_ws, user_.roles);
+
+  // Where the partner is in the library: the estimate, or where it was when there is none.
+  int take = result.take;
+  int frame_in_take = result.frame_in_take;
+  const int takes = static_cast<int>(models_.size());
+  if (take < 0 || take >= takes || frame_in_take < 0 ||
+      frame_in_take >= models_[static_cast<std::size_t>(take)].frame_count()) {
+    take = std::max(previous_take_, 0);
+    frame_in_take = previous_frame_;
+  }
+  const PartnerModel& model = models_[static_cast<std::size_t>(take)];
+  const Clip& response = library_->takes()[static_cast<std::size_t>(take)].response_motion.clip;
+
+  PartnerSynthesisJob job;
+  job.model = &model;
+  job.params = &params_;
+  job.frame = frame_in_take;
+  job.jumped = result.jumped || (previous_take_ >= 0 && take != previous_take_);
+  job.dt_s = has_previous_ ? frame.time_s - previous_time_s_ : 0.0;
+  job.translations_ls = response.translations_ls(frame_in_take);
+  job.rotations_ls = response.rotations_ls(frame_in_take);
+  job.user = &user_pose_;
+  job.context = &context_;
+  job.translations_ls_out = out_.partner_translations_ls;
+  job.rotations_ls_out = out_.partner_rotations_ls;
+  job.info = &out_.partner_info;
+  out_.partner_synthesised = job.run();
+  if (!out_.partner_synthesised) {
+    out_.partner_info = PartnerFrameInfo{};
+    std::ranges::copy(job.translations_ls, out_.partner_translations_ls.begin());
+    std::ranges::copy(job.rotations_ls, out_.partner_rotations_ls.begin());
+  }
+  forward_kinematics(model.response_skeleton(), out_.partner_translations_ls,
+                     out_.partner_rotations_ls, out_.partner_positions_ws,
+                     out_.partner_rotations_ws);
+
+  const std::uint8_t mask = model.contacts().mask(frame_in_take);
+  out_.contact_left = out_.contact_right = false;
+  for (int pair = 0; pair < kHandPairCount; ++pair) {
+    if ((mask & (1u << pair)) == 0) continue;
+    (template_side(pair) == Side::kLeft ? out_.contact_left : out_.contact_right) = true;
+  }
+  out_.partner_take = take;
+
+  previous_take_ = take;
+  previous_frame_ = frame_in_take;
+  if (std::isfinite(frame.time_s)) {
+    previous_time_s_ = frame.time_s;
+    has_previous_ = true;
+  }
+  return out_;
+}
+
+}  // namespace duet

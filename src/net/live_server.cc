@@ -1,0 +1,470 @@
+#include "duet/net/live_server.h"
+
+#include <fmt/format.h>
+
+#include <atomic>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <csignal>
+#include <ctime>
+#include <optional>
+#include <thread>
+
+#include "duet/live/source_neuron.h"
+#include "duet/live/source_pose.h"
+#include "duet/net/neuron_receiver.h"
+#include "duet/net/thread_priority.h"
+
+namespace duet::net {
+
+namespace asio = boost::asio;
+using boost::system::error_code;
+
+namespace {
+
+std::int64_t microseconds(SteadyClock::duration d) {
+  return std::chrono::duration_cast<std::chrono::microseconds>(d).count();
+}
+
+LatencySummary summarize(const LatencyHistogram& h) {
+  return {h.percentile(0.5), h.percentile(0.99), h.max(), h.count()};
+}
+
+std::string start_stamp() {
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  char buffer[32];
+  std::strftime(buffer, sizeof buffer, "%Y%m%d-%H%M%S", &local);
+  return buffer;
+}
+
+std::string ms(std::int64_t us) { return fmt::format("{:.2f}", static_cast<double>(us) / 1000.0); }
+
+// Frame messages are shared by every client's queue; a buffer is reused once no queue holds it,
+// so formatting a frame allocates nothing in the steady state. One thread only.
+class MessagePool {
+ public:
+  std::shared_ptr<std::string> acquire() {
+    for (std::size_t k = 0; k < buffers_.size(); ++k) {
+      const std::size_t i = (next_ + k) % buffers_.size();
+      if (buffers_[i].use_count() == 1) {
+        next_ = (i + 1) % buffers_.size();
+        return buffers_[i];
+      }
+    }
+    auto buffer = std::make_shared<std::string>();
+    buffer->reserve(32 * 1024);
+    if (buffers_.size() < kMaxBuffers) buffers_.push_back(buffer);
+    return buffer;
+  }
+
+ private:
+  static constexpr std::size_t kMaxBuffers = 64;
+  std::vector<std::shared_ptr<std::string>> buffers_;
+  std::size_t next_ = 0;
+};
+
+}  // namespace
+
+struct LiveServer::Impl {
+  Impl(LiveServerOptions o, SourceSpec s, std::unique_ptr<FrameSource> src,
+       std::unique_ptr<LiveLoop> l, LoopFactory f)
+      : options(std::move(o)),
+        spec(std::move(s)),
+        source(std::move(src)),
+        loop(std::move(l)),
+        factory(std::move(f)),
+        io(1),
+        server(io, options.server, make_callbacks()),
+        replay_timer(io),
+        stats_timer(io) {
+    if (!options.log) {
+      options.log = [](const std::string& line) { fmt::print(stderr, "duet serve: {}\n", line); };
+    }
+    neuron = dynamic_cast<NeuronSource*>(source.get());
+    pose = dynamic_cast<PoseSource*>(source.get());
+    frame.resize(source->source_skeleton().joint_count());
+    hello = std::make_shared<const std::string>(make_hello(*loop, source->describe()));
+  }
+
+  ServerCallbacks make_callbacks() {
+    ServerCallbacks c;
+    c.hello = [this] {
+      ++summary.clients_seen;
+      return hello;
+    };
+    c.on_text = [this](ClientId id, std::string_view text) { on_text(id, text); };
+    c.on_rejected = [this](ClientId id, std::string_view reason) { reject(id, reason); };
+    return c;
+  }
+
+  void log(const std::string& line) { options.log(line); }
+
+  // ---- Start and stop ----
+
+  Status start() {
+    if (Status s = server.start(); !s) return s;
+    if (!options.record_dir.empty()) {
+      record_stem = options.record_stem.empty() ? start_stamp() : options.record_stem;
+      if (Status s = start_recording(record_stem); !s) return s;
+    }
+    auto on_input = [this] { drain(); };
+    auto log_fn = [this](const std::string& line) { log(line); };
+    if (spec.kind == SourceKind::kNeuronTcp) {
+      receiver = NeuronReceiver::connect_tcp(io, spec.host, spec.port, *neuron, on_input, log_fn);
+    } else if (spec.kind == SourceKind::kNeuronUdp) {
+      auto r = NeuronReceiver::bind_udp(io, spec.host, spec.port, *neuron, on_input, log_fn);
+      if (!r) return r.error();
+      receiver = std::move(r).value();
+    }
+    if (options.handle_signals) {
+      signals.emplace(io, SIGINT, SIGTERM);
+      signals->async_wait([this](error_code ec, int signal) {
+        if (ec) return;
+        log(fmt::format("{}: stopping", signal == SIGINT ? "SIGINT" : "SIGTERM"));
+        shutdown();
+      });
+    }
+    return Ok{};
+  }
+
+  Status start_recording(const std::string& stem) {
+    RecorderOptions r;
+    r.directory = options.record_dir;
+    r.stem = stem;
+    Result<std::unique_ptr<SessionRecorder>> started =
+        SessionRecorder::start(r, source->source_skeleton().skeleton, loop->partner_skeleton(),
+                               source->source_skeleton().frame_rate);
+    if (!started) return started.error();
+    if (recorder) retire_recorder();
+    recorder = std::move(started).value();
+    log("recording to " + recorder->user_path() + ", " + recorder->partner_path() + ", " +
+        recorder->follow_path());
+    return Ok{};
+  }
+
+  // Closes the current recording on a background thread (file work stays off the loop's).
+  void retire_recorder() {
+    if (!recorder) return;
+    add_recording_summary(*recorder);
+    retiring.emplace_back([r = std::move(recorder)]() mutable {
+      use_normal_priority();
+      (void)r->stop();
+    });
+  }
+
+  void add_recording_summary(const SessionRecorder& r) {
+    summary.recordings.push_back(r.user_path());
+    summary.recordings.push_back(r.partner_path());
+    summary.recordings.push_back(r.follow_path());
+  }
+
+  Status run() {
+    if (options.realtime) log("loop thread: " + raise_thread_priority());
+    const auto now = SteadyClock::now();
+    source->start(now);
+    last_stats = last_log = now;
+    schedule_replay();
+    schedule_stats();
+    io.run();
+    if (options.realtime) use_normal_priority();
+
+    // Stopped: the loop thread is this one, so no frame is in flight any more.
+    if (receiver) receiver->stop();
+    server.stop();
+    if (loader.joinable()) loader.join();
+    Status status = Ok{};
+    if (recorder) {
+      add_recording_summary(*recorder);
+      status = recorder->stop();
+      summary.recorded += recorder->frames_recorded();
+      summary.record_lost += recorder->frames_lost();
+    }
+    for (std::thread& t : retiring) t.join();
+    retiring.clear();
+    finish_summary();
+    return status;
+  }
+
+  void shutdown() {
+    if (stopping) return;
+    stopping = true;
+    replay_timer.cancel();
+    stats_timer.cancel();
+    if (signals) signals->cancel();
+    if (receiver) receiver->stop();
+    server.stop();
+    io.stop();
+  }
+
+  void finish_summary() {
+    summary.frames = frames;
+    summary.rejected = rejected;
+    summary.dropped = server.frames_dropped();
+    LatencyHistogram send = send_total;
+    send.merge(server.send_latency());
+    LatencyHistogram built = loop_total;
+    built.merge(loop_window);
+    summary.latency_total = summarize(send);
+    summary.loop_total = summarize(built);
+  }
+
+  // ---- Frames ----
+
+  void schedule_replay() {
+    if (stopping) return;
+    const std::optional<SteadyClock::time_point> due = source->next_due();
+    if (!due) return;
+    replay_timer.expires_at(*due);
+    replay_timer.async_wait([this](error_code ec) {
+      if (!ec && !stopping) drain();
+    });
+  }
+
+  void drain() {
+    if (stopping) return;
+    const auto now = SteadyClock::now();
+    while (source->poll(now, frame)) process(frame);
+    if (source->next_due()) {
+      schedule_replay();
+    } else if (source->finished() && !source_end_reported) {
+      source_end_reported = true;
+      log(fmt::format("the source finished after {} frames{}", source->stats().frames,
+                      options.exit_at_end ? "; stopping" : ""));
+      if (options.exit_at_end) shutdown();
+    }
+  }
+
+  void process(const SourceFrame& input) {
+    const LiveOutput& out = loop->step(input);
+    const std::int64_t step_us = microseconds(SteadyClock::now() - input.arrival);
+    if (recorder) recorder->push(input, out);
+    std::shared_ptr<std::string> text = pool.acquire();
+    format_frame(out, loop->params(), step_us, *text);
+    loop_window.record(microseconds(SteadyClock::now() - input.arrival));
+    server.broadcast_frame(std::move(text), input.arrival);
+    ++frames;
+  }
+
+  // ---- Client messages ----
+
+  void reject(ClientId id, std::string_view reason) {
+    ++rejected;
+    server.send(id, std::make_shared<const std::string>(make_error(reason)));
+  }
+
+  void on_text(ClientId id, std::string_view text) {
+    if (std::optional<std::string> problem = parse_client_message(text, message)) {
+      reject(id, *problem);
+      return;
+    }
+    switch (message.type) {
+      case ClientMessage::Type::kSet:
+        loop->set_correction(message.correction, message.enabled);
+        return;
+      case ClientMessage::Type::kReset:
+        loop->reset();
+        return;
+      case ClientMessage::Type::kRole:
+        request_role(message.role);
+        return;
+      case ClientMessage::Type::kPose:
+        if (pose == nullptr) {
+          reject(id, "pose messages are for the WebSocket source (duet serve --source ws)");
+          return;
+        }
+        if (!pose->push(message.time_s, message.root, message.rotations, SteadyClock::now(),
+                        pose_reason)) {
+          reject(id, pose_reason);
+          return;
+        }
+        drain();
+        return;
+    }
+  }
+
+  // ---- Role switching ----
+
+  void request_role(DancerRole role) {
+    wanted_role = role;
+    if (role == loop->role()) return;  // a load in progress for the other role is kept for later
+    if (other_loop && other_loop->role() == role) {
+      activate_other();
+      return;
+    }
+    if (loading) return;
+    loading = true;
+    log(fmt::format("building the model for the {} role", dancer_role_name(role)));
+    if (loader.joinable()) loader.join();
+    loader = std::thread([this, role, params = loop->params()] {
+      use_normal_priority();  // building a model takes seconds of CPU: never at the loop's priority
+      auto result = std::make_shared<Result<std::unique_ptr<LiveLoop>>>(Error{"no factory"});
+      if (factory) {
+        try {
+          *result = factory(role, params);
+        } catch (const std::exception& e) {
+          *result = Error{e.what()};
+        }
+      }
+      asio::post(io, [this, role, result] { on_loaded(role, std::move(*result)); });
+    });
+  }
+
+  void on_loaded(DancerRole role, Result<std::unique_ptr<LiveLoop>> result) {
+    loading = false;
+    if (stopping) return;
+    if (!result) {
+      const std::string why = fmt::format("cannot switch to the {} role: {}",
+                                          dancer_role_name(role), result.error().message);
+      log(why);
+      server.broadcast(std::make_shared<const std::string>(make_error(why)));
+      if (wanted_role == role) wanted_role = loop->role();
+      return;
+    }
+    other_loop = std::move(result).value();
+    if (wanted_role == role) activate_other();
+  }
+
+  void activate_other() {
+    other_loop->set_params(loop->params());
+    other_loop->reset();
+    std::swap(loop, other_loop);
+    hello = std::make_shared<const std::string>(make_hello(*loop, source->describe()));
+    server.broadcast(hello);
+    log(fmt::format("the user now dances the {}", dancer_role_name(loop->role())));
+    if (recorder) {
+      ++segment;
+      if (Status s = start_recording(fmt::format("{}-seg{}", record_stem, segment)); !s) {
+        log("recording stopped: " + s.error().message);
+        retire_recorder();
+      }
+    }
+  }
+
+  // ---- Statistics ----
+
+  void schedule_stats() {
+    stats_timer.expires_after(std::chrono::duration_cast<SteadyClock::duration>(
+        std::chrono::duration<double>(options.stats_interval_s)));
+    stats_timer.async_wait([this](error_code ec) {
+      if (ec || stopping) return;
+      stats_tick();
+      schedule_stats();
+    });
+  }
+
+  void stats_tick() {
+    server.close_stalled_clients();
+    const auto now = SteadyClock::now();
+    LatencyHistogram& send = server.send_latency();
+    send_total.merge(send);
+    send_log.merge(send);
+    loop_total.merge(loop_window);
+    loop_log.merge(loop_window);
+
+    StatsSnapshot s;
+    s.frames = frames;
+    s.clients = server.client_count();
+    s.dropped = server.frames_dropped();
+    s.rejected = rejected;
+    const double window_s = std::chrono::duration<double>(now - last_stats).count();
+    s.rate_hz = window_s > 0.0 ? static_cast<double>(frames - frames_at_stats) / window_s : 0.0;
+    s.latency = summarize(send);
+    s.latency_total = summarize(send_total);
+    s.loop = summarize(loop_window);
+    s.source = source->stats();
+    if (recorder) {
+      s.recorded = recorder->frames_recorded();
+      s.record_lost = recorder->frames_lost();
+    }
+    server.broadcast(std::make_shared<const std::string>(make_stats(s)));
+    send.clear();
+    loop_window.clear();
+    last_stats = now;
+    frames_at_stats = frames;
+
+    const double log_s = std::chrono::duration<double>(now - last_log).count();
+    if (options.log_interval_s > 0.0 && log_s >= options.log_interval_s - 1e-3) {
+      const LatencySummary sent = summarize(send_log);
+      const LatencySummary built = summarize(loop_log);
+      log(fmt::format(
+          "{} frames in {:.1f} s ({:.1f} Hz), {} client(s); arrival->sent p50 {} ms, p99 {} ms, "
+          "max {} ms; arrival->built p50 {} ms, p99 {} ms; dropped {}, rejected {}, source "
+          "rejected {}",
+          frames - frames_at_log, log_s, static_cast<double>(frames - frames_at_log) / log_s,
+          s.clients, ms(sent.p50), ms(sent.p99), ms(sent.max), ms(built.p50), ms(built.p99),
+          s.dropped, s.rejected, s.source.rejected));
+      send_log.clear();
+      loop_log.clear();
+      last_log = now;
+      frames_at_log = frames;
+    }
+  }
+
+  LiveServerOptions options;
+  SourceSpec spec;
+  std::unique_ptr<FrameSource> source;
+  NeuronSource* neuron = nullptr;
+  PoseSource* pose = nullptr;
+  std::unique_ptr<LiveLoop> loop;
+  LoopFactory factory;
+
+  asio::io_context io;
+  Server server;
+  asio::steady_timer replay_timer;
+  asio::steady_timer stats_timer;
+  std::optional<asio::signal_set> signals;
+  std::unique_ptr<NeuronReceiver> receiver;
+  bool stopping = false;
+
+  std::unique_ptr<SessionRecorder> recorder;
+  std::vector<std::thread> retiring;
+  std::string record_stem;
+  int segment = 1;
+
+  SourceFrame frame;
+  MessagePool pool;
+  std::shared_ptr<const std::string> hello;
+  ClientMessage message;
+  std::string pose_reason;
+
+  std::unique_ptr<LiveLoop> other_loop;
+  std::thread loader;
+  bool loading = false;
+  DancerRole wanted_role = DancerRole::kLeader;
+
+  long long frames = 0;
+  long long rejected = 0;
+  bool source_end_reported = false;
+  LatencyHistogram loop_window, loop_log, loop_total;
+  LatencyHistogram send_log, send_total;
+  SteadyClock::time_point last_stats{}, last_log{};
+  long long frames_at_stats = 0, frames_at_log = 0;
+  ServeSummary summary;
+};
+
+LiveServer::LiveServer(LiveServerOptions options, SourceSpec spec,
+                       std::unique_ptr<FrameSource> source, std::unique_ptr<LiveLoop> loop,
+                       LoopFactory factory)
+    : impl_(std::make_unique<Impl>(std::move(options), std::move(spec), std::move(source),
+                                   std::move(loop), std::move(factory))) {}
+
+LiveServer::~LiveServer() {
+  if (impl_->loader.joinable()) impl_->loader.join();
+  for (std::thread& t : impl_->retiring) t.join();
+}
+
+Status LiveServer::start() { return impl_->start(); }
+std::uint16_t LiveServer::port() const { return impl_->server.port(); }
+const std::filesystem::path* LiveServer::web_root() const { return impl_->server.web_root(); }
+Status LiveServer::run() { return impl_->run(); }
+void LiveServer::stop() {
+  Impl* impl = impl_.get();
+  asio::post(impl->io, [impl] { impl->shutdown(); });
+}
+const ServeSummary& LiveServer::summary() const { return impl_->summary; }
+
+}  // namespace duet::net

@@ -1,0 +1,163 @@
+// `duet eval` and `duet improvise` end to end, through the binary, on two short salsa takes.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "apps/run_command.h"
+
+namespace duet {
+namespace {
+
+using testing::data_path;
+using testing::run_duet;
+
+std::string pair(const std::string& trial) {
+  return "--pair " + data_path("cmu-salsa/bvh/60/60_" + trial + "_scaled.bvh") + " " +
+         data_path("cmu-salsa/bvh/61/61_" + trial + "_scaled.bvh");
+}
+
+std::filesystem::path scratch_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("duet_eval_test_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<std::string> split(const std::string& line, char sep) {
+  std::vector<std::string> out;
+  std::stringstream s(line);
+  std::string cell;
+  while (std::getline(s, cell, sep)) out.push_back(cell);
+  return out;
+}
+
+// Pooled rows of the eval CSV: (case, tracker) -> column -> value.
+std::map<std::pair<std::string, std::string>, std::map<std::string, std::string>> pooled_rows(
+    const std::string& csv) {
+  std::stringstream s(csv);
+  std::string line;
+  std::getline(s, line);
+  const std::vector<std::string> header = split(line, ',');
+  std::map<std::pair<std::string, std::string>, std::map<std::string, std::string>> rows;
+  while (std::getline(s, line)) {
+    const std::vector<std::string> cells = split(line, ',');
+    if (cells.size() < 3 || cells[2] != "all") continue;
+    auto& row = rows[{cells[0], cells[1]}];
+    for (std::size_t c = 0; c < header.size() && c < cells.size(); ++c) row[header[c]] = cells[c];
+  }
+  return rows;
+}
+
+TEST(CliEval, RunsCasesAndWritesTableCsvAndPlots) {
+  const auto dir = scratch_dir("run");
+  const std::string csv = (dir / "eval.csv").string();
+  const std::string plots = (dir / "plots").string();
+  const bool have_gnuplot = std::system("command -v gnuplot >/dev/null 2>&1") == 0;
+  const auto r = run_duet("eval " + pair("10") + " " + pair("05") +
+                          " --fps 60 --takes 0 --cases clean,improv-pause,partner-role "
+                          "--trackers hmm,nearest,naive-hmm --seed 3 --csv " +
+                          csv + (have_gnuplot ? " --plots " + plots : std::string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // The table: a header and one row per case x tracker.
+  EXPECT_NE(r.output.find("acc@100"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("improv-pause"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("naive O(M^2) forward"), std::string::npos) << r.output;
+
+  const auto rows = pooled_rows(read_text(csv));
+  ASSERT_EQ(rows.size(), 6u) << read_text(csv);
+  // Plausible numbers: the follower on the unperturbed take is nearly always right.
+  const auto& clean = rows.at({"clean", "hmm"});
+  EXPECT_GT(std::stod(clean.at("acc_100ms")), 0.9) << r.output;
+  EXPECT_GT(std::stod(rows.at({"partner-role", "hmm"}).at("acc_100ms")), 0.8) << r.output;
+  const auto& improv = rows.at({"improv-pause", "hmm"});
+  EXPECT_GT(std::stoi(improv.at("jumps")), 3);
+  EXPECT_GT(std::stoi(improv.at("pause_frames")), 0);
+  EXPECT_GT(std::stod(improv.at("acc_100ms")), 0.6) << r.output;
+  EXPECT_GT(std::stod(clean.at("mean_step_us")), 0.0);
+  // The naive forward agrees with the O(M) one.
+  const std::string text = read_text(csv);
+  EXPECT_NE(text.find(",naive-hmm,0,60_10_scaled,"), std::string::npos);
+  if (have_gnuplot) {
+    EXPECT_GT(std::filesystem::file_size(std::filesystem::path(plots) / "accuracy.png"), 1000u);
+    EXPECT_GT(std::filesystem::file_size(std::filesystem::path(plots) / "trace.png"), 1000u);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliEval, BadOptionsExitTwoAndBadFilesExitOne) {
+  const std::string pairs = pair("10") + " --fps 60";
+  auto r = run_duet("eval " + pairs + " --cases clean,bogus");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("unknown case 'bogus'"), std::string::npos) << r.output;
+  r = run_duet("eval " + pairs + " --takes 1");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--takes 1"), std::string::npos) << r.output;
+  r = run_duet("eval " + pairs + " --trackers hmm,magic");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = run_duet("eval " + pairs + " --sigma -1");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = run_duet("eval " + pairs + " --trace-case nothing");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+
+  const auto dir = scratch_dir("bad");
+  const std::string garbage = (dir / "garbage.bvh").string();
+  std::ofstream(garbage) << "HIERARCHY\nROOT hip\n{\n";
+  r = run_duet("eval --pair " + garbage + " " + garbage + " --fps 60 --cases clean");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("garbage.bvh"), std::string::npos) << r.output;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliImprovise, WritesAPerformanceAndItsTruthThatFollowReads) {
+  const auto dir = scratch_dir("improvise");
+  const std::string perf = (dir / "perf.bvh").string();
+  const std::string truth = (dir / "truth.csv").string();
+  auto r = run_duet("improvise " + pair("05") + " " + pair("10") +
+                    " --fps 60 --take 1 --rate 30 --noise-deg 2 --seed 4 -o " + perf + " --truth " +
+                    truth);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string truth_text = read_text(truth);
+  std::stringstream lines(truth_text);
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line, "frame,time_s,take,template_frame,in_pause,jump");
+  int frames = 0, jumps = 0;
+  while (std::getline(lines, line)) {
+    const auto cells = split(line, ',');
+    ASSERT_EQ(cells.size(), 6u);
+    EXPECT_EQ(cells[2], "1");  // take index among the pairs given
+    jumps += cells[5] == "1" ? 1 : 0;
+    ++frames;
+  }
+  EXPECT_GT(jumps, 2);
+  // 1197 frames at 60 Hz = 19.95 s at 30 Hz.
+  EXPECT_NEAR(frames, 19.95 * 30, 2);
+
+  const std::string trace = (dir / "trace.csv").string();
+  r = run_duet("follow " + pair("05") + " " + pair("10") + " --fps 60 --input " + perf +
+               " --trace " + trace);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string trace_text = read_text(trace);
+  EXPECT_EQ(std::count(trace_text.begin(), trace_text.end(), '\n'), frames + 1);
+
+  // Usage errors.
+  r = run_duet("improvise -o " + perf);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = run_duet("improvise " + pair("05") + " --take 3 -o " + perf);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace duet

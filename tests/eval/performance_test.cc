@@ -1,0 +1,386 @@
+#include "duet/eval/performance.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "duet/features/feature_extractor.h"
+#include "duet/io/motion_file.h"
+#include "duet/math/rotation.h"
+#include "features/synthetic_dancer.h"
+
+namespace duet {
+namespace {
+
+using testing::daz_roles;
+using testing::make_dance;
+using testing::make_role_skeleton;
+
+struct Fixture {
+  Clip clip;
+  JointRoles roles;
+  SourceTake source() const { return {3, &clip, roles}; }
+};
+
+Fixture make_fixture(int frames = 900) {
+  auto skeleton = make_role_skeleton();
+  Fixture f{make_dance(skeleton, 60.0, frames), daz_roles(*skeleton)};
+  return f;
+}
+
+// The pose of `clip` at a real template frame (what the truth says frame k shows).
+Pose pose_at_frame(const Clip& clip, double template_frame) {
+  Pose pose;
+  clip.sample(template_frame / clip.frame_rate(), pose);
+  return pose;
+}
+
+// Frame k of the performance equals the take's pose at the true template frame, up to a rigid
+// turn about the vertical and a horizontal move of the root. Returns that move.
+struct RigidMove {
+  double yaw;
+  Vec3 offset;
+};
+RigidMove expect_same_pose_up_to_rigid(const Performance& p, const Clip& take, int k) {
+  const TruthFrame& truth = p.truth[static_cast<std::size_t>(k)];
+  const Pose expected = pose_at_frame(take, truth.template_frame);
+  const auto translations = p.motion.translations_ls(k);
+  const auto rotations = p.motion.rotations_ls(k);
+  for (int j = 1; j < take.joint_count(); ++j) {
+    const auto i = static_cast<std::size_t>(j);
+    EXPECT_TRUE(translations[i].isApprox(expected.translations_ls[i], 1e-9)) << "frame " << k;
+    EXPECT_LT(rotations[i].angularDistance(expected.rotations_ls[i]), 1e-9) << "frame " << k;
+  }
+  const double yaw = wrap_angle(heading_yaw(rotations[0]) - heading_yaw(expected.rotations_ls[0]));
+  EXPECT_LT(rotations[0].angularDistance(yaw_rotation(yaw) * expected.rotations_ls[0]), 1e-9)
+      << "frame " << k;
+  const Vec3 offset = translations[0] - yaw_rotation(yaw) * expected.translations_ls[0];
+  EXPECT_NEAR(offset.y(), 0.0, 1e-9) << "frame " << k;
+  return {yaw, offset};
+}
+
+TEST(Play, SteadyTempoOneIsTheTakeItself) {
+  const Fixture f = make_fixture();
+  const Performance p = play(f.source(), {});
+  ASSERT_EQ(p.frame_count(), f.clip.frame_count());
+  EXPECT_DOUBLE_EQ(p.template_rate_hz, 60.0);
+  for (int k = 0; k < p.frame_count(); k += 37) {
+    const TruthFrame& t = p.truth[static_cast<std::size_t>(k)];
+    EXPECT_EQ(t.take, 3);
+    EXPECT_NEAR(t.template_frame, k, 1e-6);
+    EXPECT_FALSE(t.in_pause || t.jump);
+    EXPECT_DOUBLE_EQ(p.times_s[static_cast<std::size_t>(k)], k / 60.0);
+    EXPECT_TRUE(p.motion.translations_ls(k)[0].isApprox(f.clip.translations_ls(k)[0], 1e-9));
+  }
+}
+
+TEST(Play, FastTempoAtThirtyHertzSamplesTheTakeAtTheTrueFrame) {
+  const Fixture f = make_fixture();
+  PlayOptions options;
+  options.tempo.factor = 1.4;
+  options.rate_hz = 30.0;
+  const Performance p = play(f.source(), options);
+  EXPECT_DOUBLE_EQ(p.motion.frame_rate(), 30.0);
+  // 899 template frames / 60 fps / 1.4 * 30 Hz + the first frame.
+  EXPECT_NEAR(p.frame_count(), 899.0 / 60.0 / 1.4 * 30.0 + 1.0, 1.0);
+  for (int k = 0; k < p.frame_count(); ++k) {
+    EXPECT_NEAR(p.truth[static_cast<std::size_t>(k)].template_frame, k * 1.4 * 2.0, 1e-6);
+    const RigidMove m = expect_same_pose_up_to_rigid(p, f.clip, k);
+    EXPECT_NEAR(m.yaw, 0.0, 1e-9);
+    EXPECT_LT(m.offset.norm(), 1e-9);
+  }
+}
+
+TEST(Play, DriftingTempoStaysWithinItsBounds) {
+  const Fixture f = make_fixture(1800);
+  PlayOptions options;
+  options.tempo.drift_low = 0.8;
+  options.tempo.drift_high = 1.3;
+  options.tempo.drift_period_s = 6.0;
+  const Performance p = play(f.source(), options);
+  double slowest = 10.0, fastest = 0.0;
+  for (std::size_t k = 1; k < p.truth.size(); ++k) {
+    const double rate = p.truth[k].template_frame - p.truth[k - 1].template_frame;  // per 1/60 s
+    slowest = std::min(slowest, rate);
+    fastest = std::max(fastest, rate);
+  }
+  EXPECT_GT(slowest, 0.8 - 1e-3);
+  EXPECT_LT(fastest, 1.3 + 1e-3);
+  EXPECT_LT(slowest, 0.85);  // it does reach both ends over several periods
+  EXPECT_GT(fastest, 1.25);
+}
+
+ImproviseOptions improv_options(double pause_prob) {
+  ImproviseOptions options;
+  options.duration_s = 40.0;
+  options.pause_prob = pause_prob;
+  options.seed = 7;
+  return options;
+}
+
+// Largest horizontal root step and heading change per frame in the take itself.
+void take_steps(const Clip& clip, double& max_step, double& max_turn) {
+  max_step = max_turn = 0.0;
+  for (int f = 1; f < clip.frame_count(); ++f) {
+    Vec3 d = clip.translations_ls(f)[0] - clip.translations_ls(f - 1)[0];
+    d.y() = 0.0;
+    max_step = std::max(max_step, d.norm());
+    max_turn = std::max(max_turn, std::abs(wrap_angle(heading_yaw(clip.rotations_ls(f)[0]) -
+                                                      heading_yaw(clip.rotations_ls(f - 1)[0]))));
+  }
+}
+
+class Improvise : public ::testing::TestWithParam<double> {};
+
+TEST_P(Improvise, GroundTruthMatchesThePosesAndTheRootPathIsContinuous) {
+  const Fixture f = make_fixture(1800);
+  const SourceTake source = f.source();
+  Result<Performance> made = improvise(std::span(&source, 1), improv_options(GetParam()));
+  ASSERT_TRUE(made) << made.error().message;
+  const Performance& p = made.value();
+  EXPECT_EQ(p.frame_count(), 40 * 60);
+
+  double max_step = 0.0, max_turn = 0.0;
+  take_steps(f.clip, max_step, max_turn);
+  int jumps = 0, pause_frames = 0;
+  std::optional<RigidMove> segment_move;
+  for (int k = 0; k < p.frame_count(); ++k) {
+    const TruthFrame& t = p.truth[static_cast<std::size_t>(k)];
+    EXPECT_EQ(t.take, 3);
+    EXPECT_GE(t.template_frame, 0.0);
+    EXPECT_LE(t.template_frame, f.clip.frame_count() - 1.0);
+    jumps += t.jump ? 1 : 0;
+    pause_frames += t.in_pause ? 1 : 0;
+    if (t.jump) segment_move.reset();
+    if (!t.in_pause) {
+      // Same pose as the take at the true frame, one rigid move per segment.
+      const RigidMove m = expect_same_pose_up_to_rigid(p, f.clip, k);
+      if (segment_move) {
+        EXPECT_NEAR(wrap_angle(m.yaw - segment_move->yaw), 0.0, 1e-9) << "frame " << k;
+        EXPECT_TRUE(m.offset.isApprox(segment_move->offset, 1e-9)) << "frame " << k;
+      }
+      segment_move = m;
+    } else {
+      segment_move.reset();
+    }
+    if (k == 0) continue;
+    // No teleport: root steps and turns no larger than the take's own (plus the tiny sway).
+    Vec3 step = p.motion.translations_ls(k)[0] - p.motion.translations_ls(k - 1)[0];
+    step.y() = 0.0;
+    EXPECT_LE(step.norm(), 1.05 * max_step + 0.002) << "frame " << k << (t.jump ? " (jump)" : "");
+    const double turn = std::abs(wrap_angle(heading_yaw(p.motion.rotations_ls(k)[0]) -
+                                            heading_yaw(p.motion.rotations_ls(k - 1)[0])));
+    EXPECT_LE(turn, 1.05 * max_turn + 0.002) << "frame " << k;
+  }
+  EXPECT_GE(jumps, 40 / 6);  // segments are 2-5 s and most of them end in a jump
+  if (GetParam() > 0.0) {
+    // Every jump is preceded by a 0.3-0.8 s hold.
+    EXPECT_GE(pause_frames, jumps * 0.3 * 60 - 1);
+    EXPECT_LE(pause_frames, jumps * 0.8 * 60 + jumps);
+    for (int k = 1; k < p.frame_count(); ++k) {
+      if (p.truth[static_cast<std::size_t>(k)].jump) {
+        EXPECT_TRUE(p.truth[static_cast<std::size_t>(k - 1)].in_pause) << "frame " << k;
+      }
+    }
+  } else {
+    EXPECT_EQ(pause_frames, 0);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(WithAndWithoutPause, Improvise, ::testing::Values(0.0, 1.0));
+
+TEST(Improvise, ReplaysSegmentsOutOfOrderWithRepeatsAndSkips) {
+  const Fixture f = make_fixture(1800);
+  const SourceTake source = f.source();
+  Result<Performance> made = improvise(std::span(&source, 1), improv_options(0.0));
+  ASSERT_TRUE(made);
+  int backwards = 0, forwards = 0;
+  for (std::size_t k = 1; k < made.value().truth.size(); ++k) {
+    const TruthFrame& t = made.value().truth[k];
+    if (!t.jump) {
+      const double d = t.template_frame - made.value().truth[k - 1].template_frame;
+      EXPECT_NEAR(d, 1.0, 1e-6) << "frame " << k;  // tempo 1 between jumps
+      continue;
+    }
+    const double d = t.template_frame - made.value().truth[k - 1].template_frame;
+    backwards += d < 0.0 ? 1 : 0;
+    forwards += d > 2.0 ? 1 : 0;
+  }
+  EXPECT_GT(backwards, 0);
+  EXPECT_GT(forwards, 0);
+}
+
+TEST(Improvise, IsAPureFunctionOfTheSeed) {
+  const Fixture f = make_fixture();
+  const SourceTake source = f.source();
+  ImproviseOptions options = improv_options(0.5);
+  const Performance a = improvise(std::span(&source, 1), options).value();
+  const Performance b = improvise(std::span(&source, 1), options).value();
+  options.seed = 8;
+  const Performance c = improvise(std::span(&source, 1), options).value();
+  ASSERT_EQ(a.frame_count(), b.frame_count());
+  bool differs = false;
+  for (std::size_t k = 0; k < a.truth.size(); ++k) {
+    EXPECT_EQ(a.truth[k].template_frame, b.truth[k].template_frame);
+    if (k < c.truth.size() && a.truth[k].template_frame != c.truth[k].template_frame) {
+      differs = true;
+    }
+  }
+  EXPECT_TRUE(differs);
+}
+
+TEST(Improvise, DrawsFromSeveralTakesAndRejectsBadInput) {
+  const Fixture f = make_fixture(900);
+  auto skeleton = make_role_skeleton();
+  const Clip other = make_dance(skeleton, 60.0, 700);
+  const std::vector<SourceTake> sources = {f.source(), {5, &other, f.roles}};
+  ImproviseOptions options = improv_options(0.0);
+  options.duration_s = 120.0;
+  Result<Performance> made = improvise(sources, options);
+  ASSERT_TRUE(made);
+  bool saw[2] = {false, false};
+  for (const TruthFrame& t : made.value().truth) {
+    ASSERT_TRUE(t.take == 3 || t.take == 5);
+    saw[t.take == 5 ? 1 : 0] = true;
+    EXPECT_LE(t.template_frame, (t.take == 3 ? 899.0 : 699.0) + 1e-9);
+  }
+  EXPECT_TRUE(saw[0] && saw[1]);
+
+  EXPECT_FALSE(improvise({}, options));
+  const Clip slow = make_dance(skeleton, 30.0, 700);
+  const std::vector<SourceTake> mixed = {f.source(), {5, &slow, f.roles}};
+  Result<Performance> bad = improvise(mixed, options);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("frame rates"), std::string::npos);
+}
+
+TEST(Perturbations, SensorNoiseHasTheRequestedSizeAndKeepsTheTruth) {
+  const Fixture f = make_fixture(600);
+  const Performance clean = play(f.source(), {});
+  const Performance noisy = with_sensor_noise(clean, {3.0, 0.01, 11});
+  double angle_sq = 0.0, position_sq = 0.0;
+  long long n = 0;
+  for (int k = 0; k < clean.frame_count(); ++k) {
+    for (int j = 0; j < clean.motion.joint_count(); ++j) {
+      const auto i = static_cast<std::size_t>(j);
+      if (clean.motion.skeleton().joints[i].end_site) continue;
+      const double a =
+          clean.motion.rotations_ls(k)[i].angularDistance(noisy.motion.rotations_ls(k)[i]);
+      angle_sq += a * a;
+      ++n;
+      if (j > 0) {
+        EXPECT_EQ(clean.motion.translations_ls(k)[i], noisy.motion.translations_ls(k)[i]);
+      }
+    }
+    position_sq +=
+        (clean.motion.translations_ls(k)[0] - noisy.motion.translations_ls(k)[0]).squaredNorm();
+  }
+  EXPECT_NEAR(rad_to_deg(std::sqrt(angle_sq / static_cast<double>(n))), 3.0, 0.15);
+  EXPECT_NEAR(std::sqrt(position_sq / clean.frame_count() / 3.0), 0.01, 0.001);
+  for (std::size_t k = 0; k < clean.truth.size(); ++k) {
+    EXPECT_EQ(clean.truth[k].template_frame, noisy.truth[k].template_frame);
+  }
+}
+
+TEST(Perturbations, FrameLossDropsInBurstsAndDelaysTimestamps) {
+  const Fixture f = make_fixture(1800);
+  const SourceTake source = f.source();
+  const Performance full = improvise(std::span(&source, 1), improv_options(0.0)).value();
+  const Performance lossy = with_frame_loss(full, {0.10, 0.20, 1.5, 0.002, 3});
+  const double kept = static_cast<double>(lossy.frame_count()) / full.frame_count();
+  EXPECT_NEAR(kept, 0.90, 0.03);
+  int full_jumps = 0, lossy_jumps = 0;
+  for (const TruthFrame& t : full.truth) full_jumps += t.jump ? 1 : 0;
+  for (const TruthFrame& t : lossy.truth) lossy_jumps += t.jump ? 1 : 0;
+  EXPECT_EQ(full_jumps, lossy_jumps);  // a dropped jump frame passes its flag on
+  for (int k = 1; k < lossy.frame_count(); ++k) {
+    EXPECT_GT(lossy.times_s[static_cast<std::size_t>(k)],
+              lossy.times_s[static_cast<std::size_t>(k) - 1]);
+  }
+  // On the take at tempo 1 the capture time of a frame is its template frame / 60: timestamps
+  // are never early, at most 1.5 periods + jitter late, and some are late.
+  const Performance steady = with_frame_loss(play(source, {}), {0.10, 0.20, 1.5, 0.002, 3});
+  int late = 0;
+  for (int k = 0; k < steady.frame_count(); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    const double lateness = steady.times_s[i] - steady.truth[i].template_frame / 60.0;
+    EXPECT_GE(lateness, -1e-9);
+    EXPECT_LE(lateness, 1.5 / 60.0 + 0.002 + 1e-3);
+    late += lateness > 0.003 ? 1 : 0;
+  }
+  EXPECT_NEAR(static_cast<double>(late) / steady.frame_count(), 0.2 * (1.0 - 3.0 / 25.0), 0.05);
+  EXPECT_EQ(lossy.truth.size(), static_cast<std::size_t>(lossy.frame_count()));
+  EXPECT_EQ(lossy.times_s.size(), static_cast<std::size_t>(lossy.frame_count()));
+}
+
+TEST(Perturbations, BodyScaleAndRoomPlacementLeaveTheFeaturesThatShouldNotChange) {
+  const Fixture f = make_fixture(300);
+  const Performance clean = play(f.source(), {});
+  const Performance bigger = with_body_scale(clean, 1.15);
+  EXPECT_TRUE(bigger.motion.skeleton().joints[3].offset.isApprox(
+      1.15 * clean.motion.skeleton().joints[3].offset));
+  EXPECT_TRUE(
+      bigger.motion.translations_ls(10)[0].isApprox(1.15 * clean.motion.translations_ls(10)[0]));
+
+  // Another place and facing: the features (posture, velocities in the heading frame, speeds)
+  // are the same.
+  const Performance moved = with_room_placement(clean, deg_to_rad(135.0), Vec3(2.5, 0.0, -1.5));
+  EXPECT_GT((moved.motion.translations_ls(10)[0] - clean.motion.translations_ls(10)[0]).norm(),
+            1.0);
+  Result<FeatureExtractor> extractor =
+      FeatureExtractor::create(clean.motion.skeleton_ptr(), f.roles, FeatureSpec{});
+  ASSERT_TRUE(extractor);
+  const FeatureMatrix a = extractor.value().extract_clip(clean.motion);
+  const FeatureMatrix b = extractor.value().extract_clip(moved.motion);
+  EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-3f);
+}
+
+TEST(MakePerformance, ComposesImprovisationNoiseAndALowRate) {
+  const Fixture f = make_fixture(1800);
+  const SourceTake source = f.source();
+  PerformanceRecipe recipe;
+  recipe.improvise = true;
+  recipe.improvise_options = improv_options(1.0);
+  recipe.improvise_options.rate_hz = 30.0;
+  recipe.noise = {3.0, 0.01, 0};
+  recipe.loss = {0.1, 0.2, 1.5, 0.002, 0};
+  Result<Performance> p = make_performance(std::span(&source, 1), recipe, 42);
+  ASSERT_TRUE(p) << p.error().message;
+  EXPECT_DOUBLE_EQ(p.value().motion.frame_rate(), 30.0);
+  EXPECT_NEAR(p.value().frame_count(), 40 * 30 * 0.9, 40 * 30 * 0.05);
+  int jumps = 0, pauses = 0;
+  for (const TruthFrame& t : p.value().truth) {
+    jumps += t.jump ? 1 : 0;
+    pauses += t.in_pause ? 1 : 0;
+  }
+  EXPECT_GT(jumps, 3);
+  EXPECT_GT(pauses, 0);
+  Result<Performance> again = make_performance(std::span(&source, 1), recipe, 42);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again.value().times_s, p.value().times_s);
+}
+
+TEST(Improvise, RealTakeKeepsTheRootPathContinuous) {
+  MotionLoadOptions load;
+  load.frame_rate = 60.0;
+  Result<LoadedMotion> take =
+      load_motion({std::string(DUET_DATA_DIR) + "/cmu-salsa/bvh/60/60_10_scaled.bvh"}, load);
+  ASSERT_TRUE(take) << take.error().message;
+  const SourceTake source{0, &take.value().clip, take.value().roles};
+  double max_step = 0.0, max_turn = 0.0;
+  take_steps(take.value().clip, max_step, max_turn);
+  for (const double pause : {0.0, 1.0}) {
+    const Performance p = improvise(std::span(&source, 1), improv_options(pause)).value();
+    for (int k = 1; k < p.frame_count(); ++k) {
+      Vec3 step = p.motion.translations_ls(k)[0] - p.motion.translations_ls(k - 1)[0];
+      step.y() = 0.0;
+      EXPECT_LE(step.norm(), 1.05 * max_step + 0.002) << "frame " << k;
+      if (!p.truth[static_cast<std::size_t>(k)].in_pause) {
+        expect_same_pose_up_to_rigid(p, take.value().clip, k);
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace duet

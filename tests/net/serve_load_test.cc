@@ -1,0 +1,93 @@
+// Load: 8 viewers on a 120 Hz source. The server measures, per frame and per viewer, the time from
+// the frame's arrival to the end of its WebSocket write, and reports percentiles in `stats`.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <mutex>
+
+#include "serve_support.h"
+
+namespace duet::test {
+namespace {
+
+TEST(ServeLoad, EightViewersAt120Hz) {
+  TempDir dir("duet-serve-load-test");
+  ServeProcess server;
+  // The 60 Hz take replayed at twice its speed: a 120 Hz stream.
+  std::vector<std::string> args = {"--pair",
+                                   salsa("60", "03"),
+                                   salsa("61", "03"),
+                                   "--fps",
+                                   "60",
+                                   "--source",
+                                   "replay:" + salsa("60", "03") + "?speed=2&loop=1",
+                                   "--record",
+                                   (dir.path / "recordings").string(),
+                                   "--log-interval",
+                                   "2"};
+  // For measurements: DUET_SERVE_PRIORITY=normal runs the loop without real-time scheduling.
+  if (const char* priority = std::getenv("DUET_SERVE_PRIORITY")) {
+    args.insert(args.end(), {"--priority", priority});
+  }
+  ASSERT_TRUE(server.start(args, dir.path / "serve.log")) << server.log();
+
+  constexpr int kViewers = 8;
+  constexpr auto kDuration = 6s;
+  std::vector<std::unique_ptr<WsClient>> viewers;
+  for (int k = 0; k < kViewers; ++k) {
+    viewers.push_back(std::make_unique<WsClient>());
+    ASSERT_TRUE(viewers.back()->connect(server.port())) << server.log();
+  }
+  std::vector<long long> frames(kViewers, 0);
+  std::vector<Json> stats;  // every stats message viewer 0 received
+  std::mutex mutex;
+  const auto end = std::chrono::steady_clock::now() + kDuration;
+  std::vector<std::thread> threads;
+  for (int k = 0; k < kViewers; ++k) {
+    threads.emplace_back([&, k] {
+      while (std::chrono::steady_clock::now() < end) {
+        std::optional<std::string> text = viewers[static_cast<std::size_t>(k)]->read_text(2s);
+        if (!text) return;
+        if (text->starts_with("{\"type\":\"frame\"")) {
+          ++frames[static_cast<std::size_t>(k)];
+        } else if (k == 0 && text->find("\"type\":\"stats\"") != std::string::npos) {
+          std::lock_guard lock(mutex);
+          stats.push_back(Json::parse(*text));
+        }
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  ASSERT_EQ(server.stop(SIGTERM), 0) << server.log();
+
+  ASSERT_GE(stats.size(), 4u) << server.log();
+  std::printf("per-second windows, arrival -> sent (us), %d viewers at 120 Hz:\n", kViewers);
+  for (const Json& s : stats) {
+    std::printf("  rate %5.1f Hz  clients %d  p50 %5lld  p99 %5lld  max %6lld  (n=%lld)\n",
+                s["rate_hz"].get<double>(), s["clients"].get<int>(),
+                s["latency_us"]["p50"].get<long long>(), s["latency_us"]["p99"].get<long long>(),
+                s["latency_us"]["max"].get<long long>(), s["latency_us"]["count"].get<long long>());
+  }
+  const Json& total = stats.back()["latency_total_us"];
+  const Json& loop = stats.back()["loop_us"];
+  std::printf(
+      "since start: p50 %lld us, p99 %lld us, max %lld us over %lld sends; "
+      "arrival -> built (last second): p50 %lld us, p99 %lld us\n",
+      total["p50"].get<long long>(), total["p99"].get<long long>(), total["max"].get<long long>(),
+      total["count"].get<long long>(), loop["p50"].get<long long>(), loop["p99"].get<long long>());
+  for (int k = 0; k < kViewers; ++k) {
+    std::printf("viewer %d: %lld frames\n", k, frames[static_cast<std::size_t>(k)]);
+  }
+  std::fflush(stdout);
+
+  EXPECT_GT(stats.back()["rate_hz"].get<double>(), 100.0);
+  EXPECT_EQ(stats.back()["clients"].get<int>(), kViewers);
+  // Every viewer was served (slow ones may see gaps, never a stall).
+  for (long long f : frames) EXPECT_GT(f, 120 * 6 / 2);
+  EXPECT_GT(total["count"].get<long long>(), 120 * 4 * kViewers);
+  EXPECT_LT(total["p99"].get<long long>(), 2000) << server.log();
+}
+
+}  // namespace
+}  // namespace duet::test
