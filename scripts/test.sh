@@ -14,7 +14,7 @@ ctest --test-dir build --output-on-failure -j"$jobs"
 
 echo "== Sanitizer build (ASan + UBSan) and tests" >&2
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DDUET_SANITIZE=ON \
-  -DDUET_BUILD_BENCHMARKS=OFF -DDUET_DATA_DIR="$data_dir" >/dev/null
+  -DDUET_BUILD_BENCHMARKS=OFF -DDUET_BROWSER_TESTS=OFF -DDUET_DATA_DIR="$data_dir" >/dev/null
 cmake --build build-asan -j"$jobs"
 ctest --test-dir build-asan --output-on-failure -j"$jobs"
 
