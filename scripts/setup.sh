@@ -8,4 +8,10 @@ data_dir=$(scripts/get-data.sh "${1:-}")
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DDUET_DATA_DIR="$data_dir" >/dev/null
 cmake --build build -j"$(nproc)"
 echo "== duet is built: build/apps/duet/duet" >&2
+if command -v npm >/dev/null; then
+  (cd web && npm ci --no-audit --no-fund --prefer-offline >/dev/null && npm run build >/dev/null) &&
+    echo "== the viewer is built: web/dist (served by duet serve)" >&2
+else
+  echo "== npm not found: the browser viewer (web/) is not built" >&2
+fi
 scripts/demo.sh "$data_dir"
