@@ -27,6 +27,10 @@ namespace duet {
 
 namespace {
 
+using io_internal::ascii_lower;
+using io_internal::equals_ignore_case;
+using io_internal::quoted;
+
 // kPi / 180 as one factor: deg * kPi / 180 would overflow for |deg| > 5.7e307.
 constexpr double kDegToRad = kPi / 180.0;
 constexpr double kMetresPerInch = 0.0254;
@@ -42,36 +46,6 @@ constexpr long long kJointFrameAllowance = 1 << 18;
 
 inline bool is_space(char c) {
   return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
-}
-
-inline char ascii_lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c + 32) : c; }
-
-bool equals_ignore_case(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (ascii_lower(a[i]) != ascii_lower(b[i])) return false;
-  }
-  return true;
-}
-
-// A token quoted for an error message: at most 40 bytes, non-printable bytes as \xNN.
-std::string quoted(std::string_view token) {
-  std::string out = "'";
-  const std::size_t n = std::min<std::size_t>(token.size(), 40);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto c = static_cast<unsigned char>(token[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      static constexpr char kHex[] = "0123456789abcdef";
-      out += "\\x";
-      out += kHex[c >> 4];
-      out += kHex[c & 15];
-    }
-  }
-  if (token.size() > n) out += "...";
-  out += "'";
-  return out;
 }
 
 // Splits text into lines (LF or CRLF; a stray CR counts as white space) and each line into

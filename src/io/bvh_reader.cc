@@ -22,6 +22,10 @@ namespace duet {
 
 namespace {
 
+using io_internal::ascii_lower;
+using io_internal::equals_ignore_case;
+using io_internal::quoted;
+
 // kPi / 180 as one factor: deg * kPi / 180 would overflow for |deg| > 5.7e307.
 constexpr double kDegToRad = kPi / 180.0;
 
@@ -36,39 +40,13 @@ inline bool is_space(char c) {
 }
 inline bool is_brace(char c) { return c == '{' || c == '}'; }
 
-inline char ascii_lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c + 32) : c; }
-
-bool equals_ignore_case(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (ascii_lower(a[i]) != ascii_lower(b[i])) return false;
-  }
-  return true;
-}
-
 bool starts_with_ignore_case(std::string_view text, std::string_view prefix) {
   return text.size() >= prefix.size() && equals_ignore_case(text.substr(0, prefix.size()), prefix);
 }
 
-// A token quoted for an error message: at most 40 bytes, non-printable bytes as \xNN.
-std::string quoted(std::string_view token) {
-  if (token.empty()) return "end of file";
-  std::string out = "'";
-  const std::size_t n = std::min<std::size_t>(token.size(), 40);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto c = static_cast<unsigned char>(token[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      static constexpr char kHex[] = "0123456789abcdef";
-      out += "\\x";
-      out += kHex[c >> 4];
-      out += kHex[c & 15];
-    }
-  }
-  if (token.size() > n) out += "...";
-  out += "'";
-  return out;
+// A token for an error message; the empty token is the end of the file.
+std::string quoted_or_end(std::string_view token) {
+  return token.empty() ? "end of file" : quoted(token);
 }
 
 enum class NumberStatus { kOk, kNotANumber, kNotFinite };
@@ -106,7 +84,7 @@ inline bool ends_line(std::string_view text, std::size_t pos) {
 
 // For a token that had to be on the current line: an empty one means the line ended.
 std::string quoted_on_line(std::string_view token) {
-  return token.empty() ? std::string("nothing") : quoted(token);
+  return token.empty() ? std::string("nothing") : quoted_or_end(token);
 }
 
 struct Token {
@@ -267,7 +245,7 @@ std::optional<Error> BvhParser::expect(std::string_view keyword, const std::stri
   const Token token = scanner_.next();
   if (!equals_ignore_case(token.text, keyword)) {
     return error(token.line, "expected '" + std::string(keyword) + "' " + context + ", found " +
-                                 quoted(token.text));
+                                 quoted_or_end(token.text));
   }
   return std::nullopt;
 }
@@ -288,8 +266,8 @@ std::optional<Error> BvhParser::add_joint(Joint joint, int line, const std::stri
 std::optional<Error> BvhParser::parse_offset(Joint& joint) {
   const Token keyword = scanner_.next();
   if (!equals_ignore_case(keyword.text, "OFFSET")) {
-    return error(keyword.line,
-                 "expected 'OFFSET' in joint '" + joint.name + "', found " + quoted(keyword.text));
+    return error(keyword.line, "expected 'OFFSET' in joint '" + joint.name + "', found " +
+                                   quoted_or_end(keyword.text));
   }
   for (int axis = 0; axis < 3; ++axis) {
     const Token token = scanner_.next();
@@ -297,12 +275,12 @@ std::optional<Error> BvhParser::parse_offset(Joint& joint) {
     const NumberStatus status = parse_number(token.text, value);
     if (status == NumberStatus::kNotANumber) {
       return error(token.line, "OFFSET of joint '" + joint.name + "' needs 3 numbers, found " +
-                                   quoted(token.text));
+                                   quoted_or_end(token.text));
     }
     value *= options_.scale;
     if (status == NumberStatus::kNotFinite || !std::isfinite(value)) {
       return error(token.line, "OFFSET of joint '" + joint.name + "' has a non-finite value " +
-                                   quoted(token.text));
+                                   quoted_or_end(token.text));
     }
     joint.offset[axis] = value;
   }
@@ -314,7 +292,7 @@ std::optional<Error> BvhParser::parse_channels(Joint& joint, const Token& joint_
   if (!equals_ignore_case(keyword.text, "CHANNELS")) {
     return error(keyword.line, "expected 'CHANNELS' after the OFFSET of " +
                                    std::string(joint_keyword.text) + " '" + joint.name +
-                                   "', found " + quoted(keyword.text));
+                                   "', found " + quoted_or_end(keyword.text));
   }
   const Token count_token = scanner_.next_on_line();
   int count = -1;
@@ -345,7 +323,7 @@ std::optional<Error> BvhParser::parse_channels(Joint& joint, const Token& joint_
       }
     }
     if (!channel) {
-      return error(name.line, "unknown channel name " + quoted(name.text) + " in joint '" +
+      return error(name.line, "unknown channel name " + quoted_or_end(name.text) + " in joint '" +
                                   joint.name + "' (expected Xposition, Yposition, Zposition, " +
                                   "Xrotation, Yrotation or Zrotation)");
     }
@@ -396,7 +374,7 @@ std::optional<Error> BvhParser::parse_joint_head(const Token& keyword, int paren
   if (brace.at_end()) brace = scanner_.next();
   if (brace.text != "{") {
     return error(brace.line, "expected '{' after " + std::string(keyword.text) + " " + joint.name +
-                                 ", found " + quoted(brace.text));
+                                 ", found " + quoted_or_end(brace.text));
   }
   if (auto e = parse_offset(joint)) return e;
   if (auto e = parse_channels(joint, keyword)) return e;
@@ -406,7 +384,8 @@ std::optional<Error> BvhParser::parse_joint_head(const Token& keyword, int paren
 std::optional<Error> BvhParser::parse_end_site(const Token& keyword, int parent) {
   const Token site = scanner_.next_on_line();
   if (!equals_ignore_case(site.text, "Site")) {
-    return error(keyword.line, "expected 'End Site', found 'End' followed by " + quoted(site.text));
+    return error(keyword.line,
+                 "expected 'End Site', found 'End' followed by " + quoted_or_end(site.text));
   }
   const std::string& parent_name = skeleton_->joints[static_cast<std::size_t>(parent)].name;
   const int nth = ++end_site_counts_[static_cast<std::size_t>(parent)];
@@ -420,7 +399,7 @@ std::optional<Error> BvhParser::parse_end_site(const Token& keyword, int parent)
   if (close.text != "}") {
     return error(close.line, "expected '}' to close the End Site of '" + parent_name +
                                  "' (an End Site holds only an OFFSET), found " +
-                                 quoted(close.text));
+                                 quoted_or_end(close.text));
   }
   return add_joint(std::move(joint), keyword.line, " (End Site of '" + parent_name + "')");
 }
@@ -437,12 +416,12 @@ std::optional<Error> BvhParser::parse_hierarchy() {
   }
   const Token first = scanner_.next();
   if (!equals_ignore_case(first.text, "HIERARCHY")) {
-    return error(first.line,
-                 "expected 'HIERARCHY' at the start of a BVH file, found " + quoted(first.text));
+    return error(first.line, "expected 'HIERARCHY' at the start of a BVH file, found " +
+                                 quoted_or_end(first.text));
   }
   const Token root = scanner_.next();
   if (!equals_ignore_case(root.text, "ROOT")) {
-    return error(root.line, "expected 'ROOT' after HIERARCHY, found " + quoted(root.text));
+    return error(root.line, "expected 'ROOT' after HIERARCHY, found " + quoted_or_end(root.text));
   }
   if (auto e = parse_joint_head(root, -1)) return e;
 
@@ -462,10 +441,10 @@ std::optional<Error> BvhParser::parse_hierarchy() {
     } else if (token.at_end() || equals_ignore_case(token.text, "MOTION")) {
       return error(token.line, "unbalanced braces: joint '" + name + "' (opened at line " +
                                    std::to_string(joint_lines_[static_cast<std::size_t>(current)]) +
-                                   ") is not closed with '}' before " + quoted(token.text));
+                                   ") is not closed with '}' before " + quoted_or_end(token.text));
     } else {
       return error(token.line, "expected JOINT, End Site or '}' in joint '" + name + "', found " +
-                                   quoted(token.text));
+                                   quoted_or_end(token.text));
     }
   }
   const Token motion = scanner_.next();
@@ -478,7 +457,7 @@ std::optional<Error> BvhParser::parse_hierarchy() {
   if (!equals_ignore_case(motion.text, "MOTION")) {
     return error(motion.line, motion.at_end() ? "missing MOTION section after the hierarchy"
                                               : "expected 'MOTION' after the hierarchy, found " +
-                                                    quoted(motion.text));
+                                                    quoted_or_end(motion.text));
   }
   const std::string problem = skeleton_->validate();
   if (!problem.empty()) return error(motion.line, problem);
@@ -492,14 +471,14 @@ std::optional<Error> BvhParser::read_header_value(std::string_view keyword, Toke
   std::string_view rest;
   if (keyword == "Frame Time:") {
     if (!equals_ignore_case(token.text, "Frame")) {
-      return error(line, "expected 'Frame Time:' after Frames, found " + quoted(token.text));
+      return error(line, "expected 'Frame Time:' after Frames, found " + quoted_or_end(token.text));
     }
     token = scanner_.next_on_line();
     keyword = "Time:";
   }
   if (!starts_with_ignore_case(token.text, keyword)) {
     return error(line, "expected '" + std::string(keyword == "Time:" ? "Frame Time:" : keyword) +
-                           "', found " + quoted(token.text));
+                           "', found " + quoted_or_end(token.text));
   }
   rest = token.text.substr(keyword.size());
   value = rest.empty() ? scanner_.next_on_line() : Token{rest, token.line};
@@ -571,9 +550,10 @@ Error BvhParser::value_count_error(std::size_t motion_begin, int motion_line, lo
                      std::to_string(channels) + "; the motion data has " + std::to_string(total) +
                      " values, " + std::to_string(total - expected) + " more than " + declared);
   }
-  return error(extra_line, "extra value " + quoted(extra_token) + " after the last frame: the " +
-                               "motion data has " + std::to_string(total) + " values (" +
-                               std::to_string(full_lines) + " frames), but " + declared);
+  return error(extra_line, "extra value " + quoted_or_end(extra_token) +
+                               " after the last frame: the " + "motion data has " +
+                               std::to_string(total) + " values (" + std::to_string(full_lines) +
+                               " frames), but " + declared);
 }
 
 Result<Clip> BvhParser::parse_motion() {
@@ -705,10 +685,11 @@ Result<Clip> BvhParser::parse_motion() {
       const std::string_view token = token_at(p);
       const NumberStatus status = parse_number(token, v);
       if (status == NumberStatus::kNotANumber) {
-        return error(line, "expected a number in " + describe(f, k) + ", found " + quoted(token));
+        return error(line,
+                     "expected a number in " + describe(f, k) + ", found " + quoted_or_end(token));
       }
       if (status == NumberStatus::kNotFinite) {
-        return error(line, "non-finite value " + quoted(token) + " in " + describe(f, k));
+        return error(line, "non-finite value " + quoted_or_end(token) + " in " + describe(f, k));
       }
       values[k] = v;
       p += token.size();

@@ -1,5 +1,6 @@
 #include "io/text_file.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -40,6 +41,33 @@ Result<std::string> read_text_file(const std::string& path) {
   std::fclose(file);
   if (failed) return make_error(path, 0, "cannot read: " + errno_text(error));
   return text;
+}
+
+bool equals_ignore_case(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (ascii_lower(a[i]) != ascii_lower(b[i])) return false;
+  }
+  return true;
+}
+
+std::string quoted(std::string_view token) {
+  std::string out = "'";
+  const std::size_t n = std::min<std::size_t>(token.size(), 40);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(token[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      static constexpr char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  if (token.size() > n) out += "...";
+  out += "'";
+  return out;
 }
 
 }  // namespace duet::io_internal
