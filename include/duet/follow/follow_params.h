@@ -33,19 +33,22 @@ struct FollowParams {
   // Emission (eq. 7): b_i(phi) = exp(-||phi - phi_i||^2 / (2 sigma^2)), in the units of the
   // standardised, weighted features. sigma sets how much one frame's evidence weighs against the
   // band's prior: too large and the estimate lags behind tempo changes (the prior wins), too small
-  // and noise makes it jitter and jump. 0.7 is of the order of the per-dimension residual expected
-  // between two dancers (0.3-0.5 standardised units) and, on synthetic walks whose neighbouring
-  // frames are 0.45 apart (squared, D = 60), tracks 0.7x-1.5x replays within one frame.
-  float emission_sigma = 0.7f;
+  // and noise makes it jitter and jump. Chosen by `duet eval` on the 14 salsa duets
+  // (docs/evaluation.md): with the features' block scaling two random template frames are about
+  // 2.5 apart (squared) and frames 0.1 s apart about 0.25, so 0.7 let the prior win (78.6% within
+  // 100 ms at 1.4x tempo) while 0.15 gives >= 97.5% in every case.
+  float emission_sigma = 0.15f;
 
   // The pause state's emission is flat: the likelihood of a template frame at this mean squared
   // distance per dimension, i.e. b_N = exp(-pause_distance_per_dim * D / (2 sigma^2)). The pause
-  // state (and through it the jump) wins when every reachable frame is farther than that.
-  float pause_distance_per_dim = 0.5f;
+  // state (and through it the jump) wins when every reachable frame is farther than that. Keep
+  // pause_distance_per_dim * D / (2 sigma^2) near 25 when changing sigma: larger and the pause
+  // state's mass rounds to zero, so no jump is ever taken.
+  float pause_distance_per_dim = 0.02f;
 
   // Lost: no template frame is within this mean squared distance per dimension of the input, or
   // the pause state holds most of the posterior mass.
-  float lost_distance_per_dim = 1.0f;
+  float lost_distance_per_dim = 0.05f;
 
   // Confidence: posterior mass within +/- this many template frames of the estimate (same take).
   int confidence_window_frames = 6;
