@@ -295,7 +295,8 @@ Command register_eval(CLI::App& app) {
                    "Length of the improvised performances in s (default: the take's length)")
       ->check(CLI::NonNegativeNumber);
 
-  auto* tuning = app.add_option_group("follower tuning (the hmm tracker; see FollowParams)");
+  auto* tuning = app.add_option_group(
+      "tuning (FollowParams of the hmm trackers; FeatureSpec weights feed every tracker)");
   tuning->add_option("--sigma", args->sigma, "Emission sigma (all HMM variants)")
       ->check(CLI::PositiveNumber);
   tuning->add_option("--self", args->self_prob, "self_prob")->check(CLI::Range(0.0, 1.0));

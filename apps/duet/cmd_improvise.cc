@@ -70,6 +70,9 @@ int run_improvise(const ImproviseArgs& args) {
   if (args.drift.size() == 2 && !(args.drift[0] > 0.0 && args.drift[1] > args.drift[0])) {
     return usage_error("--drift LOW HIGH needs 0 < LOW < HIGH");
   }
+  if (args.segment_min_s > args.segment_max_s) {
+    return usage_error("--segment-min must not exceed --segment-max");
+  }
   if (args.mode == "play" && args.across_takes) {
     return usage_error("--across-takes needs --mode improv");
   }
