@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "duet/io/asf_amc.h"
 #include "duet/io/bvh.h"
 #include "duet/motion/forward_kinematics.h"
 
@@ -76,6 +77,23 @@ void BM_ReadBvhFromFile(benchmark::State& state) {
   per_frame_counters(state, frames);
 }
 BENCHMARK(BM_ReadBvhFromFile)->Unit(benchmark::kMillisecond);
+
+// The CMU original of the same take: 60.asf + 60_01.amc (1.8 MB).
+void BM_ReadAsfAmcFromFile(benchmark::State& state) {
+  const std::string dir = std::string(DUET_DATA_DIR) + "/cmu-salsa/asf-amc/";
+  int frames = 0;
+  for (auto _ : state) {
+    duet::Result<duet::Clip> clip = duet::read_asf_amc(dir + "60.asf", dir + "60_01.amc");
+    if (!clip) {
+      state.SkipWithError(clip.error().message.c_str());
+      return;
+    }
+    frames = clip.value().frame_count();
+    benchmark::DoNotOptimize(clip);
+  }
+  per_frame_counters(state, frames);
+}
+BENCHMARK(BM_ReadAsfAmcFromFile)->Unit(benchmark::kMillisecond);
 
 void BM_FormatBvh(benchmark::State& state) {
   duet::Clip clip;

@@ -86,7 +86,10 @@ TEST(ServeLoad, EightViewersAt120Hz) {
   // Every viewer was served (slow ones may see gaps, never a stall).
   for (long long f : frames) EXPECT_GT(f, 120 * 6 / 2);
   EXPECT_GT(total["count"].get<long long>(), 120 * 4 * kViewers);
+#ifndef DUET_SANITIZED
+  // The latency bound is for optimised builds; the sanitizer build checks delivery only.
   EXPECT_LT(total["p99"].get<long long>(), 2000) << server.log();
+#endif
 }
 
 }  // namespace
