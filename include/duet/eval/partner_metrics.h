@@ -1,0 +1,168 @@
+// Partner metrics (method.md 7, of the synthesis of method.md 5): the synthesized partner against
+// the true response, i.e. what the partner would have been had the follower known the true
+// template frame of every input frame. Exact definitions in docs/evaluation.md, "Partner metrics".
+//
+//   joint error   mean over joints of |synthesized - true response| world positions, where the
+//                 true response is the response clip sampled at the TRUE template frame and placed
+//                 by the same alignment (5.1) relative to the user's current root: compared in the
+//                 user's frame;
+//   hand error    at frames whose true template frame has a hand contact (5.2), per contacting
+//                 pair: | output wrist-to-user-wrist distance - captured wrist-to-wrist distance |;
+//   foot slip     frames in which a toe near its ground height (FootLockParams margin, the
+//                 PartnerModel's ground heights) moves horizontally faster than the foot lock's
+//                 speed threshold (5.3); also for the captured response over its own takes;
+//   jump speed    the largest local joint angular speed in the window after each true jump,
+//                 against the captured response's 99th percentile (5.3 blending).
+//
+// Offline code: allocates freely (it is not on the live path; the synthesis it measures is).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "duet/eval/performance.h"
+#include "duet/motion/clip.h"
+#include "duet/motion/skeleton_map.h"
+#include "duet/partner/partner_synthesis.h"
+
+namespace duet {
+
+struct PartnerMetricsOptions {
+  // Foot slip uses height_margin_m and speed_threshold_mps, the foot lock's own thresholds.
+  FootLockParams foot;
+  double post_jump_window_s = 0.5;  // frames with t_jump <= t < t_jump + window follow a jump
+  double reference_percentile = 0.99;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Per-frame geometry
+
+// Mean over joints of the distance between two sets of world positions (same size, > 0), metres.
+double mean_joint_distance_m(std::span<const Vec3> a, std::span<const Vec3> b);
+
+// Angle of the rotation from `previous` to `current` divided by dt (radians per second); 0 when
+// dt <= 0 or not finite. The shorter way round (q and -q are the same rotation).
+double angular_speed_rad_s(const Quat& previous, const Quat& current, double dt_s);
+
+// Largest angular speed over the skeleton's animated joints (End Sites are never rotated).
+double max_joint_angular_speed_rad_s(const Skeleton& skeleton, std::span<const Quat> previous_ls,
+                                     std::span<const Quat> current_ls, double dt_s);
+
+// A toe near the ground that slides: both positions within margin of the ground height and the
+// horizontal (x, z) speed between them above the threshold.
+bool foot_slips(const Vec3& previous_ws, const Vec3& current_ws, double ground_height_m,
+                double dt_s, const FootLockParams& thresholds);
+
+// The captured duet of one take, sampled at a real template frame (Clip::sample: translations
+// lerped, rotations slerped). Sized once; compute() reuses its buffers.
+class CapturedDuetSampler {
+ public:
+  // template_clip / response_clip: the take's two clips (same frame count and rate); model: the
+  // PartnerModel of that take (alignment and contacts). All must outlive the sampler.
+  CapturedDuetSampler(const Clip& template_clip, const JointRoles& template_roles,
+                      const Clip& response_clip, const PartnerModel& model);
+
+  // Samples both dancers at `template_frame` (clamped to the take) in the capture's world frame,
+  // and places the response like the synthesis's alignment does: root = heading frame of the
+  // user's root times the placement (interpolated between the two nearest frames).
+  void compute(double template_frame, const Vec3& user_root_position_ws,
+               const Quat& user_root_rotation_ws);
+
+  // The true response, placed relative to the user (world positions and local rotations).
+  std::span<const Vec3> placed_positions_ws() const { return placed_positions_; }
+  std::span<const Quat> placed_rotations_ls() const { return placed_pose_.rotations_ls; }
+  // Captured distance between the template's and the response's wrists of a hand pair (capture
+  // frame, metres).
+  double captured_wrist_distance_m(int pair) const;
+  // Contacts at the nearest integer frame (bit = hand pair).
+  std::uint8_t contact_mask() const { return mask_; }
+
+ private:
+  const Clip* template_clip_;
+  JointRoles template_roles_;
+  const Clip* response_clip_;
+  const PartnerModel* model_;
+  Pose template_pose_, response_pose_, placed_pose_;
+  std::vector<Vec3> template_positions_, response_positions_, placed_positions_;
+  std::vector<Quat> rotations_scratch_;
+  std::uint8_t mask_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// One synthesized partner over one performance
+
+// What the metrics keep of one frame of the synthesis.
+struct PartnerFrameRecord {
+  double joint_error_m = 0.0;
+  // Hand error per pair, only for pairs in contact at the true template frame.
+  std::array<double, kHandPairCount> hand_error_m{};
+  std::uint8_t hand_pairs = 0;   // bit p: hand_error_m[p] is set
+  bool slip = false;             // a foot slipped since the previous frame (false on frame 0)
+  double max_angular_speed_rad_s = 0.0;  // since the previous frame (0 on frame 0)
+  double step_us = 0.0;          // wall-clock time of the loop step that made it
+};
+
+// The captured response of the takes a performance was made from, at the take's own rate: the
+// references for foot slip and angular speed.
+struct CapturedReference {
+  long long slip_frames = 0;  // frames (from the second) in which a foot slipped
+  long long frames = 0;       // frames from the second
+  std::vector<double> angular_speeds_rad_s;  // every animated joint, every frame from the second
+  // Non-overlapping windows of post_jump_window_s over the take: how often the captured motion
+  // itself exceeds its percentile inside such a window (context for the jump metric).
+  long long windows = 0;
+  std::vector<double> window_max_rad_s;
+};
+// Adds one take's response clip (roles: its joint roles; ground: the PartnerModel's heights).
+void add_captured_reference(const Clip& response, const JointRoles& roles,
+                            const std::array<double, 2>& ground_heights,
+                            const PartnerMetricsOptions& options, CapturedReference& reference);
+
+// The summary of one or more synthesized performances (one configuration of the corrections).
+struct PartnerMetrics {
+  long long frames = 0;
+  double mean_joint_error_cm = 0.0;
+  long long hand_samples = 0;  // (frame, contacting pair) samples
+  double median_hand_error_cm = 0.0;
+  double mean_hand_error_cm = 0.0;
+  double slip_rate = 0.0;  // slipping frames / frames from the second
+  long long jumps = 0;     // true jumps whose window holds at least one frame after the first
+  double max_jump_speed_deg_s = 0.0;     // largest over every jump window
+  double median_jump_speed_deg_s = 0.0;  // median over jumps of each window's largest
+  long long jumps_over_reference = 0;    // windows whose largest exceeds the reference
+  double mean_step_us = 0.0;
+  // The captured response's own numbers over the same takes.
+  double captured_slip_rate = 0.0;
+  double reference_speed_deg_s = 0.0;  // its reference_percentile angular speed
+  double captured_windows_over_reference = 0.0;  // fraction of its windows over that
+};
+
+// Pools the records of performances (frames and jumps weigh equally across performances) and
+// the captured references of their takes.
+class PartnerMetricsAccumulator {
+ public:
+  explicit PartnerMetricsAccumulator(PartnerMetricsOptions options = {}) : options_(options) {}
+
+  // records: one per frame of `performance` (times and truth come from it).
+  void add(const Performance& performance, std::span<const PartnerFrameRecord> records);
+  void add_reference(const CapturedReference& reference);
+  void merge(const PartnerMetricsAccumulator& other);
+
+  PartnerMetrics summary() const;
+  const PartnerMetricsOptions& options() const { return options_; }
+
+ private:
+  PartnerMetricsOptions options_;
+  long long frames_ = 0, slip_frames_ = 0, slip_pairs_ = 0;
+  double joint_error_sum_m_ = 0.0, step_us_sum_ = 0.0;
+  std::vector<double> hand_errors_m_;
+  std::vector<double> jump_max_rad_s_;  // one per jump window
+  CapturedReference reference_;
+};
+
+// The value at quantile q in [0, 1] of `values` (nearest rank on the sorted copy; 0 when empty).
+double quantile(std::vector<double> values, double q);
+
+}  // namespace duet

@@ -1,0 +1,283 @@
+#include "duet/eval/partner_metrics.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "duet/math/rotation.h"
+#include "duet/motion/forward_kinematics.h"
+
+namespace duet {
+
+namespace {
+
+constexpr std::array<Role, 2> kWrists = {Role::kLeftWrist, Role::kRightWrist};
+constexpr std::array<Role, 2> kToes = {Role::kLeftToe, Role::kRightToe};
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::ranges::sort(values);
+  const std::size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+bool valid_dt(double dt_s) { return dt_s > 0.0 && std::isfinite(dt_s); }
+
+}  // namespace
+
+double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::ranges::sort(values);
+  const double rank = std::ceil(std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size()));
+  const auto k = static_cast<std::size_t>(std::max(rank, 1.0)) - 1;
+  return values[std::min(k, values.size() - 1)];
+}
+
+double mean_joint_distance_m(std::span<const Vec3> a, std::span<const Vec3> b) {
+  assert(a.size() == b.size() && !a.empty());
+  const std::size_t n = std::min(a.size(), b.size());
+  if (n == 0) return 0.0;
+  double sum = 0.0;
+  for (std::size_t j = 0; j < n; ++j) sum += (a[j] - b[j]).norm();
+  return sum / static_cast<double>(n);
+}
+
+double angular_speed_rad_s(const Quat& previous, const Quat& current, double dt_s) {
+  if (!valid_dt(dt_s)) return 0.0;
+  // |dot| of unit quaternions is cos(angle / 2); the abs takes the shorter way round.
+  const double dot = std::abs(previous.normalized().dot(current.normalized()));
+  return 2.0 * std::acos(std::min(dot, 1.0)) / dt_s;
+}
+
+double max_joint_angular_speed_rad_s(const Skeleton& skeleton, std::span<const Quat> previous_ls,
+                                     std::span<const Quat> current_ls, double dt_s) {
+  double largest = 0.0;
+  const std::size_t n =
+      std::min({previous_ls.size(), current_ls.size(), skeleton.joints.size()});
+  for (std::size_t j = 0; j < n; ++j) {
+    if (skeleton.joints[j].end_site) continue;
+    largest = std::max(largest, angular_speed_rad_s(previous_ls[j], current_ls[j], dt_s));
+  }
+  return largest;
+}
+
+bool foot_slips(const Vec3& previous_ws, const Vec3& current_ws, double ground_height_m,
+                double dt_s, const FootLockParams& thresholds) {
+  if (!valid_dt(dt_s)) return false;
+  const double margin = thresholds.height_margin_m;
+  if (!(previous_ws.y() - ground_height_m <= margin && current_ws.y() - ground_height_m <= margin)) {
+    return false;
+  }
+  const double dx = current_ws.x() - previous_ws.x(), dz = current_ws.z() - previous_ws.z();
+  return std::sqrt(dx * dx + dz * dz) / dt_s > thresholds.speed_threshold_mps;
+}
+
+// ---------------------------------------------------------------------------------------------
+// CapturedDuetSampler
+
+CapturedDuetSampler::CapturedDuetSampler(const Clip& template_clip,
+                                         const JointRoles& template_roles,
+                                         const Clip& response_clip, const PartnerModel& model)
+    : template_clip_(&template_clip),
+      template_roles_(template_roles),
+      response_clip_(&response_clip),
+      model_(&model) {
+  template_pose_.resize(template_clip.joint_count());
+  response_pose_.resize(response_clip.joint_count());
+  placed_pose_.resize(response_clip.joint_count());
+  template_positions_.assign(static_cast<std::size_t>(template_clip.joint_count()), Vec3::Zero());
+  response_positions_.assign(static_cast<std::size_t>(response_clip.joint_count()), Vec3::Zero());
+  placed_positions_.assign(static_cast<std::size_t>(response_clip.joint_count()), Vec3::Zero());
+  rotations_scratch_.assign(
+      static_cast<std::size_t>(std::max(template_clip.joint_count(), response_clip.joint_count())),
+      Quat::Identity());
+}
+
+void CapturedDuetSampler::compute(double template_frame, const Vec3& user_root_position_ws,
+                                  const Quat& user_root_rotation_ws) {
+  const int last = response_clip_->frame_count() - 1;
+  const double frame = std::clamp(template_frame, 0.0, static_cast<double>(last));
+  const double time_s = frame / response_clip_->frame_rate();
+  template_clip_->sample(time_s, template_pose_);
+  response_clip_->sample(time_s, response_pose_);
+  const auto tn = static_cast<std::size_t>(template_clip_->joint_count());
+  const auto rn = static_cast<std::size_t>(response_clip_->joint_count());
+  forward_kinematics(template_clip_->skeleton(), template_pose_.translations_ls,
+                     template_pose_.rotations_ls, template_positions_,
+                     std::span(rotations_scratch_).first(tn));
+  forward_kinematics(response_clip_->skeleton(), response_pose_.translations_ls,
+                     response_pose_.rotations_ls, response_positions_,
+                     std::span(rotations_scratch_).first(rn));
+
+  // The placement of 5.1 at a real frame: lerp / slerp between the two nearest frames, as the
+  // clips themselves are sampled.
+  const int f0 = static_cast<int>(std::floor(frame));
+  const int f1 = std::min(f0 + 1, last);
+  const double w = frame - f0;
+  const RootPlacement& p0 = model_->alignment().placement(f0);
+  const RootPlacement& p1 = model_->alignment().placement(f1);
+  RootPlacement placement;
+  placement.position_hs = (1.0 - w) * p0.position_hs + w * p1.position_hs;
+  placement.rotation_hs = p0.rotation_hs.slerp(w, p1.rotation_hs).normalized();
+  const Transform root = place_root(placement, user_root_position_ws, user_root_rotation_ws);
+  placed_pose_.translations_ls = response_pose_.translations_ls;
+  placed_pose_.rotations_ls = response_pose_.rotations_ls;
+  placed_pose_.translations_ls[0] = root.translation;
+  placed_pose_.rotations_ls[0] = root.rotation;
+  forward_kinematics(response_clip_->skeleton(), placed_pose_.translations_ls,
+                     placed_pose_.rotations_ls, placed_positions_,
+                     std::span(rotations_scratch_).first(rn));
+
+  mask_ = model_->contacts().mask(static_cast<int>(std::lround(frame)));
+}
+
+double CapturedDuetSampler::captured_wrist_distance_m(int pair) const {
+  const int t = template_roles_[kWrists[static_cast<std::size_t>(template_side(pair))]];
+  const int r = model_->response_roles()[kWrists[static_cast<std::size_t>(response_side(pair))]];
+  return (template_positions_[static_cast<std::size_t>(t)] -
+          response_positions_[static_cast<std::size_t>(r)])
+      .norm();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Captured reference
+
+void add_captured_reference(const Clip& response, const JointRoles& roles,
+                            const std::array<double, 2>& ground_heights,
+                            const PartnerMetricsOptions& options, CapturedReference& reference) {
+  const int frames = response.frame_count();
+  if (frames < 2) return;
+  const double dt = response.frame_time();
+  const std::vector<Vec3> positions = world_positions(response);
+  const auto joints = static_cast<std::size_t>(response.joint_count());
+  const Skeleton& skeleton = response.skeleton();
+  std::vector<double> frame_max(static_cast<std::size_t>(frames), 0.0);
+  for (int f = 1; f < frames; ++f) {
+    const auto fs = static_cast<std::size_t>(f);
+    bool slip = false;
+    for (std::size_t side = 0; side < 2; ++side) {
+      const auto toe = static_cast<std::size_t>(roles[kToes[side]]);
+      slip = slip || foot_slips(positions[(fs - 1) * joints + toe], positions[fs * joints + toe],
+                                ground_heights[side], dt, options.foot);
+    }
+    reference.slip_frames += slip ? 1 : 0;
+    ++reference.frames;
+    const std::span<const Quat> previous = response.rotations_ls(f - 1);
+    const std::span<const Quat> current = response.rotations_ls(f);
+    for (std::size_t j = 0; j < joints; ++j) {
+      if (skeleton.joints[j].end_site) continue;
+      const double speed = angular_speed_rad_s(previous[j], current[j], dt);
+      reference.angular_speeds_rad_s.push_back(speed);
+      frame_max[fs] = std::max(frame_max[fs], speed);
+    }
+  }
+  // Non-overlapping windows of the post-jump length, from the second frame on.
+  const int window =
+      std::max(1, static_cast<int>(std::lround(options.post_jump_window_s / dt)));
+  for (int begin = 1; begin + window <= frames; begin += window) {
+    reference.window_max_rad_s.push_back(
+        *std::max_element(frame_max.begin() + begin, frame_max.begin() + begin + window));
+    ++reference.windows;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Accumulator
+
+void PartnerMetricsAccumulator::add(const Performance& performance,
+                                    std::span<const PartnerFrameRecord> records) {
+  assert(records.size() == performance.truth.size());
+  const std::size_t n = std::min(records.size(), performance.truth.size());
+  for (std::size_t f = 0; f < n; ++f) {
+    const PartnerFrameRecord& r = records[f];
+    ++frames_;
+    joint_error_sum_m_ += r.joint_error_m;
+    step_us_sum_ += r.step_us;
+    for (int pair = 0; pair < kHandPairCount; ++pair) {
+      if ((r.hand_pairs & (1u << pair)) != 0) {
+        hand_errors_m_.push_back(r.hand_error_m[static_cast<std::size_t>(pair)]);
+      }
+    }
+    if (f > 0) {
+      ++slip_pairs_;
+      slip_frames_ += r.slip ? 1 : 0;
+    }
+  }
+  // Jump windows: frames from the jump frame to window seconds after it; frame 0 has no speed.
+  for (std::size_t j = 0; j < n; ++j) {
+    if (!performance.truth[j].jump) continue;
+    const double end = performance.times_s[j] + options_.post_jump_window_s;
+    double largest = -1.0;
+    for (std::size_t f = std::max<std::size_t>(j, 1); f < n && performance.times_s[f] < end; ++f) {
+      largest = std::max(largest, records[f].max_angular_speed_rad_s);
+    }
+    if (largest >= 0.0) jump_max_rad_s_.push_back(largest);
+  }
+}
+
+void PartnerMetricsAccumulator::add_reference(const CapturedReference& reference) {
+  reference_.slip_frames += reference.slip_frames;
+  reference_.frames += reference.frames;
+  reference_.windows += reference.windows;
+  reference_.angular_speeds_rad_s.insert(reference_.angular_speeds_rad_s.end(),
+                                         reference.angular_speeds_rad_s.begin(),
+                                         reference.angular_speeds_rad_s.end());
+  reference_.window_max_rad_s.insert(reference_.window_max_rad_s.end(),
+                                     reference.window_max_rad_s.begin(),
+                                     reference.window_max_rad_s.end());
+}
+
+void PartnerMetricsAccumulator::merge(const PartnerMetricsAccumulator& other) {
+  frames_ += other.frames_;
+  slip_frames_ += other.slip_frames_;
+  slip_pairs_ += other.slip_pairs_;
+  joint_error_sum_m_ += other.joint_error_sum_m_;
+  step_us_sum_ += other.step_us_sum_;
+  hand_errors_m_.insert(hand_errors_m_.end(), other.hand_errors_m_.begin(),
+                        other.hand_errors_m_.end());
+  jump_max_rad_s_.insert(jump_max_rad_s_.end(), other.jump_max_rad_s_.begin(),
+                         other.jump_max_rad_s_.end());
+  add_reference(other.reference_);
+}
+
+PartnerMetrics PartnerMetricsAccumulator::summary() const {
+  PartnerMetrics m;
+  m.frames = frames_;
+  if (frames_ > 0) {
+    m.mean_joint_error_cm = 100.0 * joint_error_sum_m_ / static_cast<double>(frames_);
+    m.mean_step_us = step_us_sum_ / static_cast<double>(frames_);
+  }
+  m.hand_samples = static_cast<long long>(hand_errors_m_.size());
+  if (!hand_errors_m_.empty()) {
+    m.median_hand_error_cm = 100.0 * median(hand_errors_m_);
+    double sum = 0.0;
+    for (const double e : hand_errors_m_) sum += e;
+    m.mean_hand_error_cm = 100.0 * sum / static_cast<double>(hand_errors_m_.size());
+  }
+  if (slip_pairs_ > 0) {
+    m.slip_rate = static_cast<double>(slip_frames_) / static_cast<double>(slip_pairs_);
+  }
+  if (reference_.frames > 0) {
+    m.captured_slip_rate =
+        static_cast<double>(reference_.slip_frames) / static_cast<double>(reference_.frames);
+  }
+  const double reference_rad_s =
+      quantile(reference_.angular_speeds_rad_s, options_.reference_percentile);
+  m.reference_speed_deg_s = rad_to_deg(reference_rad_s);
+  if (!reference_.window_max_rad_s.empty()) {
+    const auto over = std::ranges::count_if(reference_.window_max_rad_s,
+                                            [&](double s) { return s > reference_rad_s; });
+    m.captured_windows_over_reference =
+        static_cast<double>(over) / static_cast<double>(reference_.window_max_rad_s.size());
+  }
+  m.jumps = static_cast<long long>(jump_max_rad_s_.size());
+  if (!jump_max_rad_s_.empty()) {
+    m.max_jump_speed_deg_s = rad_to_deg(*std::ranges::max_element(jump_max_rad_s_));
+    m.median_jump_speed_deg_s = rad_to_deg(median(jump_max_rad_s_));
+    m.jumps_over_reference = std::ranges::count_if(
+        jump_max_rad_s_, [&](double s) { return s > reference_rad_s; });
+  }
+  return m;
+}
+
+}  // namespace duet

@@ -1,0 +1,214 @@
+#include "duet/eval/partner_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+
+#include "duet/live/live_loop.h"
+
+namespace duet {
+
+namespace {
+
+constexpr std::array<Role, 2> kWrists = {Role::kLeftWrist, Role::kRightWrist};
+constexpr std::array<Role, 2> kToes = {Role::kLeftToe, Role::kRightToe};
+
+// Wraps the real tracker: records its results in the first pass, replays them after rewind().
+// Its buffer is reserved up front, so step() allocates nothing in either mode.
+class ReplayTracker final : public Tracker {
+ public:
+  ReplayTracker(std::unique_ptr<Tracker> inner, int frames) : inner_(std::move(inner)) {
+    recorded_.reserve(static_cast<std::size_t>(frames));
+  }
+  void reset() noexcept override {
+    if (!replaying_) inner_->reset();
+    next_ = 0;
+  }
+  FollowResult step(std::span<const float> features, double dt_s) noexcept override {
+    if (replaying_) return next_ < recorded_.size() ? recorded_[next_++] : FollowResult{};
+    const FollowResult r = inner_->step(features, dt_s);
+    if (recorded_.size() < recorded_.capacity()) recorded_.push_back(r);
+    return r;
+  }
+  std::string_view name() const noexcept override { return inner_->name(); }
+  void start_replay() noexcept {
+    replaying_ = true;
+    next_ = 0;
+  }
+
+ private:
+  std::unique_ptr<Tracker> inner_;
+  std::vector<FollowResult> recorded_;
+  std::size_t next_ = 0;
+  bool replaying_ = false;
+};
+
+double elapsed_us(std::chrono::steady_clock::time_point start,
+                  std::chrono::steady_clock::time_point stop) {
+  return std::chrono::duration<double, std::micro>(stop - start).count();
+}
+
+void load_frame(const Performance& performance, int f, SourceFrame& frame) {
+  frame.time_s = performance.times_s[static_cast<std::size_t>(f)];
+  frame.arrival = SteadyClock::now();
+  std::ranges::copy(performance.motion.translations_ls(f), frame.translations_ls.begin());
+  std::ranges::copy(performance.motion.rotations_ls(f), frame.rotations_ls.begin());
+}
+
+}  // namespace
+
+std::vector<PartnerConfig> standard_partner_configs(const PartnerParams& base) {
+  std::vector<PartnerConfig> configs;
+  auto add = [&](std::string name, auto&& edit) {
+    PartnerParams p = base;
+    edit(p);
+    configs.push_back({std::move(name), p});
+  };
+  add("all", [](PartnerParams& p) { p.align = p.contact = p.smooth = p.foot_lock = p.blend = true; });
+  add("no-contact", [](PartnerParams& p) {
+    p.align = p.smooth = p.foot_lock = p.blend = true;
+    p.contact = false;
+  });
+  add("no-footlock", [](PartnerParams& p) {
+    p.align = p.contact = p.smooth = p.blend = true;
+    p.foot_lock = false;
+  });
+  add("no-blend", [](PartnerParams& p) {
+    p.align = p.contact = p.smooth = p.foot_lock = true;
+    p.blend = false;
+  });
+  add("no-smooth", [](PartnerParams& p) {
+    p.align = p.contact = p.foot_lock = p.blend = true;
+    p.smooth = false;
+  });
+  add("align-only", [](PartnerParams& p) {
+    p.align = true;
+    p.contact = p.smooth = p.foot_lock = p.blend = false;
+  });
+  add("none", [](PartnerParams& p) {
+    p.align = p.contact = p.smooth = p.foot_lock = p.blend = false;
+  });
+  return configs;
+}
+
+Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& library,
+                                                         const Performance& performance,
+                                                         std::unique_ptr<Tracker> tracker,
+                                                         std::span<const PartnerConfig> configs,
+                                                         const PartnerMetricsOptions& options) {
+  const int frames = performance.frame_count();
+  if (frames == 0) return Error{"partner metrics: the performance has no frames"};
+  if (configs.empty()) return Error{"partner metrics: no configuration to run"};
+  const int takes = static_cast<int>(library.takes().size());
+  for (const TruthFrame& t : performance.truth) {
+    if (t.take < 0 || t.take >= takes) {
+      return Error{"partner metrics: the performance's truth names take " +
+                   std::to_string(t.take) + ", not in the library"};
+    }
+  }
+
+  auto replay = std::make_unique<ReplayTracker>(std::move(tracker), frames);
+  ReplayTracker* replay_ptr = replay.get();  // owned by the loop below
+  // LiveLoop shares its library; this one is the caller's and outlives the loop (no owner).
+  const std::shared_ptr<const DuetLibrary> shared(std::shared_ptr<const DuetLibrary>(), &library);
+  const SourceSkeleton user{performance.motion.skeleton_ptr(), performance.roles, 1.0,
+                            performance.motion.frame_rate()};
+  Result<LiveLoop> created = LiveLoop::create(shared, user, std::move(replay), configs[0].params);
+  if (!created) return Error{"partner metrics: " + created.error().message};
+  LiveLoop& loop = created.value();
+
+  SourceFrame frame;
+  frame.resize(performance.motion.joint_count());
+  PartnerPerformanceResult result;
+
+  // Recording pass: the real tracker, the whole loop timed.
+  double total_us = 0.0;
+  for (int f = 0; f < frames; ++f) {
+    load_frame(performance, f, frame);
+    const auto start = std::chrono::steady_clock::now();
+    loop.step(frame);
+    total_us += elapsed_us(start, std::chrono::steady_clock::now());
+  }
+  result.loop_step_us = total_us / frames;
+  replay_ptr->start_replay();
+
+  // The truth's takes: their captured duets (for the true response) and the references.
+  std::map<int, CapturedDuetSampler> samplers;
+  CapturedReference reference;
+  for (const TruthFrame& t : performance.truth) {
+    if (samplers.contains(t.take)) continue;
+    const DuetTake& take = library.takes()[static_cast<std::size_t>(t.take)];
+    const PartnerModel& model = loop.partner_model(t.take);
+    samplers.emplace(t.take, CapturedDuetSampler(take.template_motion.clip, take.template_motion.roles,
+                                                 take.response_motion.clip, model));
+    add_captured_reference(take.response_motion.clip, take.response_motion.roles,
+                           {model.foot_ground_height(Side::kLeft),
+                            model.foot_ground_height(Side::kRight)},
+                           options, reference);
+  }
+
+  const Skeleton& partner_skeleton = *loop.partner_skeleton();
+  const auto partner_joints = static_cast<std::size_t>(partner_skeleton.joint_count());
+  std::vector<Quat> previous_rotations(partner_joints, Quat::Identity());
+  std::vector<PartnerFrameRecord> records(static_cast<std::size_t>(frames));
+  for (const PartnerConfig& config : configs) {
+    loop.set_params(config.params);
+    loop.reset();  // rewinds the replay too
+    std::array<Vec3, 2> previous_toes{Vec3::Zero(), Vec3::Zero()};
+    for (int f = 0; f < frames; ++f) {
+      const auto fs = static_cast<std::size_t>(f);
+      load_frame(performance, f, frame);
+      const auto start = std::chrono::steady_clock::now();
+      const LiveOutput& out = loop.step(frame);
+      const auto stop = std::chrono::steady_clock::now();
+
+      PartnerFrameRecord& r = records[fs];
+      r = PartnerFrameRecord{};
+      r.step_us = elapsed_us(start, stop);
+      const TruthFrame& truth = performance.truth[fs];
+      CapturedDuetSampler& sampler = samplers.at(truth.take);
+      sampler.compute(truth.template_frame, out.user_positions_ws[0], out.user_rotations_ws[0]);
+      r.joint_error_m = mean_joint_distance_m(out.partner_positions_ws,
+                                              sampler.placed_positions_ws());
+
+      const PartnerModel& model = loop.partner_model(out.partner_take);
+      const JointRoles& partner_roles = model.response_roles();
+      for (int pair = 0; pair < kHandPairCount; ++pair) {
+        if ((sampler.contact_mask() & (1u << pair)) == 0) continue;
+        const int pw = partner_roles[kWrists[static_cast<std::size_t>(response_side(pair))]];
+        const int uw = performance.roles[kWrists[static_cast<std::size_t>(template_side(pair))]];
+        if (pw < 0 || uw < 0) continue;
+        const double output = (out.partner_positions_ws[static_cast<std::size_t>(pw)] -
+                               out.user_positions_ws[static_cast<std::size_t>(uw)])
+                                  .norm();
+        r.hand_error_m[static_cast<std::size_t>(pair)] =
+            std::abs(output - sampler.captured_wrist_distance_m(pair));
+        r.hand_pairs |= static_cast<std::uint8_t>(1u << pair);
+      }
+
+      std::array<Vec3, 2> toes;
+      for (std::size_t side = 0; side < 2; ++side) {
+        toes[side] = out.partner_positions_ws[static_cast<std::size_t>(partner_roles[kToes[side]])];
+      }
+      if (f > 0) {
+        const double dt = performance.times_s[fs] - performance.times_s[fs - 1];
+        for (std::size_t side = 0; side < 2; ++side) {
+          r.slip = r.slip || foot_slips(previous_toes[side], toes[side],
+                                        model.foot_ground_height(static_cast<Side>(side)), dt,
+                                        options.foot);
+        }
+        r.max_angular_speed_rad_s = max_joint_angular_speed_rad_s(
+            partner_skeleton, previous_rotations, out.partner_rotations_ls, dt);
+      }
+      previous_toes = toes;
+      std::ranges::copy(out.partner_rotations_ls, previous_rotations.begin());
+    }
+    PartnerMetricsAccumulator accumulator(options);
+    accumulator.add(performance, records);
+    accumulator.add_reference(reference);
+    result.configs.push_back(std::move(accumulator));
+  }
+  return result;
+}
+
+}  // namespace duet

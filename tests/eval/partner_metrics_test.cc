@@ -1,0 +1,259 @@
+#include "duet/eval/partner_metrics.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "duet/eval/partner_run.h"
+#include "duet/follow/hmm_follower.h"
+#include "duet/live/duet_library.h"
+#include "partner/synthetic_partner.h"
+
+namespace duet {
+namespace {
+
+using test::make_humanoid;
+using test::make_standing_clip;
+
+constexpr double kFps = 60.0;
+
+TEST(PartnerGeometry, MeanJointDistanceAndQuantile) {
+  const std::vector<Vec3> a = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 2, 0)};
+  std::vector<Vec3> b = a;
+  EXPECT_DOUBLE_EQ(mean_joint_distance_m(a, b), 0.0);
+  b[0] += Vec3(0.03, 0.04, 0);  // 5 cm
+  b[2] += Vec3(0, 0, 0.1);      // 10 cm
+  EXPECT_NEAR(mean_joint_distance_m(a, b), 0.05, 1e-12);
+
+  std::vector<double> v;
+  for (int k = 1; k <= 100; ++k) v.push_back(k);
+  EXPECT_DOUBLE_EQ(quantile(v, 0.99), 99.0);
+  EXPECT_DOUBLE_EQ(quantile(v, 1.0), 100.0);
+  EXPECT_DOUBLE_EQ(quantile(v, 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(quantile({}, 0.5), 0.0);
+}
+
+TEST(PartnerGeometry, AngularSpeedIsTheShorterAngleOverDt) {
+  const Quat a = quat_from_axis_angle(Vec3::UnitX(), 0.2);
+  const Quat b = quat_from_axis_angle(Vec3::UnitX(), 0.2 + deg_to_rad(30.0));
+  EXPECT_NEAR(rad_to_deg(angular_speed_rad_s(a, b, 0.1)), 300.0, 1e-9);
+  // -b is the same rotation.
+  const Quat minus_b(-b.w(), -b.x(), -b.y(), -b.z());
+  EXPECT_NEAR(rad_to_deg(angular_speed_rad_s(a, minus_b, 0.1)), 300.0, 1e-9);
+  EXPECT_DOUBLE_EQ(angular_speed_rad_s(a, b, 0.0), 0.0);
+
+  // Only animated joints count: an End Site's rotation is never looked at.
+  const auto skeleton = make_humanoid();
+  const auto n = static_cast<std::size_t>(skeleton->joint_count());
+  std::vector<Quat> previous(n, Quat::Identity()), current(n, Quat::Identity());
+  const int end = skeleton->find("lFoot_End");
+  ASSERT_GE(end, 0);
+  current[static_cast<std::size_t>(end)] = quat_from_axis_angle(Vec3::UnitY(), 1.0);
+  EXPECT_DOUBLE_EQ(max_joint_angular_speed_rad_s(*skeleton, previous, current, 0.1), 0.0);
+  const int elbow = skeleton->find("rForeArm");
+  current[static_cast<std::size_t>(elbow)] = quat_from_axis_angle(Vec3::UnitY(), 0.5);
+  EXPECT_NEAR(max_joint_angular_speed_rad_s(*skeleton, previous, current, 0.1), 5.0, 1e-9);
+}
+
+TEST(PartnerGeometry, FootSlipsOnlyNearTheGroundAndAboveTheSpeed) {
+  const FootLockParams thresholds;  // 0.03 m, 0.2 m/s
+  const double ground = 0.05;
+  const double dt = 0.1;
+  // 3 cm per 0.1 s = 0.3 m/s on the ground: slip; 1 cm = 0.1 m/s: no slip.
+  EXPECT_TRUE(foot_slips(Vec3(0, 0.06, 0), Vec3(0.03, 0.06, 0), ground, dt, thresholds));
+  EXPECT_FALSE(foot_slips(Vec3(0, 0.06, 0), Vec3(0.01, 0.06, 0), ground, dt, thresholds));
+  // Vertical motion does not count.
+  EXPECT_FALSE(foot_slips(Vec3(0, 0.05, 0), Vec3(0, 0.07, 0.015), ground, dt, thresholds));
+  // Above the margin at either end: a step, not a slip.
+  EXPECT_FALSE(foot_slips(Vec3(0, 0.09, 0), Vec3(0.05, 0.06, 0), ground, dt, thresholds));
+  EXPECT_FALSE(foot_slips(Vec3(0, 0.06, 0), Vec3(0.05, 0.09, 0), ground, dt, thresholds));
+  EXPECT_FALSE(foot_slips(Vec3(0, 0.06, 0), Vec3(0.05, 0.06, 0), ground, 0.0, thresholds));
+}
+
+// A duet of two standing humanoids: the response 1 m in front of the template, facing it, and
+// moving 1 cm per frame along x; the template's right hand near the response's left hand.
+struct SyntheticDuet {
+  std::shared_ptr<const Skeleton> skeleton = make_humanoid();
+  JointRoles roles = test::humanoid_roles(*skeleton);
+  Clip template_clip = make_standing_clip(skeleton, 40);
+  Clip response_clip = make_standing_clip(skeleton, 40);
+  PartnerModel model;
+
+  SyntheticDuet() {
+    for (int f = 0; f < 40; ++f) {
+      test::set_root(template_clip, f, Vec3(0, 0.97, 0), 0.0);
+      test::set_root(response_clip, f, Vec3(0.01 * f, 0.97, 1.0), kPi);
+    }
+    Result<PartnerModel> built = PartnerModel::build(template_clip, roles, response_clip, roles);
+    if (!built) std::abort();
+    model = std::move(built).value();
+  }
+};
+
+TEST(CapturedDuetSampler, PlacesTheTrueResponseRelativeToTheUser) {
+  const SyntheticDuet duet;
+  CapturedDuetSampler sampler(duet.template_clip, duet.roles, duet.response_clip, duet.model);
+  // The user stands elsewhere and faces elsewhere; the true response keeps its captured relation.
+  const double yaw = 0.5;
+  const Vec3 user_root(3.0, 0.97, -2.0);
+  sampler.compute(10.5, user_root, yaw_rotation(yaw));
+  const Vec3 root = sampler.placed_positions_ws()[0];
+  // Captured at frame 10.5: 0.105 m along x and 1 m along z from the template; turned by yaw.
+  const Vec3 expected = user_root + yaw_rotation(yaw) * Vec3(0.105, 0.0, 1.0);
+  EXPECT_NEAR((root - expected).norm(), 0.0, 1e-9) << root.transpose();
+  EXPECT_NEAR(root.y(), 0.97, 1e-12);
+
+  // A synthesized partner 5 cm off everywhere has a joint error of exactly 5 cm.
+  std::vector<Vec3> shifted(sampler.placed_positions_ws().begin(),
+                            sampler.placed_positions_ws().end());
+  for (Vec3& p : shifted) p += Vec3(0.0, 0.03, 0.04);
+  EXPECT_NEAR(mean_joint_distance_m(shifted, sampler.placed_positions_ws()), 0.05, 1e-12);
+
+  // The captured wrist distance is measured in the capture, whatever the user does.
+  const int tw = duet.roles[Role::kRightWrist], rw = duet.roles[Role::kLeftWrist];
+  const test::WorldPose t = test::world_pose(duet.template_clip, 10);
+  const test::WorldPose r = test::world_pose(duet.response_clip, 10);
+  sampler.compute(10.0, Vec3(-5, 1, 7), yaw_rotation(2.0));
+  const double captured =
+      (t.positions[static_cast<std::size_t>(tw)] - r.positions[static_cast<std::size_t>(rw)])
+          .norm();
+  EXPECT_NEAR(sampler.captured_wrist_distance_m(hand_pair(Side::kRight, Side::kLeft)), captured,
+              1e-12);
+}
+
+TEST(CapturedReference, CountsSlipsAndKeepsSpeeds) {
+  const auto skeleton = make_humanoid();
+  const JointRoles roles = test::humanoid_roles(*skeleton);
+  Clip clip = make_standing_clip(skeleton, 61, kFps);
+  // The dancer stands on the floor and slides 1 cm per frame (0.6 m/s) in frames 31..60: both toes
+  // slip in 30 of the 60 frame pairs. The right elbow turns at 120 deg/s throughout.
+  const int elbow = skeleton->find("rForeArm");
+  for (int f = 0; f <= 60; ++f) {
+    test::set_root(clip, f, Vec3(f > 30 ? 0.01 * (f - 30) : 0.0, 0.97, 0.0), 0.0);
+    clip.rotations_ls(f)[static_cast<std::size_t>(elbow)] =
+        quat_from_axis_angle(Vec3::UnitY(), deg_to_rad(2.0 * f));
+  }
+  const test::WorldPose w = test::world_pose(clip, 0);
+  const double toe_height = w.positions[static_cast<std::size_t>(roles[Role::kLeftToe])].y();
+  PartnerMetricsOptions options;
+  CapturedReference reference;
+  add_captured_reference(clip, roles, {toe_height, toe_height}, options, reference);
+  EXPECT_EQ(reference.frames, 60);
+  EXPECT_EQ(reference.slip_frames, 30);
+  const std::size_t animated = static_cast<std::size_t>(skeleton->animated_joint_count());
+  EXPECT_EQ(reference.angular_speeds_rad_s.size(), 60 * animated);
+  EXPECT_NEAR(rad_to_deg(quantile(reference.angular_speeds_rad_s, 1.0)), 120.0, 1e-6);
+  EXPECT_EQ(reference.windows, 2);  // 0.5 s windows of 30 frames from frame 1
+
+  // The same clip 10 cm above its ground: never near it, never slips.
+  CapturedReference lifted;
+  add_captured_reference(clip, roles, {toe_height - 0.1, toe_height - 0.1}, options, lifted);
+  EXPECT_EQ(lifted.slip_frames, 0);
+}
+
+TEST(PartnerMetricsAccumulator, PoolsFramesHandsSlipsAndJumpWindows) {
+  // 10 frames at 10 Hz with a true jump at frame 4 (window: frames 4..8, t in [0.4, 0.9)).
+  Performance performance;
+  for (int f = 0; f < 10; ++f) {
+    performance.times_s.push_back(0.1 * f);
+    performance.truth.push_back({0, static_cast<double>(f), false, f == 4});
+  }
+  std::vector<PartnerFrameRecord> records(10);
+  for (int f = 0; f < 10; ++f) {
+    PartnerFrameRecord& r = records[static_cast<std::size_t>(f)];
+    r.joint_error_m = 0.01 * f;  // mean 4.5 cm
+    r.step_us = 10.0;
+    r.slip = f == 0 || f == 3 || f == 5;  // frame 0 has no previous frame: not counted
+    r.max_angular_speed_rad_s = f == 2 ? 100.0 : (f == 6 ? 20.0 : 1.0);
+  }
+  // Hand samples 1, 2, 3, 10 cm: median 2.5 cm, mean 4 cm.
+  records[1].hand_pairs = 0b0001;
+  records[1].hand_error_m[0] = 0.01;
+  records[2].hand_pairs = 0b1010;
+  records[2].hand_error_m[1] = 0.02;
+  records[2].hand_error_m[3] = 0.03;
+  records[7].hand_pairs = 0b0100;
+  records[7].hand_error_m[2] = 0.10;
+
+  PartnerMetricsAccumulator accumulator;
+  accumulator.add(performance, records);
+  CapturedReference reference;
+  reference.frames = 100;
+  reference.slip_frames = 5;
+  for (int k = 1; k <= 100; ++k) reference.angular_speeds_rad_s.push_back(0.1 * k);  // p99: 9.9
+  reference.windows = 4;
+  reference.window_max_rad_s = {1.0, 5.0, 9.95, 10.0};
+  accumulator.add_reference(reference);
+
+  const PartnerMetrics m = accumulator.summary();
+  EXPECT_EQ(m.frames, 10);
+  EXPECT_NEAR(m.mean_joint_error_cm, 4.5, 1e-9);
+  EXPECT_EQ(m.hand_samples, 4);
+  EXPECT_NEAR(m.median_hand_error_cm, 2.5, 1e-9);
+  EXPECT_NEAR(m.mean_hand_error_cm, 4.0, 1e-9);
+  EXPECT_NEAR(m.slip_rate, 2.0 / 9.0, 1e-12);
+  EXPECT_NEAR(m.captured_slip_rate, 0.05, 1e-12);
+  EXPECT_EQ(m.jumps, 1);
+  // The window holds frames 4..8 (the spike at frame 2 is before the jump).
+  EXPECT_NEAR(m.max_jump_speed_deg_s, rad_to_deg(20.0), 1e-9);
+  EXPECT_NEAR(m.reference_speed_deg_s, rad_to_deg(9.9), 1e-9);
+  EXPECT_EQ(m.jumps_over_reference, 1);
+  EXPECT_NEAR(m.captured_windows_over_reference, 0.5, 1e-12);
+  EXPECT_NEAR(m.mean_step_us, 10.0, 1e-12);
+
+  // Merging is pooling.
+  PartnerMetricsAccumulator twice;
+  twice.merge(accumulator);
+  twice.merge(accumulator);
+  const PartnerMetrics m2 = twice.summary();
+  EXPECT_EQ(m2.frames, 20);
+  EXPECT_EQ(m2.jumps, 2);
+  EXPECT_NEAR(m2.median_hand_error_cm, 2.5, 1e-9);
+  EXPECT_NEAR(m2.slip_rate, m.slip_rate, 1e-12);
+}
+
+// The whole run on a real take: the user dances 60_10 exactly, so the true response is the
+// captured follower placed relative to the user and the raw pose (align only) matches it.
+TEST(PartnerRun, RealTakeFollowedExactly) {
+  const std::string dir = std::string(DUET_DATA_DIR) + "/cmu-salsa/bvh/";
+  LibraryOptions options;
+  options.load.frame_rate = 60.0;
+  Result<DuetLibrary> library =
+      DuetLibrary::load({{dir + "60/60_10_scaled.bvh", dir + "61/61_10_scaled.bvh"}}, options);
+  ASSERT_TRUE(library) << library.error().message;
+  const DuetLibrary& lib = library.value();
+  const DuetTake& take = lib.takes()[0];
+  const SourceTake source{0, &take.template_motion.clip, take.template_motion.roles};
+  const Performance performance = play(source, PlayOptions{});
+  ASSERT_GT(performance.frame_count(), 600);
+
+  Result<HmmFollower> hmm = HmmFollower::create(lib.model(), FollowParams{});
+  ASSERT_TRUE(hmm);
+  const std::vector<PartnerConfig> configs = standard_partner_configs();
+  ASSERT_EQ(configs[0].name, "all");
+  Result<PartnerPerformanceResult> run = run_partner_performance(
+      lib, performance, std::make_unique<HmmFollower>(std::move(hmm).value()), configs, {});
+  ASSERT_TRUE(run) << run.error().message;
+  ASSERT_EQ(run.value().configs.size(), configs.size());
+  std::map<std::string, PartnerMetrics> m;
+  for (std::size_t c = 0; c < configs.size(); ++c) {
+    m[configs[c].name] = run.value().configs[c].summary();
+    EXPECT_EQ(m[configs[c].name].frames, performance.frame_count()) << configs[c].name;
+  }
+  // The raw pose at a (nearly always) exact estimate: the true response itself.
+  EXPECT_LT(m["align-only"].mean_joint_error_cm, 1.0);
+  // The corrections move it by little (smoothing lag, IK, foot lock).
+  EXPECT_LT(m["all"].mean_joint_error_cm, 4.0);
+  EXPECT_GT(m["all"].hand_samples, 100);
+  // Contact IK towards the captured offset reproduces the captured hand distance.
+  EXPECT_LT(m["all"].median_hand_error_cm, 1.0);
+  EXPECT_LE(m["all"].median_hand_error_cm, m["no-contact"].median_hand_error_cm);
+  // The take as captured, played at its own rate: the raw response slips exactly as captured.
+  EXPECT_NEAR(m["none"].slip_rate, m["none"].captured_slip_rate, 0.01);
+  EXPECT_GT(m["all"].reference_speed_deg_s, 0.0);
+  EXPECT_GT(run.value().loop_step_us, 0.0);
+}
+
+}  // namespace
+}  // namespace duet
