@@ -28,12 +28,16 @@ void add_tracker_options(CLI::App& app, TrackerArgs& args) {
       ->check(CLI::IsMember({"default", "paper"}));
   app.add_option("--sigma", args.sigma, "Emission sigma (standardised feature units)")
       ->check(CLI::PositiveNumber);
+  app.add_flag("--fixed-band", args.fixed_band,
+               "Keep the HMM's band at the template's tempo instead of centring it on the "
+               "dancer's tempo (the paper preset always does)");
 }
 
 Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args,
                                               const TemplateModel& model) {
   FollowParams params = args.preset == "paper" ? FollowParams::paper() : FollowParams{};
   if (args.sigma) params.emission_sigma = *args.sigma;
+  if (args.fixed_band) params.tempo_adaptive = false;
   if (args.kind == "nearest") return boxed(NearestNeighbourTracker::create(model, params));
   if (args.kind == "dtw") return boxed(OnlineDtwTracker::create(model, OnlineDtwParams{}));
   if (args.kind == "naive") return boxed(NaiveHmmFollower::create(model, params));

@@ -16,6 +16,7 @@ struct TrackerArgs {
   std::string kind = "hmm";        // hmm | left-to-right | nearest | dtw | naive
   std::string preset = "default";  // default | paper
   std::optional<float> sigma;      // emission sigma override
+  bool fixed_band = false;         // tempo_adaptive = false
 };
 
 void add_tracker_options(CLI::App& app, TrackerArgs& args);

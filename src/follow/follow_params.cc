@@ -19,6 +19,7 @@ FollowParams FollowParams::paper() {
   params.skip_prob = 0.0f;
   params.leave_prob = 0.165f;
   params.pause_stay_prob = 1.0f - 0.165f;
+  params.tempo_adaptive = false;
   return params;
 }
 
@@ -53,6 +54,10 @@ Status FollowParams::validate(int num_states) const {
     return params_error("pause_distance_per_dim must be finite and >= 0, got " +
                         std::to_string(pause_distance_per_dim));
   }
+  if (!(velocity_distance_cap >= 0.0f)) {  // +inf allowed: no cap
+    return params_error("velocity_distance_cap must be >= 0, got " +
+                        std::to_string(velocity_distance_cap));
+  }
   if (!(lost_distance_per_dim >= 0.0f)) {  // +inf allowed: never lost by distance
     return params_error("lost_distance_per_dim must be >= 0, got " +
                         std::to_string(lost_distance_per_dim));
@@ -64,6 +69,20 @@ Status FollowParams::validate(int num_states) const {
   if (max_steps_per_frame < 1 || max_steps_per_frame > 1000) {
     return params_error("max_steps_per_frame must be in [1, 1000], got " +
                         std::to_string(max_steps_per_frame));
+  }
+  if (tempo_adaptive) {
+    if (!(tempo_time_constant_s > 0.0 && std::isfinite(tempo_time_constant_s))) {
+      return params_error("tempo_time_constant_s must be finite and > 0, got " +
+                          std::to_string(tempo_time_constant_s));
+    }
+    if (!(min_tempo > 0.0f && max_tempo >= min_tempo && max_tempo < 2.0f)) {
+      return params_error("the tempo range needs 0 < min_tempo <= max_tempo < 2, got [" +
+                          std::to_string(min_tempo) + ", " + std::to_string(max_tempo) + "]");
+    }
+    if (!(self_prob > 0.0f && skip_prob > 0.0f)) {
+      return params_error("tempo_adaptive needs self_prob > 0 and skip_prob > 0 (slower and "
+                          "faster moves to tilt the band towards)");
+    }
   }
   if (!resume_weights.empty()) {
     if (static_cast<int>(resume_weights.size()) != num_states) {

@@ -48,6 +48,28 @@ float squared_distances(const FeatureMatrix& features, const float* phi, int beg
   return best;
 }
 
+float emission_distances(const TemplateModel& model, const float* phi, float velocity_cap,
+                         float* out) noexcept {
+  const FeatureMatrix& features = model.features();
+  const int num_states = model.num_states();
+  const Eigen::Index velocity = model.velocity_dims();
+  if (velocity == 0 || !(velocity_cap < FLT_MAX)) {
+    return squared_distances(features, phi, 0, num_states, out);
+  }
+  const Eigen::Index posture = features.cols() - velocity;
+  const Eigen::Map<const Eigen::RowVectorXf> query(phi, features.cols());
+  float best = FLT_MAX;
+  for (int i = 0; i < num_states; ++i) {
+    const auto row = features.row(i);
+    const float posture_d2 = (row.head(posture) - query.head(posture)).squaredNorm();
+    const float velocity_d2 = (row.tail(velocity) - query.tail(velocity)).squaredNorm();
+    const float d2 = std::min(posture_d2 + std::min(velocity_d2, velocity_cap), FLT_MAX);
+    out[i] = d2;
+    best = std::min(best, d2);
+  }
+  return best;
+}
+
 double weigh_and_normalise(const float* predicted, const float* distance_sq, float best_distance_sq,
                            float inv_two_sigma_sq, int num_states, float log_b_pause,
                            bool with_pause, float* out) noexcept {

@@ -46,6 +46,12 @@ int steps_for(double dt_s, double template_fps, int max_steps) noexcept;
 float squared_distances(const FeatureMatrix& features, const float* phi, int begin, int end,
                         float* out) noexcept;
 
+// The same with the distance over the last model.velocity_dims() dimensions capped at
+// velocity_cap (FollowParams::velocity_distance_cap); plain squared_distances when there are no
+// velocity dimensions or the cap is infinite.
+float emission_distances(const TemplateModel& model, const float* phi, float velocity_cap,
+                         float* out) noexcept;
+
 // log b = max(-d^2 * inv_two_sigma_sq, kMinLogEmission) (eq. 7, without its constant).
 inline float log_emission(float distance_sq, float inv_two_sigma_sq) noexcept {
   const float log_b = -distance_sq * inv_two_sigma_sq;

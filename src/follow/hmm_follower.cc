@@ -32,6 +32,7 @@ void ForwardContext::reset() noexcept {
   frames_ = 0;
   previous_state_ = -1;
   previous_lost_ = false;
+  tempo_.reset();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -48,9 +49,8 @@ Result<HmmForward> HmmForward::create(const TemplateModel& model, const FollowPa
   // the four probabilities are normalised together.
   const float total =
       params.self_prob + params.next_prob + params.skip_prob + (jump ? params.leave_prob : 0.0f);
-  forward.self_ = params.self_prob / total;
-  forward.next_ = params.next_prob / total;
-  forward.skip_ = params.skip_prob / total;
+  forward.band_ = {params.self_prob / total, params.next_prob / total, params.skip_prob / total};
+  forward.tempo_limits_ = {params.tempo_time_constant_s, params.min_tempo, params.max_tempo};
   forward.leave_ = jump ? params.leave_prob / total : 0.0f;
   forward.pause_stay_ = jump ? params.pause_stay_prob : 1.0f;
   if (jump && !params.resume_weights.empty()) {
@@ -78,13 +78,17 @@ int HmmForward::steps_for(double dt_s) const noexcept {
   return follow_detail::steps_for(dt_s, model_->frame_rate_hz(), params_.max_steps_per_frame);
 }
 
-HmmForward::Row HmmForward::row(int j) const noexcept {
+BandProbabilities HmmForward::band_for(float tempo) const noexcept {
+  return params_.tempo_adaptive ? tilt_band(band_, tempo) : band_;
+}
+
+HmmForward::Row HmmForward::row(int j, const BandProbabilities& band) const noexcept {
   const int end = model_->take_end(model_->take_of(j));
   const int remaining = end - 1 - j;  // frames after j in its take
-  Row r{{self_, remaining >= 1 ? next_ : 0.0f, remaining >= 2 ? skip_ : 0.0f}, leave_};
+  Row r{{band.self, remaining >= 1 ? band.next : 0.0f, remaining >= 2 ? band.skip : 0.0f}, leave_};
   if (params_.jump_enabled) {
     // End of a take (library): next/skip lead into the pause state, not into the next take.
-    r.leave += (next_ - r.band[1]) + (skip_ - r.band[2]);
+    r.leave += (band.next - r.band[1]) + (band.skip - r.band[2]);
   } else {
     // No pause state: renormalise what is left; a state with nothing left keeps its mass.
     const float sum = r.band[0] + r.band[1] + r.band[2];
@@ -123,7 +127,8 @@ void band_interior(const float* alpha, float* next, int begin, int end, float se
 
 }  // namespace
 
-void HmmForward::transition(const float* alpha, float* next) const noexcept {
+void HmmForward::transition(const float* alpha, const BandProbabilities& band,
+                            float* next) const noexcept {
   const TemplateModel& model = *model_;
   const int num_states = model.num_states();
   const bool jump = params_.jump_enabled;
@@ -145,9 +150,11 @@ void HmmForward::transition(const float* alpha, float* next) const noexcept {
     const int begin = model.take_begin(take);
     const int end = model.take_end(take);
     if (uniform) {
-      band_interior<true>(alpha, next, begin + 2, end, self_, next_, skip_, pause_out, resume);
+      band_interior<true>(alpha, next, begin + 2, end, band.self, band.next, band.skip, pause_out,
+                          resume);
     } else {
-      band_interior<false>(alpha, next, begin + 2, end, self_, next_, skip_, pause_out, resume);
+      band_interior<false>(alpha, next, begin + 2, end, band.self, band.next, band.skip,
+                           pause_out, resume);
     }
     // The first two targets have fewer sources; the last two have sources whose rows are cut by
     // the end of the take. Recompute those with the exact rows (O(takes) per frame).
@@ -155,12 +162,12 @@ void HmmForward::transition(const float* alpha, float* next) const noexcept {
     for (const int i : edges) {
       if (i < begin || i >= end) continue;
       float value = uniform ? pause_out : pause_out * resume[i];
-      for (int d = 0; d <= 2 && i - d >= begin; ++d) value += alpha[i - d] * row(i - d).band[d];
+      for (int d = 0; d <= 2 && i - d >= begin; ++d) value += alpha[i - d] * row(i - d, band).band[d];
       next[i] = value;
     }
     if (jump) {
-      into_pause += alpha[end - 1] * (next_ + skip_);
-      if (end - 2 >= begin) into_pause += alpha[end - 2] * skip_;
+      into_pause += alpha[end - 1] * (band.next + band.skip);
+      if (end - 2 >= begin) into_pause += alpha[end - 2] * band.skip;
     }
   }
   next[num_states] = into_pause;
@@ -182,14 +189,15 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
 
   // Input slower than the template (or late): the HMM runs at the template rate, so the band is
   // applied once per elapsed template frame before the emission.
+  const BandProbabilities band = band_for(context.tempo_.tempo());
   for (int s = 0; s < result.steps; ++s) {
-    transition(context.alpha_.data(), context.scratch_.data());
+    transition(context.alpha_.data(), band, context.scratch_.data());
     context.alpha_.swap(context.scratch_);
   }
 
   if (!result.missing) {
-    const float best = follow_detail::squared_distances(model.features(), features.data(), 0,
-                                                        num_states, context.distance_sq_.data());
+    const float best = follow_detail::emission_distances(
+        model, features.data(), params_.velocity_distance_cap, context.distance_sq_.data());
     result.log_likelihood = follow_detail::weigh_and_normalise(
         context.alpha_.data(), context.distance_sq_.data(), best, inv_two_sigma_sq_, num_states,
         log_pause_emission_, params_.jump_enabled, context.scratch_.data());
@@ -207,6 +215,12 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   follow_detail::decide(model, alpha, 1.0f, alpha[num_states], context.previous_state_,
                         result.steps, params_.confidence_window_frames, result);
   result.lost = result.missing ? context.previous_lost_ : (result.lost || result.in_pause);
+  if (params_.tempo_adaptive) {
+    const bool band_move = !result.missing && !result.lost && !result.jumped;
+    context.tempo_.update(context.previous_state_, result.state, result.steps, dt_s, band_move,
+                          tempo_limits_);
+  }
+  result.tempo = context.tempo_.tempo();
 
   context.total_log_likelihood_ += result.log_likelihood;
   ++context.frames_;

@@ -29,50 +29,23 @@ Result<NaiveHmmFollower> NaiveHmmFollower::create(const TemplateModel& model,
   // that the tests comparing the two check the factorisation of eq. 11.
   const float total =
       params.self_prob + params.next_prob + params.skip_prob + (jump ? params.leave_prob : 0.0f);
-  const float self = params.self_prob / total;
-  const float next = params.next_prob / total;
-  const float skip = params.skip_prob / total;
-  const float leave = jump ? params.leave_prob / total : 0.0f;
+  follower.band_ = {params.self_prob / total, params.next_prob / total, params.skip_prob / total};
+  follower.leave_ = jump ? params.leave_prob / total : 0.0f;
+  follower.tempo_limits_ = {params.tempo_time_constant_s, params.min_tempo, params.max_tempo};
   double resume_sum = 0.0;
   for (const float w : params.resume_weights) resume_sum += w;
 
   auto& a = follower.transition_to_from_;
   a.setZero(num_states + 1, num_states + 1);
-  for (int j = 0; j <= num_states; ++j) {  // from
-    const int end = j < num_states ? model.take_end(model.take_of(j)) : 0;
-    for (int i = 0; i <= num_states; ++i) {  // to
-      float p = 0.0f;
-      if (j == pause) {
-        if (i == pause) {
-          p = jump ? params.pause_stay_prob : 1.0f;  // A_NN (eq. 6)
-        } else if (jump) {                           // (1 - A_NN) R_i (eq. 6)
-          const float r = params.resume_weights.empty()
-                              ? 1.0f / static_cast<float>(num_states)
-                              : static_cast<float>(params.resume_weights[i] / resume_sum);
-          p = (1.0f - params.pause_stay_prob) * r;
-        }
-      } else if (i == pause) {
-        // L_j (eq. 5); at the end of a take, next/skip lead into the pause state.
-        if (jump) p = leave + (j + 1 >= end ? next : 0.0f) + (j + 2 >= end ? skip : 0.0f);
-      } else if (i == j) {
-        p = self;  // B, eq. 4
-      } else if (i == j + 1 && i < end) {
-        p = next;
-      } else if (i == j + 2 && i < end) {
-        p = skip;
-      }
-      a(i, j) = p;
-    }
-    if (!jump && j < num_states) {
-      // Left-to-right: renormalise what stays in the take; nothing left -> keep the mass.
-      const float sum = a.col(j).sum();
-      if (sum > 0.0f) {
-        a.col(j) /= sum;
-      } else {
-        a(j, j) = 1.0f;
-      }
-    }
+  // Out of the pause state (eq. 6): stay A_NN, resume (1 - A_NN) R_i.
+  a(pause, pause) = jump ? params.pause_stay_prob : 1.0f;
+  for (int i = 0; jump && i < num_states; ++i) {
+    const float r = params.resume_weights.empty()
+                        ? 1.0f / static_cast<float>(num_states)
+                        : static_cast<float>(params.resume_weights[i] / resume_sum);
+    a(i, pause) = (1.0f - params.pause_stay_prob) * r;
   }
+  follower.set_template_columns(follower.band_);
 
   const double dims = model.num_dims();
   const double sigma = params.emission_sigma;
@@ -90,12 +63,44 @@ Result<NaiveHmmFollower> NaiveHmmFollower::create(const TemplateModel& model,
   return follower;
 }
 
+void NaiveHmmFollower::set_template_columns(const BandProbabilities& band) noexcept {
+  const TemplateModel& model = *model_;
+  const int num_states = model.num_states();
+  const int pause = num_states;
+  const bool jump = params_.jump_enabled;
+  auto& a = transition_to_from_;
+  // Out of template state j (eq. 4-5): only these four entries of column j can be non-zero.
+  for (int j = 0; j < num_states; ++j) {
+    const int end = model.take_end(model.take_of(j));
+    a(j, j) = band.self;
+    if (j + 1 < end) a(j + 1, j) = band.next;
+    if (j + 2 < end) a(j + 2, j) = band.skip;
+    // L_j; at the end of a take, next/skip lead into the pause state.
+    a(pause, j) = jump ? leave_ + (j + 1 >= end ? band.next : 0.0f) +
+                             (j + 2 >= end ? band.skip : 0.0f)
+                       : 0.0f;
+    if (!jump) {
+      // Left-to-right: renormalise what stays in the take; nothing left -> keep the mass.
+      const float sum = a(j, j) + (j + 1 < end ? a(j + 1, j) : 0.0f) +
+                        (j + 2 < end ? a(j + 2, j) : 0.0f);
+      if (sum > 0.0f) {
+        a(j, j) /= sum;
+        if (j + 1 < end) a(j + 1, j) /= sum;
+        if (j + 2 < end) a(j + 2, j) /= sum;
+      } else {
+        a(j, j) = 1.0f;
+      }
+    }
+  }
+}
+
 void NaiveHmmFollower::reset() noexcept {
   const int num_states = model_->num_states();
   std::fill(alpha_.begin(), alpha_.end() - 1, 1.0f / static_cast<float>(num_states));
   alpha_.back() = 0.0f;
   previous_state_ = -1;
   previous_lost_ = false;
+  tempo_.reset();
 }
 
 FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s) noexcept {
@@ -108,6 +113,7 @@ FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s
                    !follow_detail::all_finite(features);
   result.steps = follow_detail::steps_for(dt_s, model.frame_rate_hz(), params_.max_steps_per_frame);
 
+  if (params_.tempo_adaptive) set_template_columns(tilt_band(band_, tempo_.tempo()));
   const Eigen::Index size = num_states + 1;
   for (int s = 0; s < result.steps; ++s) {
     // eq. 10's sum over every pair (j, i): O(M^2).
@@ -117,8 +123,8 @@ FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s
   }
 
   if (!result.missing) {
-    const float best = follow_detail::squared_distances(model.features(), features.data(), 0,
-                                                        num_states, distance_sq_.data());
+    const float best = follow_detail::emission_distances(
+        model, features.data(), params_.velocity_distance_cap, distance_sq_.data());
     result.log_likelihood = follow_detail::weigh_and_normalise(
         alpha_.data(), distance_sq_.data(), best, inv_two_sigma_sq_, num_states,
         log_pause_emission_, params_.jump_enabled, scratch_.data());
@@ -133,6 +139,11 @@ FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s
   follow_detail::decide(model, alpha_.data(), 1.0f, alpha_[static_cast<std::size_t>(num_states)],
                         previous_state_, result.steps, params_.confidence_window_frames, result);
   result.lost = result.missing ? previous_lost_ : (result.lost || result.in_pause);
+  if (params_.tempo_adaptive) {
+    const bool band_move = !result.missing && !result.lost && !result.jumped;
+    tempo_.update(previous_state_, result.state, result.steps, dt_s, band_move, tempo_limits_);
+  }
+  result.tempo = tempo_.tempo();
   previous_state_ = result.state;
   previous_lost_ = result.lost;
   return result;

@@ -14,7 +14,7 @@ Error model_error(const std::string& reason) { return make_error("template model
 }  // namespace
 
 Result<TemplateModel> TemplateModel::build(FeatureMatrix features, std::vector<int> take_start,
-                                           double frame_rate_hz) {
+                                           double frame_rate_hz, int velocity_dims) {
   const Eigen::Index num_frames = features.rows();
   const Eigen::Index num_dims = features.cols();
   if (num_frames == 0 || num_dims == 0) {
@@ -23,6 +23,10 @@ Result<TemplateModel> TemplateModel::build(FeatureMatrix features, std::vector<i
   }
   if (num_frames >= (Eigen::Index{1} << 30)) {
     return model_error("too many template frames: " + std::to_string(num_frames));
+  }
+  if (velocity_dims < 0 || velocity_dims > num_dims) {
+    return model_error("velocity_dims must be in [0, " + std::to_string(num_dims) + "], got " +
+                       std::to_string(velocity_dims));
   }
   if (!std::isfinite(frame_rate_hz) || frame_rate_hz <= 0.0) {
     return model_error("frame rate must be positive, got " + std::to_string(frame_rate_hz));
@@ -58,12 +62,14 @@ Result<TemplateModel> TemplateModel::build(FeatureMatrix features, std::vector<i
   model.features_ = std::move(features);
   model.take_start_ = std::move(take_start);
   model.frame_rate_hz_ = frame_rate_hz;
+  model.velocity_dims_ = velocity_dims;
   return model;
 }
 
 Result<TemplateModel> TemplateModel::build(std::span<const float> features_row_major,
                                            int num_frames, int num_dims,
-                                           std::vector<int> take_start, double frame_rate_hz) {
+                                           std::vector<int> take_start, double frame_rate_hz,
+                                           int velocity_dims) {
   if (num_frames <= 0 || num_dims <= 0) {
     return model_error("no template features (" + std::to_string(num_frames) + " frames x " +
                        std::to_string(num_dims) + " dimensions)");
@@ -76,7 +82,7 @@ Result<TemplateModel> TemplateModel::build(std::span<const float> features_row_m
   }
   FeatureMatrix features =
       Eigen::Map<const FeatureMatrix>(features_row_major.data(), num_frames, num_dims);
-  return build(std::move(features), std::move(take_start), frame_rate_hz);
+  return build(std::move(features), std::move(take_start), frame_rate_hz, velocity_dims);
 }
 
 int TemplateModel::take_of(int state) const {

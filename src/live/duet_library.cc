@@ -102,8 +102,11 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
   }
   library.normalizer_ = FeatureNormalizer::fit(all, options.features);
   library.normalizer_.apply(all);
-  Result<TemplateModel> model = TemplateModel::build(
-      std::move(all), std::move(take_start), library.takes_[0].template_motion.clip.frame_rate());
+  // The feature vector ends with its velocity blocks (root velocity, effector speed).
+  const int velocity_dims = FeatureSpec::kRootVelocityDims + FeatureSpec::kEffectorSpeedDims;
+  Result<TemplateModel> model =
+      TemplateModel::build(std::move(all), std::move(take_start),
+                           library.takes_[0].template_motion.clip.frame_rate(), velocity_dims);
   if (!model) return model.error();
   library.model_ = std::make_shared<const TemplateModel>(std::move(model).value());
   return library;

@@ -42,6 +42,8 @@ struct Scenario {
   const char* name;
   std::vector<int> takes;
   FollowParams params;
+  int velocity_dims = 0;  // trailing dimensions whose distance is capped
+  bool tempo_moves = false;  // the replay must move the tempo-centred band away from 1
 };
 
 std::vector<Scenario> scenarios() {
@@ -50,6 +52,19 @@ std::vector<Scenario> scenarios() {
   // Short takes exercise every boundary case of the band (1, 2 and 3 frames).
   out.push_back({"default, library", {90, 1, 2, 3, 60, 84}, FollowParams{}});
   out.push_back({"paper", {120, 120}, FollowParams::paper()});
+  // The defaults' pause distance is below this replay's noise (the pause state wins and nothing
+  // is a band move); a larger one lets the band follow the replay's 0.6x-1.6x tempo.
+  FollowParams tempo;
+  tempo.pause_distance_per_dim = 0.05f;
+  tempo.lost_distance_per_dim = 1.0f;
+  out.push_back({"tempo-centred band", {200, 90}, tempo, 0, true});
+  FollowParams fixed_band;
+  fixed_band.tempo_adaptive = false;
+  out.push_back({"fixed band", {120, 60}, fixed_band});
+  // The synthetic features are about unit size per dimension: a cap of 0.5 bites often.
+  FollowParams capped;
+  capped.velocity_distance_cap = 0.5f;
+  out.push_back({"velocity cap", {150, 70}, capped, 4});
   out.push_back({"left to right", {100, 3, 1, 2, 90}, FollowParams::left_to_right()});
   FollowParams resume;
   resume.resume_weights.resize(200);
@@ -67,7 +82,7 @@ std::vector<Scenario> scenarios() {
 TEST(ForwardEquivalence, TransitionMatricesAgree) {
   for (const Scenario& s : scenarios()) {
     SCOPED_TRACE(s.name);
-    const TemplateModel model = test::make_model(s.takes, 12, 5);
+    const TemplateModel model = test::make_model(s.takes, 12, 5, 60.0, s.velocity_dims);
     expect_same_transitions(model, s.params);
   }
 }
@@ -75,7 +90,7 @@ TEST(ForwardEquivalence, TransitionMatricesAgree) {
 TEST(ForwardEquivalence, SameAlphaAndEstimatesOverJumpsRatesAndMissingFrames) {
   for (const Scenario& s : scenarios()) {
     SCOPED_TRACE(s.name);
-    const TemplateModel model = test::make_model(s.takes, 16, 11);
+    const TemplateModel model = test::make_model(s.takes, 16, 11, 60.0, s.velocity_dims);
     HmmFollower fast = HmmFollower::create(model, s.params).value();
     NaiveHmmFollower naive = NaiveHmmFollower::create(model, s.params).value();
     std::mt19937 rng(42);
@@ -85,6 +100,7 @@ TEST(ForwardEquivalence, SameAlphaAndEstimatesOverJumpsRatesAndMissingFrames) {
 
     double position = anywhere(rng);
     int agree = 0;
+    float tempo_range = 0.0f;
     const int frames = 400;
     for (int t = 0; t < frames; ++t) {
       if (t % 60 == 59) position = anywhere(rng);  // jump elsewhere (another take, too)
@@ -111,6 +127,8 @@ TEST(ForwardEquivalence, SameAlphaAndEstimatesOverJumpsRatesAndMissingFrames) {
       EXPECT_EQ(a.in_pause, b.in_pause);
       EXPECT_NEAR(a.log_likelihood, b.log_likelihood, 1e-3 + 1e-5 * std::abs(a.log_likelihood));
       EXPECT_NEAR(a.confidence, b.confidence, 1e-4f);
+      EXPECT_NEAR(a.tempo, b.tempo, 1e-4f);
+      tempo_range = std::max(tempo_range, std::abs(a.tempo - 1.0f));
       // Equal estimates, unless two states tie within float noise.
       if (a.state == b.state) {
         ++agree;
@@ -121,6 +139,13 @@ TEST(ForwardEquivalence, SameAlphaAndEstimatesOverJumpsRatesAndMissingFrames) {
       }
     }
     EXPECT_GE(agree, frames - 2);
+    // The tempo-centred band was exercised (the replay runs at 0.6x-1.6x), or is off.
+    if (s.tempo_moves) {
+      EXPECT_GT(tempo_range, 0.05f);
+    }
+    if (!s.params.tempo_adaptive) {
+      EXPECT_EQ(tempo_range, 0.0f);
+    }
   }
 }
 

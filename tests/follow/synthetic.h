@@ -33,8 +33,9 @@ inline FeatureMatrix smooth_walk(int frames, int dims, unsigned seed) {
 // plus white noise of 0.03 so that no two frames are alike. With D = 60, neighbouring frames are
 // about 0.45 apart in squared distance, frames 6 apart (100 ms) about 11, frames 30 apart about
 // 130 (decorrelated: 2 D).
+// velocity_dims: how many trailing dimensions the model treats as velocities (capped distance).
 inline TemplateModel make_model(const std::vector<int>& take_lengths, int dims, unsigned seed,
-                                double fps = 60.0) {
+                                double fps = 60.0, int velocity_dims = 0) {
   int total = 0;
   std::vector<int> starts;
   for (const int n : take_lengths) {
@@ -55,7 +56,7 @@ inline TemplateModel make_model(const std::vector<int>& take_lengths, int dims, 
   std::mt19937 rng(seed);
   std::normal_distribution<float> noise(0.0f, 0.03f);
   for (Eigen::Index i = 0; i < f.size(); ++i) f.data()[i] += noise(rng);
-  return std::move(TemplateModel::build(std::move(f), starts, fps)).value();
+  return std::move(TemplateModel::build(std::move(f), starts, fps, velocity_dims)).value();
 }
 
 // Features at fractional template position `position` (global state index), linearly

@@ -80,6 +80,10 @@ TEST(TemplateModel, RejectsBadInputWithClearMessages) {
             std::string::npos);
   EXPECT_FALSE(TemplateModel::build(ones(4, 3), {}, -60.0).ok());
   EXPECT_FALSE(TemplateModel::build(ones(4, 3), {}, std::nan("")).ok());
+  EXPECT_NE(error_of(TemplateModel::build(ones(4, 3), {}, 60.0, 4)).find("velocity_dims"),
+            std::string::npos);
+  EXPECT_FALSE(TemplateModel::build(ones(4, 3), {}, 60.0, -1).ok());
+  EXPECT_EQ(TemplateModel::build(ones(4, 3), {}, 60.0, 3).value().velocity_dims(), 3);
 
   const std::vector<float> buffer(11, 0.0f);
   EXPECT_NE(error_of(TemplateModel::build(buffer, 4, 3, {}, 60.0)).find("expected 4 frames"),
@@ -94,6 +98,10 @@ TEST(FollowParams, DefaultsAndPresetsAreValid) {
   EXPECT_TRUE(FollowParams::paper().validate(10).ok());
   EXPECT_TRUE(FollowParams::left_to_right().validate(10).ok());
   EXPECT_FALSE(FollowParams::left_to_right().jump_enabled);
+  EXPECT_FALSE(FollowParams::paper().tempo_adaptive);  // the paper's band is fixed
+  FollowParams uncapped;
+  uncapped.velocity_distance_cap = std::numeric_limits<float>::infinity();
+  EXPECT_TRUE(uncapped.validate(10).ok());
 }
 
 TEST(FollowParams, RejectsBadValues) {
@@ -113,6 +121,11 @@ TEST(FollowParams, RejectsBadValues) {
   check([](FollowParams& p) { p.pause_distance_per_dim = -1.0f; }, "pause_distance_per_dim");
   check([](FollowParams& p) { p.lost_distance_per_dim = std::nanf(""); }, "lost_distance");
   check([](FollowParams& p) { p.confidence_window_frames = -1; }, "confidence_window");
+  check([](FollowParams& p) { p.velocity_distance_cap = -0.1f; }, "velocity_distance_cap");
+  check([](FollowParams& p) { p.tempo_time_constant_s = 0.0; }, "tempo_time_constant_s");
+  check([](FollowParams& p) { p.max_tempo = 2.0f; }, "tempo range");
+  check([](FollowParams& p) { p.min_tempo = 0.0f; }, "tempo range");
+  check([](FollowParams& p) { p.skip_prob = 0.0f; }, "tempo_adaptive needs");
   check([](FollowParams& p) { p.max_steps_per_frame = 0; }, "max_steps_per_frame");
   check([](FollowParams& p) { p.resume_weights.assign(9, 1.0f); }, "resume_weights has 9");
   check([](FollowParams& p) { p.resume_weights.assign(10, 0.0f); }, "sum to zero");

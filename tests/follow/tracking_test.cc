@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <memory>
 #include <random>
 #include <vector>
@@ -131,6 +132,68 @@ TEST_F(TrackingTest, FollowsFasterAndSlowerReplaysWithNoise) {
     OnlineDtwTracker dtw = OnlineDtwTracker::create(model_, {}).value();
     EXPECT_LE(misses(replay(dtw, model_, frames, 0.1f), 2), input_frames / 50);
   }
+}
+
+// Mean of (estimate - truth) in frames after the first second: the lag (< 0) or lead (> 0).
+double mean_offset(const Trace& r) {
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t t = 60; t < r.results.size(); ++t, ++n) sum += r.results[t].state - r.truth[t];
+  return n > 0 ? sum / n : 0.0;
+}
+
+TEST_F(TrackingTest, TempoCentredBandRemovesTheLagOfAWeakEmission) {
+  // A weak emission (large sigma, noisy input) leaves the band's prior to set the pace: a fixed
+  // band, centred on the template's tempo, lags behind a fast dancer and runs ahead of a slow
+  // one; the tempo-centred band learns the dancer's tempo and removes most of that offset.
+  FollowParams adaptive;
+  adaptive.emission_sigma = 4.0f;
+  adaptive.pause_distance_per_dim = 50.0f;
+  adaptive.lost_distance_per_dim = 1e9f;
+  FollowParams fixed = adaptive;
+  fixed.tempo_adaptive = false;
+  for (const double speed : {1.5, 0.6}) {
+    SCOPED_TRACE(speed);
+    const std::vector<Frame> frames =
+        perform({{0, static_cast<int>(590 / speed), speed}}, 1.0 / 60);
+    HmmFollower with = HmmFollower::create(model_, adaptive).value();
+    HmmFollower without = HmmFollower::create(model_, fixed).value();
+    const Trace a = replay(with, model_, frames, 0.5f);
+    const Trace f = replay(without, model_, frames, 0.5f);
+    const double fixed_offset = mean_offset(f);
+    const double adaptive_offset = mean_offset(a);
+    EXPECT_GT(std::abs(fixed_offset), 2.0);  // the effect exists in this set-up
+    EXPECT_LT(std::abs(adaptive_offset), 0.5 * std::abs(fixed_offset));
+    EXPECT_NEAR(a.results.back().tempo, speed, 0.1);
+    EXPECT_EQ(f.results.back().tempo, 1.0f);
+  }
+}
+
+TEST(VelocityCap, LetsThePostureDecideWhileTheVelocitiesAreCorrupt) {
+  // The last 6 of 60 dimensions are velocities. For 6 frames they are far off (a tracking glitch,
+  // or the window after a dancer's jump): uncapped, they pull the estimate elsewhere; capped, the
+  // posture keeps it where it is.
+  const TemplateModel model = test::make_model({600}, kDims, 8, 60.0, 6);
+  FollowParams capped;
+  capped.velocity_distance_cap = 0.5f;
+  FollowParams uncapped = capped;
+  uncapped.velocity_distance_cap = std::numeric_limits<float>::infinity();
+  HmmFollower with = HmmFollower::create(model, capped).value();
+  HmmFollower without = HmmFollower::create(model, uncapped).value();
+  int misses_with = 0, misses_without = 0;
+  for (int t = 0; t < 400; ++t) {
+    std::vector<float> phi = test::features_at(model, t);
+    if (t >= 200 && t < 206) {
+      for (int d = kDims - 6; d < kDims; ++d) phi[static_cast<std::size_t>(d)] += 8.0f;
+    }
+    const FollowResult a = with.step(phi, 1.0 / 60);
+    const FollowResult b = without.step(phi, 1.0 / 60);
+    if (t < 3) continue;
+    misses_with += std::abs(a.state - t) > 1;
+    misses_without += std::abs(b.state - t) > 1;
+  }
+  EXPECT_EQ(misses_with, 0);
+  EXPECT_GE(misses_without, 3);
 }
 
 TEST_F(TrackingTest, ThirtyHertzInputAgainstSixtyHertzTemplate) {

@@ -16,6 +16,7 @@
 
 #include "duet/base/result.h"
 #include "duet/follow/follow_params.h"
+#include "duet/follow/tempo_band.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tracker.h"
 
@@ -40,6 +41,8 @@ class ForwardContext {
   // The normalised forward variable after the last step (posterior over M + 1 states).
   std::span<const float> alpha() const { return alpha_; }
   double total_log_likelihood() const { return total_log_likelihood_; }
+  // The tempo the band is centred on (1 until the dancer has shown another one).
+  float tempo() const { return tempo_.tempo(); }
   long long frames() const { return frames_; }
 
  private:
@@ -53,6 +56,7 @@ class ForwardContext {
   long long frames_ = 0;
   int previous_state_ = -1;
   bool previous_lost_ = false;
+  TempoEstimator tempo_;
 };
 
 class HmmForward {
@@ -78,7 +82,11 @@ class HmmForward {
     float band[3];
     float leave;
   };
-  Row row(int j) const noexcept;
+  Row row(int j) const noexcept { return row(j, band_); }
+  // The same with the band tilted to a tempo (tempo_band.h), as step() uses it.
+  Row row(int j, const BandProbabilities& band) const noexcept;
+  // The band for a tempo: tilted when params().tempo_adaptive, the fixed band otherwise.
+  BandProbabilities band_for(float tempo) const noexcept;
   // A(N -> N) and A(N -> i) (eq. 6).
   float pause_stay() const { return pause_stay_; }
   float resume(int i) const noexcept;
@@ -86,11 +94,13 @@ class HmmForward {
  private:
   HmmForward() = default;
   // alpha_{t-1} -> sum_j alpha_{t-1}(j) A(j -> i) for every i, in O(M) (the bracket of eq. 11).
-  void transition(const float* alpha, float* next) const noexcept;
+  void transition(const float* alpha, const BandProbabilities& band, float* next) const noexcept;
 
   const TemplateModel* model_ = nullptr;
   FollowParams params_;
-  float self_ = 0.0f, next_ = 0.0f, skip_ = 0.0f, leave_ = 0.0f;  // normalised, interior rows
+  BandProbabilities band_;  // normalised with leave_: the interior rows at the template's tempo
+  float leave_ = 0.0f;
+  TempoLimits tempo_limits_;
   float pause_stay_ = 0.0f;
   std::vector<float> resume_;  // R_i, normalised; empty = uniform 1/M
   float inv_two_sigma_sq_ = 0.0f;

@@ -11,6 +11,7 @@
 
 #include "duet/base/result.h"
 #include "duet/follow/follow_params.h"
+#include "duet/follow/tempo_band.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tracker.h"
 
@@ -32,12 +33,18 @@ class NaiveHmmFollower final : public Tracker {
 
  private:
   NaiveHmmFollower() = default;
+  // Writes the columns out of the template states for this band (the pause column is fixed).
+  void set_template_columns(const BandProbabilities& band) noexcept;
 
   const TemplateModel* model_ = nullptr;
   FollowParams params_;
   // Row i holds A(j -> i) for every j, so the predicted alpha is one row-major matrix-vector
   // product over all pairs (eq. 10).
   Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> transition_to_from_;
+  BandProbabilities band_;  // normalised together with leave_, at the template's tempo
+  float leave_ = 0.0f;
+  TempoLimits tempo_limits_;
+  TempoEstimator tempo_;
   float inv_two_sigma_sq_ = 0.0f;
   float log_pause_emission_ = 0.0f;
   float lost_distance_sq_ = 0.0f;

@@ -26,17 +26,22 @@ class TemplateModel {
   //   covers states [take_start[k], take_start[k+1]) and the last take ends at M. Empty means one
   //   take.
   // frame_rate_hz: rate of the template frames (the HMM runs at this rate), > 0.
+  // velocity_dims: how many of the last dimensions are velocities (finite differences of the
+  //   input, which a glitch or a jump in the input corrupts for a while; the HMM bounds their
+  //   share of the distance, FollowParams::velocity_distance_cap). In [0, D].
   static Result<TemplateModel> build(FeatureMatrix features, std::vector<int> take_start,
-                                     double frame_rate_hz);
+                                     double frame_rate_hz, int velocity_dims = 0);
   // Same, from a row-major buffer of num_frames * num_dims floats (copied).
   static Result<TemplateModel> build(std::span<const float> features_row_major, int num_frames,
                                      int num_dims, std::vector<int> take_start,
-                                     double frame_rate_hz);
+                                     double frame_rate_hz, int velocity_dims = 0);
 
   int num_states() const { return static_cast<int>(features_.rows()); }  // M
   int num_dims() const { return static_cast<int>(features_.cols()); }    // D
   int num_takes() const { return static_cast<int>(take_start_.size()) - 1; }
   double frame_rate_hz() const { return frame_rate_hz_; }
+  // The last velocity_dims() of the D dimensions are velocities (see build).
+  int velocity_dims() const { return velocity_dims_; }
 
   const FeatureMatrix& features() const { return features_; }
   // First state of take k, and one past its last state.
@@ -51,6 +56,7 @@ class TemplateModel {
   FeatureMatrix features_;
   std::vector<int> take_start_;  // num_takes + 1 entries; the last one is M
   double frame_rate_hz_ = 0.0;
+  int velocity_dims_ = 0;
 };
 
 }  // namespace duet

@@ -25,6 +25,9 @@ struct FollowResult {
   double log_likelihood = 0.0;
   // min_i ||phi - phi_i||^2 / D over all states (online DTW: over its window); -1 if missing.
   float best_distance_per_dim = 0.0f;
+  // The dancer's tempo as the tracker sees it (template frames per template frame of input time,
+  // 1 = the template's tempo); 1 for trackers that do not estimate one.
+  float tempo = 1.0f;
 };
 
 // A per-frame follower. step() is the live path: it allocates nothing, throws nothing and does no

@@ -1,0 +1,107 @@
+// The tempo-centred band (tempo_band.h): the tilt reaches the asked mean and stays a valid band;
+// the estimator learns a steady tempo, ignores what is not a band move and keeps its range.
+#include "duet/follow/tempo_band.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace duet {
+namespace {
+
+constexpr BandProbabilities kDefaultBand{0.30f, 0.35f, 0.30f};  // FollowParams{} without leave
+
+TEST(TiltBand, ReachesTheTempoAndKeepsTheTotal) {
+  for (const float tempo : {0.4f, 0.7f, 1.0f, 1.3f, 1.8f}) {
+    SCOPED_TRACE(tempo);
+    const BandProbabilities band = tilt_band(kDefaultBand, tempo);
+    EXPECT_NEAR(band.mean_advance(), tempo, 1e-4f);
+    EXPECT_NEAR(band.total(), kDefaultBand.total(), 1e-6f);
+    EXPECT_GT(band.self, 0.0f);
+    EXPECT_GT(band.next, 0.0f);
+    EXPECT_GT(band.skip, 0.0f);
+  }
+}
+
+TEST(TiltBand, IsTheIdentityAtTheBandsOwnMean) {
+  const BandProbabilities band = tilt_band(kDefaultBand, kDefaultBand.mean_advance());
+  EXPECT_NEAR(band.self, kDefaultBand.self, 1e-6f);
+  EXPECT_NEAR(band.next, kDefaultBand.next, 1e-6f);
+  EXPECT_NEAR(band.skip, kDefaultBand.skip, 1e-6f);
+}
+
+TEST(TiltBand, SlowerTempoMovesMassTowardsSelf) {
+  const BandProbabilities slow = tilt_band(kDefaultBand, 0.7f);
+  const BandProbabilities fast = tilt_band(kDefaultBand, 1.4f);
+  EXPECT_GT(slow.self, kDefaultBand.self);
+  EXPECT_LT(slow.skip, kDefaultBand.skip);
+  EXPECT_LT(fast.self, kDefaultBand.self);
+  EXPECT_GT(fast.skip, kDefaultBand.skip);
+}
+
+TEST(TiltBand, ClampsUnreachableTempiAndRejectsDegenerateBands) {
+  // A mean of 2 needs all mass on skip: clamped just inside, still finite and positive.
+  const BandProbabilities fastest = tilt_band(kDefaultBand, 5.0f);
+  EXPECT_TRUE(std::isfinite(fastest.self) && fastest.self > 0.0f);
+  EXPECT_NEAR(fastest.mean_advance(), 1.98f, 1e-3f);
+  const BandProbabilities stopped = tilt_band(kDefaultBand, -1.0f);
+  EXPECT_NEAR(stopped.mean_advance(), 0.02f, 1e-3f);
+  // Without a skip the band can only reach means below 1.
+  const BandProbabilities no_skip = tilt_band({0.4f, 0.4f, 0.0f}, 1.5f);
+  EXPECT_NEAR(no_skip.mean_advance(), 0.99f, 1e-3f);
+  EXPECT_EQ(no_skip.skip, 0.0f);
+  // Nothing to tilt: returned as it is, also for a NaN tempo.
+  const BandProbabilities only_self = tilt_band({0.5f, 0.0f, 0.0f}, 1.0f);
+  EXPECT_EQ(only_self.self, 0.5f);
+  const BandProbabilities nan_tempo = tilt_band(kDefaultBand, std::nanf(""));
+  EXPECT_EQ(nan_tempo.next, kDefaultBand.next);
+}
+
+TEST(TempoEstimator, LearnsASteadyTempo) {
+  TempoEstimator estimator;
+  const TempoLimits limits;  // 2 s memory
+  // A dancer at 1.5x: 3 frames every 2 steps, in alternation 1 and 2.
+  int state = 100;
+  for (int t = 0; t < 600; ++t) {
+    const int moved = t % 2 == 0 ? 1 : 2;
+    estimator.update(state, state + moved, 1, 1.0 / 60, true, limits);
+    state += moved;
+  }
+  EXPECT_NEAR(estimator.tempo(), 1.5f, 0.02f);
+  // A 30 Hz input (two steps per frame) at 0.7x.
+  estimator.reset();
+  EXPECT_EQ(estimator.tempo(), 1.0f);
+  double position = 0.0;
+  for (int t = 0; t < 300; ++t) {
+    const int before = static_cast<int>(position);
+    position += 1.4;
+    estimator.update(before, static_cast<int>(position), 2, 1.0 / 30, true, limits);
+  }
+  EXPECT_NEAR(estimator.tempo(), 0.7f, 0.02f);
+}
+
+TEST(TempoEstimator, IgnoresJumpsPausesAndBackwardMoves) {
+  TempoEstimator estimator;
+  const TempoLimits limits;
+  for (int t = 0; t < 200; ++t) estimator.update(t, t + 1, 1, 1.0 / 60, true, limits);
+  const float learned = estimator.tempo();
+  EXPECT_NEAR(learned, 1.0f, 1e-3f);
+  estimator.update(50, 900, 1, 1.0 / 60, true, limits);   // a jump forward
+  estimator.update(900, 20, 1, 1.0 / 60, true, limits);   // a jump back
+  estimator.update(20, 20, 1, 1.0 / 60, false, limits);   // a pause frame
+  estimator.update(-1, 20, 1, 1.0 / 60, true, limits);    // first frame: no previous state
+  estimator.update(20, 21, 1, std::nan(""), true, limits);  // broken timestamp
+  EXPECT_EQ(estimator.tempo(), learned);
+}
+
+TEST(TempoEstimator, StaysInItsRange) {
+  TempoEstimator estimator;
+  const TempoLimits limits{0.5, 0.4f, 1.8f};
+  for (int t = 0; t < 300; ++t) estimator.update(t, t, 1, 1.0 / 60, true, limits);  // frozen
+  EXPECT_FLOAT_EQ(estimator.tempo(), 0.4f);
+  for (int t = 0; t < 300; ++t) estimator.update(t, t + 2, 1, 1.0 / 60, true, limits);
+  EXPECT_FLOAT_EQ(estimator.tempo(), 1.8f);
+}
+
+}  // namespace
+}  // namespace duet
