@@ -76,6 +76,14 @@ bool finite_time(double t) { return t >= 0.0 && std::isfinite(t); }
 
 double smoothstep(double x) { return x * x * (3.0 - 2.0 * x); }
 
+// The half-life at which a critically damped offset of size x0 (decaying from rest) peaks at
+// max_speed: the peak speed is x0 * y / e with y = 2 ln 2 / half-life. At least `minimum`.
+double capped_half_life(double minimum, double x0, double max_speed) {
+  constexpr double kPeak = 2.0 * 0.69314718055994531 / 2.71828182845904524;
+  if (!(max_speed > 0.0) || !std::isfinite(x0)) return minimum;
+  return std::max(minimum, kPeak * x0 / max_speed);
+}
+
 bool finite_pose(const UserPose& user, Side side) {
   const auto s = static_cast<std::size_t>(side);
   return user.wrist_positions_ws[s].allFinite() && user.wrist_rotations_ws[s].coeffs().allFinite();
@@ -149,7 +157,10 @@ std::string PartnerParams::validate() const {
       {"smooth_rotation_half_life_s", smooth_rotation_half_life_s},
       {"smooth_translation_half_life_s", smooth_translation_half_life_s},
       {"blend_half_life_s", blend_half_life_s},
+      {"blend_max_speed_rad_s", blend_max_speed_rad_s},
+      {"ik_target_max_blend_speed_mps", ik_target_max_blend_speed_mps},
       {"ik_fade_s", ik_fade_s},
+      {"ik_target_jump_speed_mps", ik_target_jump_speed_mps},
       {"foot.height_margin_m", foot.height_margin_m},
       {"foot.speed_threshold_mps", foot.speed_threshold_mps},
       {"foot.max_offset_m", foot.max_offset_m},
@@ -247,6 +258,11 @@ void PartnerContext::reset() noexcept {
   user_heading_ = Transform();
   ik_ramp_ = {0.0, 0.0};
   ik_pair_ = {-1, -1};
+  ik_target_valid_ = {false, false};
+  ik_target_offset_ = {Vec3::Zero(), Vec3::Zero()};
+  ik_target_offset_velocity_ = {Vec3::Zero(), Vec3::Zero()};
+  ik_target_half_life_ = {0.0, 0.0};
+  blend_half_life_ = 0.0;
 }
 
 std::string_view PartnerSynthesisJob::validate() const noexcept {
@@ -291,8 +307,7 @@ bool PartnerSynthesisJob::run() const noexcept {
     std::copy(rotations_ls.begin(), rotations_ls.end(), out_r.begin());
   }
 
-  // 1. Align (5.1): the root relative to the user's heading frame; composed into the world after
-  //    blending, so a jump's offset is blended relative to the user.
+  // 1. Align (5.1): the root relative to the user's heading frame.
   Transform heading;
   if (p.align) {
     if (user->root_position_ws.allFinite() && user->root_rotation_ws.coeffs().allFinite() &&
@@ -302,31 +317,15 @@ bool PartnerSynthesisJob::run() const noexcept {
     }
     heading = ctx.user_heading_;
     const RootPlacement& placement = model->alignment().placement(frame);
-    out_t[0] = placement.position_hs;
-    out_r[0] = placement.rotation_hs;
-  }
-
-  // 2. Blend (5.3): inertialization. The source of a transition is what the blend stage showed
-  //    last frame; the offset then decays with the half-life.
-  if (p.blend) {
-    if (jumped && ctx.primed_) {
-      ctx.inertializer_.transition(ctx.blend_translations_, ctx.blend_rotations_, out_t, out_r);
-    }
-    ctx.inertializer_.update(out_t, out_r, p.blend_half_life_s, dt, out_t, out_r);
-    diagnostics.blend_offset_rad = ctx.inertializer_.max_rotation_offset();
-  } else {
-    ctx.inertializer_.reset();
-  }
-  std::copy(out_t.begin(), out_t.end(), ctx.blend_translations_.begin());
-  std::copy(out_r.begin(), out_r.end(), ctx.blend_rotations_.begin());
-
-  if (p.align) {
-    const Transform root = heading * Transform{out_r[0], out_t[0]};
+    const Transform root = heading * Transform{placement.rotation_hs, placement.position_hs};
     out_t[0] = root.translation;
     out_r[0] = root.rotation.normalized();
   }
 
-  // 3. Smooth (5.3): per joint, in quaternion space.
+  // 2. Smooth (5.3): per joint, in quaternion space. At a jump that the blend will take, the
+  //    smoother starts afresh from the new pose: the blend absorbs the whole jump at once, where a
+  //    smoother catching up over the next frames would pass its catch-up through as a spike.
+  if (p.blend && jumped) ctx.smoother_.reset();
   if (p.smooth) {
     ctx.smoother_.apply(out_t, out_r, p.smooth_rotation_half_life_s,
                         p.smooth_translation_half_life_s, dt, out_t, out_r);
@@ -334,7 +333,7 @@ bool PartnerSynthesisJob::run() const noexcept {
     ctx.smoother_.reset();
   }
 
-  // 4. Foot lock (5.3): shift the root horizontally to hold planted feet.
+  // 3. Foot lock (5.3): shift the root horizontally to hold planted feet.
   const bool need_world = p.foot_lock || p.contact;
   if (need_world) {
     forward_kinematics(skeleton, out_t, out_r, ctx.positions_ws_, ctx.rotations_ws_);
@@ -353,7 +352,7 @@ bool PartnerSynthesisJob::run() const noexcept {
     ctx.foot_locker_.reset();
   }
 
-  // 5. Contact (5.2): two-bone IK on each arm whose hand holds one of the user's, faded in/out.
+  // 4. Contact (5.2): two-bone IK on each arm whose hand holds one of the user's, faded in/out.
   if (p.contact) {
     const HandContacts& contacts = model->contacts();
     const double step = p.ik_fade_s > 0.0 ? dt / p.ik_fade_s : 1.0;
@@ -367,23 +366,57 @@ bool PartnerSynthesisJob::run() const noexcept {
           pair = candidate;
         }
       }
+      const int previous_pair = ctx.ik_pair_[r];
       if (pair >= 0) ctx.ik_pair_[r] = pair;
       double ramp = ctx.ik_ramp_[r] + (pair >= 0 ? step : -step);
       ramp = ramp < 1e-9 ? 0.0 : (ramp > 1.0 - 1e-9 ? 1.0 : ramp);  // land exactly on 0 and 1
       ctx.ik_ramp_[r] = ramp;
       const double weight = smoothstep(ctx.ik_ramp_[r]);
-      if (weight <= 0.0 || ctx.ik_pair_[r] < 0) continue;
+      if (weight <= 0.0 || ctx.ik_pair_[r] < 0) {
+        ctx.ik_target_valid_[r] = false;
+        continue;
+      }
       // During a fade-out the last contact's pair keeps driving the target, with the captured
       // offset of the current frame (stored for every frame), so a hand that lets go follows its
       // captured path while the weight falls.
       const Side ts = template_side(ctx.ik_pair_[r]);
-      if (!finite_pose(*user, ts)) continue;
+      if (!finite_pose(*user, ts)) {
+        ctx.ik_target_valid_[r] = false;
+        continue;
+      }
       const auto t = static_cast<std::size_t>(ts);
-      Vec3 target = user->wrist_positions_ws[t];
+      Vec3 raw_target = user->wrist_positions_ws[t];
       if (p.ik_target == IkTarget::kCapturedOffset) {
-        target +=
+        raw_target +=
             user->wrist_rotations_ws[t].normalized() * contacts.offset_ls(frame, ctx.ik_pair_[r]);
       }
+      // Keep the target continuous across jumps (5.3): the step of the raw target is absorbed
+      // by an offset that decays like the blend. The speed test uses at least one model frame
+      // as the interval, so a late frame followed by an early one is not taken for a jump.
+      // At a jump the blend (stage 5) takes the whole change of the finished pose, IK
+      // included, so the target goes straight to the new one.
+      if (ctx.ik_target_valid_[r] && !(p.blend && jumped)) {
+        const double interval = std::max(dt, 1.0 / model->frame_rate());
+        const bool discontinuous =
+            jumped || ctx.ik_pair_[r] != previous_pair ||
+            (raw_target - ctx.ik_raw_target_[r]).norm() > p.ik_target_jump_speed_mps * interval;
+        if (discontinuous) {
+          ctx.ik_target_offset_[r] = ctx.ik_shown_target_[r] - raw_target;
+          ctx.ik_target_half_life_[r] =
+              capped_half_life(p.blend_half_life_s, ctx.ik_target_offset_[r].norm(),
+                               p.ik_target_max_blend_speed_mps);
+        } else {
+          decay_spring_damper(ctx.ik_target_offset_[r], ctx.ik_target_offset_velocity_[r],
+                              std::max(ctx.ik_target_half_life_[r], p.blend_half_life_s), dt);
+        }
+      } else {
+        ctx.ik_target_offset_[r] = Vec3::Zero();
+        ctx.ik_target_offset_velocity_[r] = Vec3::Zero();
+      }
+      const Vec3 target = raw_target + ctx.ik_target_offset_[r];
+      ctx.ik_target_valid_[r] = true;
+      ctx.ik_raw_target_[r] = raw_target;
+      ctx.ik_shown_target_[r] = target;
       const ArmRoles& arm = kArms[r];
       const auto js = static_cast<std::size_t>(roles[arm.shoulder]);
       const auto jm = static_cast<std::size_t>(roles[arm.elbow]);
@@ -411,6 +444,37 @@ bool PartnerSynthesisJob::run() const noexcept {
   } else {
     ctx.ik_ramp_ = {0.0, 0.0};
     ctx.ik_pair_ = {-1, -1};
+    ctx.ik_target_valid_ = {false, false};
+  }
+
+  // 5. Blend (5.3): inertialization of the finished pose, so a jump's change is blended whatever
+  //    stage made it (the response pose, the IK's target and weight, the foot lock's shift); an
+  //    IK applied after the blend would snap the arms to the new pose in one frame. The root is
+  //    blended relative to the user's heading frame (a jump keeps the partner with the user). The
+  //    source of a transition is what was shown last frame.
+  if (p.align) {
+    const Transform root_hs = heading.inverse() * Transform{out_r[0], out_t[0]};
+    out_t[0] = root_hs.translation;
+    out_r[0] = root_hs.rotation.normalized();
+  }
+  if (p.blend) {
+    if (jumped && ctx.primed_) {
+      ctx.inertializer_.transition(ctx.blend_translations_, ctx.blend_rotations_, out_t, out_r);
+      ctx.blend_half_life_ = capped_half_life(
+          p.blend_half_life_s, ctx.inertializer_.max_rotation_offset(), p.blend_max_speed_rad_s);
+    }
+    ctx.inertializer_.update(out_t, out_r, std::max(ctx.blend_half_life_, p.blend_half_life_s),
+                             dt, out_t, out_r);
+    diagnostics.blend_offset_rad = ctx.inertializer_.max_rotation_offset();
+  } else {
+    ctx.inertializer_.reset();
+  }
+  std::copy(out_t.begin(), out_t.end(), ctx.blend_translations_.begin());
+  std::copy(out_r.begin(), out_r.end(), ctx.blend_rotations_.begin());
+  if (p.align) {
+    const Transform root = heading * Transform{out_r[0], out_t[0]};
+    out_t[0] = root.translation;
+    out_r[0] = root.rotation.normalized();
   }
 
   ctx.primed_ = true;

@@ -329,6 +329,91 @@ TEST(PartnerSynthesis, BlendHidesAJump) {
   }
 }
 
+TEST(PartnerSynthesis, BlendTurnsNoJointFasterThanItsCap) {
+  Duet duet(400, 0, 0);
+  // After frame 100 every joint is turned by 2.5 rad: a big jump.
+  for (int f = 100; f < 400; ++f) {
+    for (Quat& q : duet.follower.rotations_ls(f)) q = quat_from_axis_angle(Vec3::UnitZ(), 2.5) * q;
+  }
+  duet.rebuild();
+  const std::size_t shoulder = static_cast<std::size_t>(duet.roles[Role::kLeftShoulder]);
+  for (const double cap : {4.0, 0.0}) {
+    PartnerParams params = only(true, false, false, false, true);
+    params.blend_max_speed_rad_s = cap;  // 0: no cap, the plain 0.1 s half-life
+    Runner run(duet.model, params);
+    Quat previous = Quat::Identity();
+    double fastest = 0.0;
+    for (int i = 0; i < 330; ++i) {
+      const int frame = i < 50 ? i : 70 + i;
+      run.step(duet.follower, frame, user_from(duet.leader, i, duet.roles), i == 50);
+      if (i > 0) fastest = std::max(fastest, run.r[shoulder].angularDistance(previous) / kDt);
+      previous = run.r[shoulder];
+    }
+    if (cap > 0.0) {
+      EXPECT_LT(fastest, 1.05 * cap);  // the offset alone, the pose itself stands still
+      EXPECT_GT(fastest, 0.8 * cap);
+    } else {
+      EXPECT_GT(fastest, 2.0 * 4.0);  // 0.51 * 2.5 rad / 0.1 s = 12.8 rad/s
+    }
+    EXPECT_LT(run.r[shoulder].angularDistance(duet.follower.rotations_ls(399)[shoulder]), 1e-4);
+  }
+}
+
+TEST(PartnerSynthesis, BlendCoversTheContactIkAtAJump) {
+  // In contact throughout; after frame 100 the captured follower stands 0.15 m further along x,
+  // so at the jump both the response pose and the IK target move.
+  const Vec3 grip(0.0, 0.0, 0.04);
+  Duet duet(220, 0, 220, grip);
+  for (int f = 100; f < 220; ++f) duet.follower.translations_ls(f)[0] += Vec3(0.15, 0, 0);
+  duet.rebuild();
+  const int left_right = hand_pair(Side::kLeft, Side::kRight);
+  ASSERT_TRUE(duet.model.contacts().in_contact(50, left_right));
+  ASSERT_TRUE(duet.model.contacts().in_contact(150, left_right));
+  const std::size_t wrist = duet.wrist(Role::kRightWrist);
+  Runner run(duet.model, only(true, true, false, false, true));
+  Vec3 previous = Vec3::Zero();
+  double fastest = 0.0;
+  for (int i = 0; i < 140; ++i) {
+    const int frame = i < 50 ? i : 70 + i;
+    run.step(duet.follower, frame, user_from(duet.leader, i, duet.roles), i == 50);
+    const Vec3 now = run.world().positions[wrist];
+    if (i > 20) fastest = std::max(fastest, (now - previous).norm());
+    previous = now;
+  }
+  // The IK ran before the blend, so the blend takes its change too: no 0.15 m snap of the hand.
+  EXPECT_LT(fastest, 0.03);
+  EXPECT_LT(run.info.ik_error_m[1], 1e-6);  // and it lands on the new target
+  EXPECT_LT(run.info.blend_offset_rad, 1e-4);
+}
+
+TEST(PartnerSynthesis, ContactTargetStaysContinuousWhenTheUsersWristTeleports) {
+  const Vec3 grip(0.0, 0.0, 0.04);
+  Duet duet(200, 0, 200, grip);
+  const std::size_t wrist = duet.wrist(Role::kRightWrist);
+  for (const double jump_speed : {10.0, 1e9}) {
+    PartnerParams params = only(true, true, false, false, false);
+    params.ik_target_jump_speed_mps = jump_speed;  // 1e9: never taken for a teleport
+    Runner run(duet.model, params);
+    Vec3 previous = Vec3::Zero();
+    double fastest = 0.0;
+    for (int f = 0; f < 200; ++f) {
+      UserPose user = user_from(duet.leader, f, duet.roles);
+      // From frame 100 on the sensor puts the user's left wrist 0.3 m higher (no follower jump).
+      if (f >= 100) user.wrist_positions_ws[0] += Vec3(0, 0.3, 0);
+      run.step(duet.follower, f, user);
+      const Vec3 now = run.world().positions[wrist];
+      if (f > 20) fastest = std::max(fastest, (now - previous).norm());
+      previous = now;
+    }
+    if (jump_speed < 1e6) {
+      EXPECT_LT(fastest, 0.05);  // at most ~2 m/s
+    } else {
+      EXPECT_GT(fastest, 0.2);  // snapped
+    }
+    EXPECT_LT(run.info.ik_error_m[1], 1e-6);
+  }
+}
+
 TEST(PartnerSynthesis, FootLockHoldsASlidingFoot) {
   Duet duet(120, 0, 0);
   // The captured follower slides sideways at 0.1 m/s with her feet on the floor.

@@ -106,13 +106,29 @@ struct PartnerParams {
   double smooth_rotation_half_life_s = 0.015;
   double smooth_translation_half_life_s = 0.015;
 
-  // blend: half-life of the inertialization offset recorded at a jump.
+  // blend: half-life of the inertialization offset recorded at a jump; at least this, and long
+  // enough that the decaying offset alone turns no joint faster than blend_max_speed_rad_s (the
+  // paper's velocity-based blending, 5.3: a critically damped offset x0 peaks at a speed of
+  // x0 * 2 ln 2 / (e * half-life)). 4 rad/s (229 deg/s) is below the 99th percentile of the
+  // captured salsa partners' joint angular speeds (about 300 deg/s).
   double blend_half_life_s = 0.1;
+  double blend_max_speed_rad_s = 4.0;
 
   // contact: IK target and the time the IK weight takes to go from 0 to 1 (and back) when a
   // contact starts (ends). The weight follows a smoothstep of that linear ramp.
   IkTarget ik_target = IkTarget::kCapturedOffset;
   double ik_fade_s = 0.25;
+  // contact: the IK target is kept continuous (5.3 blending applied to the target): when the
+  // follower jumps, when a hand changes the hand it holds, or when the target moves faster than
+  // this (the user's wrist teleported: a sensor glitch, or a synthetic performance's cut), the
+  // jump of the target is absorbed by an offset that decays like the blend (blend_half_life_s).
+  // Without it the IK snaps the arm in one frame (measured: ~5000 deg/s at salsa jumps,
+  // docs/evaluation.md "Partner metrics"). Hands move at most ~3-4 m/s in the salsa takes; 10 m/s
+  // stays above a noisy sensor's wrist jitter (3 deg per joint at 30 Hz: ~3 m/s RMS). The
+  // offset's half-life is stretched like the blend's so that it alone moves the target at most
+  // ik_target_max_blend_speed_mps (about blend_max_speed_rad_s times an arm's length).
+  double ik_target_jump_speed_mps = 10.0;
+  double ik_target_max_blend_speed_mps = 2.0;
 
   // footlock thresholds and release.
   FootLockParams foot;
@@ -172,6 +188,15 @@ class PartnerContext {
   Transform user_heading_;                   // last finite user heading frame
   std::array<double, 2> ik_ramp_{0.0, 0.0};  // per response hand, linear fade state in [0, 1]
   std::array<int, 2> ik_pair_{-1, -1};       // pair that last drove that hand
+  // IK target continuity, per response hand: last frame's raw and shown targets (valid when the
+  // IK ran last frame) and the decaying offset between what is shown and the raw target.
+  std::array<bool, 2> ik_target_valid_{false, false};
+  std::array<Vec3, 2> ik_raw_target_{Vec3::Zero(), Vec3::Zero()};
+  std::array<Vec3, 2> ik_shown_target_{Vec3::Zero(), Vec3::Zero()};
+  std::array<Vec3, 2> ik_target_offset_{Vec3::Zero(), Vec3::Zero()};
+  std::array<Vec3, 2> ik_target_offset_velocity_{Vec3::Zero(), Vec3::Zero()};
+  std::array<double, 2> ik_target_half_life_{0.0, 0.0};
+  double blend_half_life_ = 0.0;  // of the current transition
 };
 
 // Per-frame diagnostics (optional output).
