@@ -1,5 +1,5 @@
 // duet eval --pair LEADER PARTNER [...] [--takes 0,2] [--cases ...] [--trackers ...] [--csv F]
-//           [--plots DIR] [tuning options]
+//           [--plots DIR] [--no-partner-metrics] [--partner-csv F] [tuning options]
 // Synthetic performances with ground truth from the real takes, followed by the HMM and the
 // baselines; prints a table (docs/evaluation.md).
 #include <fmt/format.h>
@@ -29,11 +29,15 @@ struct EvalArgs {
   std::string csv_path;
   std::string plots_dir;
   std::string trace_case = "improv-pause";
+  bool no_partner_metrics = false;
+  std::string partner_csv_path;
   CaseSettings settings;
   double noise_cm = 1.0;
   // Tuning of the "hmm" tracker (FollowParams fields); unset keeps the follower's defaults.
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
-      pause_distance, lost_distance;
+      pause_distance, lost_distance, velocity_cap;
+  std::optional<double> tempo_time_constant;
+  bool fixed_band = false;
   std::optional<int> dtw_back, dtw_ahead;
   // Feature weights (FeatureSpec); unset keeps the defaults.
   std::optional<double> posture_weight, root_velocity_weight, effector_speed_weight,
@@ -154,6 +158,10 @@ int run_eval(EvalArgs& args) {
                            [&](const EvalCase& c) { return c.name == args.trace_case; })) {
     return usage_error("--trace-case: unknown case '" + args.trace_case + "'");
   }
+  if (args.no_partner_metrics && !args.partner_csv_path.empty()) {
+    return usage_error("--partner-csv needs the partner metrics (leave out --no-partner-metrics)");
+  }
+  options.partner_metrics = !args.no_partner_metrics;
   options.takes = args.takes;
   options.seed = args.seed;
   options.trace_case = args.plots_dir.empty() ? "" : args.trace_case;
@@ -167,6 +175,9 @@ int run_eval(EvalArgs& args) {
   if (args.pause_stay) hmm.pause_stay_prob = *args.pause_stay;
   if (args.pause_distance) hmm.pause_distance_per_dim = *args.pause_distance;
   if (args.lost_distance) hmm.lost_distance_per_dim = *args.lost_distance;
+  if (args.velocity_cap) hmm.velocity_distance_cap = *args.velocity_cap;
+  if (args.tempo_time_constant) hmm.tempo_time_constant_s = *args.tempo_time_constant;
+  if (args.fixed_band) hmm.tempo_adaptive = false;
   if (Status s = hmm.validate(1); !s) return usage_error(s.error().message);
   if (args.dtw_back) options.dtw.window_back = *args.dtw_back;
   if (args.dtw_ahead) options.dtw.window_ahead = *args.dtw_ahead;
@@ -232,16 +243,24 @@ int run_eval(EvalArgs& args) {
   fmt::print(
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
-      "lost_distance {}\n\n",
+      "lost_distance {} velocity_cap {} tempo {}\n\n",
       library->takes().size(), library->model().num_states(), library->frame_rate(),
       args.library.role, takes, options.seed, hmm.self_prob, hmm.next_prob, hmm.skip_prob,
       hmm.leave_prob, hmm.pause_stay_prob, hmm.emission_sigma, hmm.pause_distance_per_dim,
-      hmm.lost_distance_per_dim);
+      hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
+      hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed");
   fmt::print("{}", format_eval_table(report.value()));
   std::fflush(stdout);
 
   if (!args.csv_path.empty()) {
     if (Status s = write_file_atomically(args.csv_path, format_eval_csv(report.value())); !s) {
+      fmt::print(stderr, "duet eval: {}\n", s.error().message);
+      return kExitFailure;
+    }
+  }
+  if (!args.partner_csv_path.empty()) {
+    if (Status s = write_file_atomically(args.partner_csv_path, format_partner_csv(report.value()));
+        !s) {
       fmt::print(stderr, "duet eval: {}\n", s.error().message);
       return kExitFailure;
     }
@@ -272,6 +291,13 @@ Command register_eval(CLI::App& app) {
   app.add_option("--csv", args->csv_path, "Write the metrics per case, tracker and take as CSV");
   app.add_option("--plots", args->plots_dir,
                  "Write PNG plots (needs gnuplot) into this directory: accuracy.png, trace.png");
+  app.add_flag("--no-partner-metrics", args->no_partner_metrics,
+               "Skip the partner metrics (by default every case x take also runs the live loop "
+               "with the hmm tracker per configuration of the corrections and scores the "
+               "synthesized partner: joint error, hand-relation error, foot slip, angular speed "
+               "after jumps, us/frame; docs/evaluation.md)");
+  app.add_option("--partner-csv", args->partner_csv_path,
+                 "Write the partner metrics per case, corrections and take as CSV");
   app.add_option("--trace-case", args->trace_case,
                  "Case whose per-frame estimates trace.png shows (default improv-pause)");
 
@@ -311,6 +337,17 @@ Command register_eval(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   tuning->add_option("--lost-distance", args->lost_distance, "lost_distance_per_dim (all trackers)")
       ->check(CLI::NonNegativeNumber);
+  tuning
+      ->add_option("--velocity-cap", args->velocity_cap,
+                   "velocity_distance_cap: most the velocity blocks add to a squared distance "
+                   "(all HMM variants; inf for none)")
+      ->check(CLI::NonNegativeNumber);
+  tuning
+      ->add_option("--tempo-time-constant", args->tempo_time_constant,
+                   "tempo_time_constant_s of the tempo-centred band (all HMM variants)")
+      ->check(CLI::PositiveNumber);
+  tuning->add_flag("--fixed-band", args->fixed_band,
+                   "Keep the band fixed at the template's tempo (tempo_adaptive = false)");
   tuning->add_option("--dtw-back", args->dtw_back, "online DTW window behind the estimate")
       ->check(CLI::NonNegativeNumber);
   tuning->add_option("--dtw-ahead", args->dtw_ahead, "online DTW window ahead of the estimate")

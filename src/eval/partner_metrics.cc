@@ -61,15 +61,22 @@ double max_joint_angular_speed_rad_s(const Skeleton& skeleton, std::span<const Q
   return largest;
 }
 
+bool foot_near_ground(const Vec3& previous_ws, const Vec3& current_ws, double ground_height_m,
+                      const FootLockParams& thresholds) {
+  const double margin = thresholds.height_margin_m;
+  return previous_ws.y() - ground_height_m <= margin && current_ws.y() - ground_height_m <= margin;
+}
+
+double horizontal_speed_mps(const Vec3& previous_ws, const Vec3& current_ws, double dt_s) {
+  if (!valid_dt(dt_s)) return 0.0;
+  const double dx = current_ws.x() - previous_ws.x(), dz = current_ws.z() - previous_ws.z();
+  return std::sqrt(dx * dx + dz * dz) / dt_s;
+}
+
 bool foot_slips(const Vec3& previous_ws, const Vec3& current_ws, double ground_height_m,
                 double dt_s, const FootLockParams& thresholds) {
-  if (!valid_dt(dt_s)) return false;
-  const double margin = thresholds.height_margin_m;
-  if (!(previous_ws.y() - ground_height_m <= margin && current_ws.y() - ground_height_m <= margin)) {
-    return false;
-  }
-  const double dx = current_ws.x() - previous_ws.x(), dz = current_ws.z() - previous_ws.z();
-  return std::sqrt(dx * dx + dz * dz) / dt_s > thresholds.speed_threshold_mps;
+  return valid_dt(dt_s) && foot_near_ground(previous_ws, current_ws, ground_height_m, thresholds) &&
+         horizontal_speed_mps(previous_ws, current_ws, dt_s) > thresholds.speed_threshold_mps;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -157,8 +164,13 @@ void add_captured_reference(const Clip& response, const JointRoles& roles,
     bool slip = false;
     for (std::size_t side = 0; side < 2; ++side) {
       const auto toe = static_cast<std::size_t>(roles[kToes[side]]);
-      slip = slip || foot_slips(positions[(fs - 1) * joints + toe], positions[fs * joints + toe],
-                                ground_heights[side], dt, options.foot);
+      const Vec3& a = positions[(fs - 1) * joints + toe];
+      const Vec3& b = positions[fs * joints + toe];
+      slip = slip || foot_slips(a, b, ground_heights[side], dt, options.foot);
+      if (foot_near_ground(a, b, ground_heights[side], options.foot)) {
+        reference.ground_speed_sum_mps += horizontal_speed_mps(a, b, dt);
+        ++reference.ground_feet;
+      }
     }
     reference.slip_frames += slip ? 1 : 0;
     ++reference.frames;
@@ -201,23 +213,31 @@ void PartnerMetricsAccumulator::add(const Performance& performance,
     if (f > 0) {
       ++slip_pairs_;
       slip_frames_ += r.slip ? 1 : 0;
+      ground_speed_sum_mps_ += r.ground_speed_sum_mps;
+      ground_feet_ += r.ground_feet;
     }
   }
   // Jump windows: frames from the jump frame to window seconds after it; frame 0 has no speed.
   for (std::size_t j = 0; j < n; ++j) {
     if (!performance.truth[j].jump) continue;
     const double end = performance.times_s[j] + options_.post_jump_window_s;
-    double largest = -1.0;
+    double largest = -1.0, true_largest = 0.0;
     for (std::size_t f = std::max<std::size_t>(j, 1); f < n && performance.times_s[f] < end; ++f) {
       largest = std::max(largest, records[f].max_angular_speed_rad_s);
+      true_largest = std::max(true_largest, records[f].true_max_angular_speed_rad_s);
     }
-    if (largest >= 0.0) jump_max_rad_s_.push_back(largest);
+    if (largest >= 0.0) {
+      jump_max_rad_s_.push_back(largest);
+      jump_true_max_rad_s_.push_back(true_largest);
+    }
   }
 }
 
 void PartnerMetricsAccumulator::add_reference(const CapturedReference& reference) {
   reference_.slip_frames += reference.slip_frames;
   reference_.frames += reference.frames;
+  reference_.ground_speed_sum_mps += reference.ground_speed_sum_mps;
+  reference_.ground_feet += reference.ground_feet;
   reference_.windows += reference.windows;
   reference_.angular_speeds_rad_s.insert(reference_.angular_speeds_rad_s.end(),
                                          reference.angular_speeds_rad_s.begin(),
@@ -231,12 +251,16 @@ void PartnerMetricsAccumulator::merge(const PartnerMetricsAccumulator& other) {
   frames_ += other.frames_;
   slip_frames_ += other.slip_frames_;
   slip_pairs_ += other.slip_pairs_;
+  ground_feet_ += other.ground_feet_;
+  ground_speed_sum_mps_ += other.ground_speed_sum_mps_;
   joint_error_sum_m_ += other.joint_error_sum_m_;
   step_us_sum_ += other.step_us_sum_;
   hand_errors_m_.insert(hand_errors_m_.end(), other.hand_errors_m_.begin(),
                         other.hand_errors_m_.end());
   jump_max_rad_s_.insert(jump_max_rad_s_.end(), other.jump_max_rad_s_.begin(),
                          other.jump_max_rad_s_.end());
+  jump_true_max_rad_s_.insert(jump_true_max_rad_s_.end(), other.jump_true_max_rad_s_.begin(),
+                              other.jump_true_max_rad_s_.end());
   add_reference(other.reference_);
 }
 
@@ -257,6 +281,13 @@ PartnerMetrics PartnerMetricsAccumulator::summary() const {
   if (slip_pairs_ > 0) {
     m.slip_rate = static_cast<double>(slip_frames_) / static_cast<double>(slip_pairs_);
   }
+  if (ground_feet_ > 0) {
+    m.ground_speed_cm_s = 100.0 * ground_speed_sum_mps_ / static_cast<double>(ground_feet_);
+  }
+  if (reference_.ground_feet > 0) {
+    m.captured_ground_speed_cm_s = 100.0 * reference_.ground_speed_sum_mps /
+                                   static_cast<double>(reference_.ground_feet);
+  }
   if (reference_.frames > 0) {
     m.captured_slip_rate =
         static_cast<double>(reference_.slip_frames) / static_cast<double>(reference_.frames);
@@ -276,6 +307,11 @@ PartnerMetrics PartnerMetricsAccumulator::summary() const {
     m.median_jump_speed_deg_s = rad_to_deg(median(jump_max_rad_s_));
     m.jumps_over_reference = std::ranges::count_if(
         jump_max_rad_s_, [&](double s) { return s > reference_rad_s; });
+    for (std::size_t k = 0; k < jump_max_rad_s_.size(); ++k) {
+      m.jumps_over_truth +=
+          jump_max_rad_s_[k] > std::max(reference_rad_s, jump_true_max_rad_s_[k]) ? 1 : 0;
+    }
+    m.median_true_jump_speed_deg_s = rad_to_deg(median(jump_true_max_rad_s_));
   }
   return m;
 }

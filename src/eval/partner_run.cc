@@ -150,7 +150,9 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
   const Skeleton& partner_skeleton = *loop.partner_skeleton();
   const auto partner_joints = static_cast<std::size_t>(partner_skeleton.joint_count());
   std::vector<Quat> previous_rotations(partner_joints, Quat::Identity());
+  std::vector<Quat> previous_true_rotations(partner_joints, Quat::Identity());
   std::vector<PartnerFrameRecord> records(static_cast<std::size_t>(frames));
+  const double nominal_period = 1.0 / performance.motion.frame_rate();
   for (const PartnerConfig& config : configs) {
     loop.set_params(config.params);
     loop.reset();  // rewinds the replay too
@@ -191,15 +193,26 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
         toes[side] = out.partner_positions_ws[static_cast<std::size_t>(partner_roles[kToes[side]])];
       }
       if (f > 0) {
-        const double dt = performance.times_s[fs] - performance.times_s[fs - 1];
+        // Speeds over at least one nominal sensor period: a late frame followed by an early one
+        // (timestamps 1 ms apart) is shown at the next display refresh, not 1 ms later.
+        const double dt =
+            std::max(performance.times_s[fs] - performance.times_s[fs - 1], nominal_period);
         for (std::size_t side = 0; side < 2; ++side) {
-          r.slip = r.slip || foot_slips(previous_toes[side], toes[side],
-                                        model.foot_ground_height(static_cast<Side>(side)), dt,
-                                        options.foot);
+          const double ground = model.foot_ground_height(static_cast<Side>(side));
+          r.slip = r.slip || foot_slips(previous_toes[side], toes[side], ground, dt, options.foot);
+          if (foot_near_ground(previous_toes[side], toes[side], ground, options.foot)) {
+            r.ground_speed_sum_mps += horizontal_speed_mps(previous_toes[side], toes[side], dt);
+            ++r.ground_feet;
+          }
         }
         r.max_angular_speed_rad_s = max_joint_angular_speed_rad_s(
             partner_skeleton, previous_rotations, out.partner_rotations_ls, dt);
+        if (!truth.jump) {  // the true response is cut at a true jump
+          r.true_max_angular_speed_rad_s = max_joint_angular_speed_rad_s(
+              partner_skeleton, previous_true_rotations, sampler.placed_rotations_ls(), dt);
+        }
       }
+      std::ranges::copy(sampler.placed_rotations_ls(), previous_true_rotations.begin());
       previous_toes = toes;
       std::ranges::copy(out.partner_rotations_ls, previous_rotations.begin());
     }

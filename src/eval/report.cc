@@ -42,7 +42,93 @@ std::string take_name(const EvalReport& report, int take) {
              : std::to_string(take);
 }
 
+std::string partner_cell(bool meaningful, double value, int decimals) {
+  return meaningful ? fmt::format("{:.{}f}", value, decimals) : std::string("-");
+}
+
+// The partner section of the table: one line per case x configuration, then per case the captured
+// partner's own numbers and the loop's cost with the tracker.
+void append_partner_table(std::string& out, const EvalReport& report) {
+  if (report.partner_rows.empty()) return;
+  out +=
+      "\npartner metrics (hmm tracker, the live loop as `duet follow` runs it; against the true "
+      "response, docs/evaluation.md):\n";
+  constexpr const char* kHeader =
+      "{:<18} {:<12} {:>7} {:>8} {:>8} {:>8} {:>7} {:>7} {:>7} {:>9} {:>9} {:>9} {:>7} "
+      "{:>7} {:>8}\n";
+  fmt::format_to(std::back_inserter(out), kHeader, "case", "corrections", "frames", "joint cm",
+                 "hand med", "hand avg", "hand n", "slip", "skate", "jump max", "jump med",
+                 "true med", ">p99", ">true", "us/frame");
+  std::string previous_case;
+  const auto case_footer = [&](const PartnerRow& row) {
+    const PartnerMetrics& m = row.metrics;
+    fmt::format_to(std::back_inserter(out),
+                   "  {}: captured partner slip {}, skate {:.1f} cm/s, p{:g} angular speed {:.0f} deg/s (its own {:g} s "
+                   "windows above it: {}); loop step with the tracker {:.0f} us/frame\n",
+                   row.case_name, percent(m.captured_slip_rate), m.captured_ground_speed_cm_s,
+                   100.0 * report.partner_options.reference_percentile, m.reference_speed_deg_s,
+                   report.partner_options.post_jump_window_s,
+                   percent(m.captured_windows_over_reference),
+                   row.loop_step_us);
+  };
+  for (std::size_t i = 0; i < report.partner_rows.size(); ++i) {
+    const PartnerRow& row = report.partner_rows[i];
+    if (!previous_case.empty() && row.case_name != previous_case) {
+      case_footer(report.partner_rows[i - 1]);
+      out += "\n";
+    }
+    previous_case = row.case_name;
+    const PartnerMetrics& m = row.metrics;
+    const bool hands = row.aligned && m.hand_samples > 0;
+    fmt::format_to(std::back_inserter(out), kHeader, row.case_name, row.config, m.frames,
+                   partner_cell(row.aligned, m.mean_joint_error_cm, 1),
+                   partner_cell(hands, m.median_hand_error_cm, 2),
+                   partner_cell(hands, m.mean_hand_error_cm, 2), m.hand_samples,
+                   percent(m.slip_rate), fmt::format("{:.1f}", m.ground_speed_cm_s),
+                   partner_cell(m.jumps > 0, m.max_jump_speed_deg_s, 0),
+                   partner_cell(m.jumps > 0, m.median_jump_speed_deg_s, 0),
+                   partner_cell(row.aligned && m.jumps > 0, m.median_true_jump_speed_deg_s, 0),
+                   m.jumps ? fmt::format("{}/{}", m.jumps_over_reference, m.jumps) : "-",
+                   row.aligned && m.jumps ? fmt::format("{}/{}", m.jumps_over_truth, m.jumps)
+                                          : "-",
+                   fmt::format("{:.1f}", m.mean_step_us));
+  }
+  case_footer(report.partner_rows.back());
+}
+
+void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::string& take,
+                            const std::string& take_name, const PartnerMetrics& m) {
+  fmt::format_to(std::back_inserter(out),
+                 "{},{},{},{},{},{},{:.4f},{},{:.4f},{:.4f},{:.5f},{:.5f},{:.3f},{:.3f},{},{:.2f},"
+                 "{:.2f},{},"
+                 "{:.2f},{},{:.2f},{:.5f},{:.3f},{:.2f}\n",
+                 row.case_name, row.config, take, take_name, row.aligned ? 1 : 0, m.frames,
+                 m.mean_joint_error_cm, m.hand_samples, m.median_hand_error_cm,
+                 m.mean_hand_error_cm, m.slip_rate, m.captured_slip_rate, m.ground_speed_cm_s,
+                 m.captured_ground_speed_cm_s, m.jumps,
+                 m.max_jump_speed_deg_s, m.median_jump_speed_deg_s, m.jumps_over_reference,
+                 m.median_true_jump_speed_deg_s, m.jumps_over_truth, m.reference_speed_deg_s, m.captured_windows_over_reference, m.mean_step_us,
+                 row.loop_step_us);
+}
+
 }  // namespace
+
+std::string format_partner_csv(const EvalReport& report) {
+  std::string out =
+      "case,corrections,take,take_name,aligned,frames,mean_joint_error_cm,hand_samples,"
+      "median_hand_error_cm,mean_hand_error_cm,slip_rate,captured_slip_rate,skate_speed_cm_s,"
+      "captured_skate_speed_cm_s,jumps,"
+      "max_jump_speed_deg_s,median_jump_speed_deg_s,jumps_over_reference,median_true_jump_speed_deg_s,"
+      "jumps_over_truth,reference_speed_deg_s,"
+      "captured_windows_over_reference,mean_step_us,loop_step_us\n";
+  for (const PartnerRow& row : report.partner_rows) {
+    for (const auto& [take, metrics] : row.per_take) {
+      append_partner_csv_row(out, row, std::to_string(take), take_name(report, take), metrics);
+    }
+    append_partner_csv_row(out, row, "all", "", row.metrics);
+  }
+  return out;
+}
 
 std::string format_eval_table(const EvalReport& report) {
   std::string out;
@@ -75,6 +161,7 @@ std::string format_eval_table(const EvalReport& report) {
         percent(n.naive.within_100ms), percent(n.fast.within_100ms), n.naive.mean_step_us,
         n.fast.mean_step_us);
   }
+  append_partner_table(out, report);
   return out;
 }
 

@@ -174,7 +174,8 @@ Result<NaiveCheck> run_naive_check(const DuetLibrary& library, const EvalCase& e
                  std::to_string(NaiveHmmFollower::kMaxStates)};
   }
   Result<TemplateModel> one = TemplateModel::build(
-      FeatureMatrix(full.features().middleRows(begin, count)), {}, full.frame_rate_hz());
+      FeatureMatrix(full.features().middleRows(begin, count)), {}, full.frame_rate_hz(),
+      full.velocity_dims());
   if (!one) return one.error();
   const TemplateModel& model = one.value();
   check.states = model.num_states();
@@ -335,10 +336,12 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
 
   EvalReport report;
   report.library_states = library.model().num_states();
+  report.partner_options = options.partner;
   for (const DuetTake& t : library.takes()) report.take_names.push_back(t.name);
 
   const long long total =
-      static_cast<long long>(options.cases.size() * options.takes.size() * trackers.size()) +
+      static_cast<long long>(options.cases.size() * options.takes.size() *
+                             (trackers.size() + (options.partner_metrics ? 1 : 0))) +
       (naive ? 1 : 0);
   long long done = 0;
 
@@ -346,6 +349,12 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
     const DuetLibrary& lib = eval_case.partner_role ? *partner_library : library;
     std::vector<MetricsAccumulator> pooled(trackers.size(), MetricsAccumulator(options.metrics));
     std::vector<std::vector<std::pair<int, Metrics>>> per_take(trackers.size());
+    const std::size_t configs = options.partner_metrics ? options.partner_configs.size() : 0;
+    std::vector<PartnerMetricsAccumulator> partner_pooled(
+        configs, PartnerMetricsAccumulator(options.partner));
+    std::vector<std::vector<std::pair<int, PartnerMetrics>>> partner_per_take(configs);
+    double loop_us_sum = 0.0;
+    long long loop_frames = 0;
     for (std::size_t ti = 0; ti < options.takes.size(); ++ti) {
       const int take = options.takes[ti];
       const std::vector<SourceTake> sources = sources_for(lib, take, eval_case.across_takes);
@@ -376,10 +385,37 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
         }
         ++done;
       }
+      if (configs > 0) {
+        // The synthesized partner, with the "hmm" tracker as `duet follow` runs it.
+        const std::string label =
+            eval_case.name + " / " + lib.takes()[static_cast<std::size_t>(take)].name + " / partner";
+        if (progress) progress(done, total, label);
+        Result<std::unique_ptr<Tracker>> tracker =
+            make_eval_tracker(TrackerKind::kHmm, lib.model(), options);
+        if (!tracker) return Error{label + ": " + tracker.error().message};
+        Result<PartnerPerformanceResult> partner = run_partner_performance(
+            lib, performance, std::move(tracker).value(), options.partner_configs, options.partner);
+        if (!partner) return Error{label + ": " + partner.error().message};
+        for (std::size_t c = 0; c < configs; ++c) {
+          const PartnerMetricsAccumulator& one = partner.value().configs[c];
+          partner_per_take[c].emplace_back(take, one.summary());
+          partner_pooled[c].merge(one);
+        }
+        loop_us_sum += partner.value().loop_step_us * performance.frame_count();
+        loop_frames += performance.frame_count();
+        ++done;
+      }
     }
     for (std::size_t k = 0; k < trackers.size(); ++k) {
       report.rows.push_back({eval_case.name, std::string(tracker_kind_name(trackers[k])),
                              pooled[k].summary(), std::move(per_take[k])});
+    }
+    for (std::size_t c = 0; c < configs; ++c) {
+      const PartnerConfig& config = options.partner_configs[c];
+      report.partner_rows.push_back(
+          {eval_case.name, config.name, config.params.align, partner_pooled[c].summary(),
+           std::move(partner_per_take[c]),
+           loop_frames > 0 ? loop_us_sum / static_cast<double>(loop_frames) : 0.0});
     }
   }
 

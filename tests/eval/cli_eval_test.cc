@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "apps/run_command.h"
+#include "duet/eval/partner_run.h"
 
 namespace duet {
 namespace {
@@ -64,10 +65,12 @@ TEST(CliEval, RunsCasesAndWritesTableCsvAndPlots) {
   const std::string csv = (dir / "eval.csv").string();
   const std::string plots = (dir / "plots").string();
   const bool have_gnuplot = std::system("command -v gnuplot >/dev/null 2>&1") == 0;
+  const std::string partner_csv = (dir / "partner.csv").string();
   const auto r = run_duet("eval " + pair("10") + " " + pair("05") +
                           " --fps 60 --takes 0 --cases clean,improv-pause,partner-role "
                           "--trackers hmm,nearest,naive-hmm --seed 3 --csv " +
-                          csv + (have_gnuplot ? " --plots " + plots : std::string()));
+                          csv + " --partner-csv " + partner_csv +
+                          (have_gnuplot ? " --plots " + plots : std::string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // The table: a header and one row per case x tracker.
   EXPECT_NE(r.output.find("acc@100"), std::string::npos) << r.output;
@@ -88,6 +91,16 @@ TEST(CliEval, RunsCasesAndWritesTableCsvAndPlots) {
   // The naive forward agrees with the O(M) one.
   const std::string text = read_text(csv);
   EXPECT_NE(text.find(",naive-hmm,0,60_10_scaled,"), std::string::npos);
+  // Partner metrics: a table section and one pooled row per case x corrections.
+  EXPECT_NE(r.output.find("partner metrics"), std::string::npos) << r.output;
+  const auto partner_rows = pooled_rows(read_text(partner_csv));
+  ASSERT_EQ(partner_rows.size(), 3u * standard_partner_configs().size())
+      << read_text(partner_csv);
+  const auto& clean_all = partner_rows.at({"clean", "all"});
+  EXPECT_LT(std::stod(clean_all.at("mean_joint_error_cm")), 5.0);
+  EXPECT_GT(std::stoi(clean_all.at("hand_samples")), 100);
+  EXPECT_LT(std::stod(clean_all.at("median_hand_error_cm")), 3.0);
+  EXPECT_GT(std::stoi(partner_rows.at({"improv-pause", "no-blend"}).at("jumps")), 3);
   if (have_gnuplot) {
     EXPECT_GT(std::filesystem::file_size(std::filesystem::path(plots) / "accuracy.png"), 1000u);
     EXPECT_GT(std::filesystem::file_size(std::filesystem::path(plots) / "trace.png"), 1000u);
@@ -109,6 +122,9 @@ TEST(CliEval, BadOptionsExitTwoAndBadFilesExitOne) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   r = run_duet("eval " + pairs + " --trace-case nothing");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = run_duet("eval " + pairs + " --no-partner-metrics --partner-csv x.csv");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--partner-csv"), std::string::npos) << r.output;
 
   const auto dir = scratch_dir("bad");
   const std::string garbage = (dir / "garbage.bvh").string();

@@ -141,6 +141,9 @@ TEST(CapturedReference, CountsSlipsAndKeepsSpeeds) {
   add_captured_reference(clip, roles, {toe_height, toe_height}, options, reference);
   EXPECT_EQ(reference.frames, 60);
   EXPECT_EQ(reference.slip_frames, 30);
+  // Both toes near the ground in every frame pair: 60 toe samples still, 60 sliding at 0.6 m/s.
+  EXPECT_EQ(reference.ground_feet, 120);
+  EXPECT_NEAR(reference.ground_speed_sum_mps, 60 * 0.6, 1e-9);
   const std::size_t animated = static_cast<std::size_t>(skeleton->animated_joint_count());
   EXPECT_EQ(reference.angular_speeds_rad_s.size(), 60 * animated);
   EXPECT_NEAR(rad_to_deg(quantile(reference.angular_speeds_rad_s, 1.0)), 120.0, 1e-6);
@@ -166,7 +169,14 @@ TEST(PartnerMetricsAccumulator, PoolsFramesHandsSlipsAndJumpWindows) {
     r.step_us = 10.0;
     r.slip = f == 0 || f == 3 || f == 5;  // frame 0 has no previous frame: not counted
     r.max_angular_speed_rad_s = f == 2 ? 100.0 : (f == 6 ? 20.0 : 1.0);
+    r.true_max_angular_speed_rad_s = f == 7 ? 30.0 : 0.5;  // the dance itself turns fast here
+    if (f > 0) {
+      r.ground_speed_sum_mps = 0.3;  // one toe on the ground at 0.3 m/s
+      r.ground_feet = 1;
+    }
   }
+  records[0].ground_speed_sum_mps = 5.0;  // frame 0 is never counted
+  records[0].ground_feet = 2;
   // Hand samples 1, 2, 3, 10 cm: median 2.5 cm, mean 4 cm.
   records[1].hand_pairs = 0b0001;
   records[1].hand_error_m[0] = 0.01;
@@ -199,6 +209,9 @@ TEST(PartnerMetricsAccumulator, PoolsFramesHandsSlipsAndJumpWindows) {
   EXPECT_NEAR(m.max_jump_speed_deg_s, rad_to_deg(20.0), 1e-9);
   EXPECT_NEAR(m.reference_speed_deg_s, rad_to_deg(9.9), 1e-9);
   EXPECT_EQ(m.jumps_over_reference, 1);
+  EXPECT_EQ(m.jumps_over_truth, 0);  // 20 rad/s, while the true response reaches 30
+  EXPECT_NEAR(m.median_true_jump_speed_deg_s, rad_to_deg(30.0), 1e-9);
+  EXPECT_NEAR(m.ground_speed_cm_s, 30.0, 1e-9);
   EXPECT_NEAR(m.captured_windows_over_reference, 0.5, 1e-12);
   EXPECT_NEAR(m.mean_step_us, 10.0, 1e-12);
 

@@ -50,8 +50,13 @@ double angular_speed_rad_s(const Quat& previous, const Quat& current, double dt_
 double max_joint_angular_speed_rad_s(const Skeleton& skeleton, std::span<const Quat> previous_ls,
                                      std::span<const Quat> current_ls, double dt_s);
 
-// A toe near the ground that slides: both positions within margin of the ground height and the
-// horizontal (x, z) speed between them above the threshold.
+// A toe near the ground: both positions within the margin of its ground height.
+bool foot_near_ground(const Vec3& previous_ws, const Vec3& current_ws, double ground_height_m,
+                      const FootLockParams& thresholds);
+// Horizontal (x, z) speed between two positions; 0 when dt <= 0 or not finite.
+double horizontal_speed_mps(const Vec3& previous_ws, const Vec3& current_ws, double dt_s);
+// A toe near the ground that slides: foot_near_ground and the horizontal speed above the
+// threshold.
 bool foot_slips(const Vec3& previous_ws, const Vec3& current_ws, double ground_height_m,
                 double dt_s, const FootLockParams& thresholds);
 
@@ -100,7 +105,13 @@ struct PartnerFrameRecord {
   std::array<double, kHandPairCount> hand_error_m{};
   std::uint8_t hand_pairs = 0;   // bit p: hand_error_m[p] is set
   bool slip = false;             // a foot slipped since the previous frame (false on frame 0)
+  // Horizontal speeds of the toes that stayed near the ground since the previous frame, summed,
+  // and how many (0-2): the mean skating speed, which also sees sliding below the threshold.
+  double ground_speed_sum_mps = 0.0;
+  int ground_feet = 0;
   double max_angular_speed_rad_s = 0.0;  // since the previous frame (0 on frame 0)
+  // The same for the true response (0 on frame 0 and at a true jump, where it is cut).
+  double true_max_angular_speed_rad_s = 0.0;
   double step_us = 0.0;          // wall-clock time of the loop step that made it
 };
 
@@ -109,6 +120,8 @@ struct PartnerFrameRecord {
 struct CapturedReference {
   long long slip_frames = 0;  // frames (from the second) in which a foot slipped
   long long frames = 0;       // frames from the second
+  double ground_speed_sum_mps = 0.0;  // toes near the ground: speeds summed ...
+  long long ground_feet = 0;          // ... and counted
   std::vector<double> angular_speeds_rad_s;  // every animated joint, every frame from the second
   // Non-overlapping windows of post_jump_window_s over the take: how often the captured motion
   // itself exceeds its percentile inside such a window (context for the jump metric).
@@ -128,13 +141,19 @@ struct PartnerMetrics {
   double median_hand_error_cm = 0.0;
   double mean_hand_error_cm = 0.0;
   double slip_rate = 0.0;  // slipping frames / frames from the second
+  double ground_speed_cm_s = 0.0;  // mean horizontal speed of toes near the ground
   long long jumps = 0;     // true jumps whose window holds at least one frame after the first
   double max_jump_speed_deg_s = 0.0;     // largest over every jump window
   double median_jump_speed_deg_s = 0.0;  // median over jumps of each window's largest
   long long jumps_over_reference = 0;    // windows whose largest exceeds the reference
+  // Windows whose largest exceeds both the reference and the true response's own largest in
+  // that window (the dance itself may spin faster than the percentile right after a jump).
+  long long jumps_over_truth = 0;
+  double median_true_jump_speed_deg_s = 0.0;  // median over jumps of the true response's largest
   double mean_step_us = 0.0;
   // The captured response's own numbers over the same takes.
   double captured_slip_rate = 0.0;
+  double captured_ground_speed_cm_s = 0.0;
   double reference_speed_deg_s = 0.0;  // its reference_percentile angular speed
   double captured_windows_over_reference = 0.0;  // fraction of its windows over that
 };
@@ -155,10 +174,12 @@ class PartnerMetricsAccumulator {
 
  private:
   PartnerMetricsOptions options_;
-  long long frames_ = 0, slip_frames_ = 0, slip_pairs_ = 0;
+  long long frames_ = 0, slip_frames_ = 0, slip_pairs_ = 0, ground_feet_ = 0;
+  double ground_speed_sum_mps_ = 0.0;
   double joint_error_sum_m_ = 0.0, step_us_sum_ = 0.0;
   std::vector<double> hand_errors_m_;
   std::vector<double> jump_max_rad_s_;  // one per jump window
+  std::vector<double> jump_true_max_rad_s_;
   CapturedReference reference_;
 };
 

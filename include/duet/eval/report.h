@@ -9,13 +9,18 @@
 
 namespace duet {
 
-// One line per case x tracker (pooled over the performed takes), then the naive check.
+// One line per case x tracker (pooled over the performed takes), then the naive check, then the
+// partner metrics when they ran.
 std::string format_eval_table(const EvalReport& report);
 
 // Header plus one row per case x tracker x take and one pooled row (take "all") per case x
 // tracker; the naive check adds rows for "naive-hmm" and "hmm-one-take". Columns are listed in
 // docs/evaluation.md.
 std::string format_eval_csv(const EvalReport& report);
+
+// The partner metrics (EvalReport::partner_rows): header plus one row per case x configuration x
+// take and one pooled row (take "all") per case x configuration. Columns in docs/evaluation.md.
+std::string format_partner_csv(const EvalReport& report);
 
 struct PlotFile {
   std::string name;  // file name inside the plot directory

@@ -13,6 +13,8 @@
 
 #include "duet/base/result.h"
 #include "duet/eval/metrics.h"
+#include "duet/eval/partner_metrics.h"
+#include "duet/eval/partner_run.h"
 #include "duet/eval/performance.h"
 #include "duet/follow/follow_params.h"
 #include "duet/follow/online_dtw.h"
@@ -69,6 +71,11 @@ struct EvalOptions {
   // The case the naive O(M^2) forward is compared on (when kNaiveHmm is among the trackers); if
   // it is not run or not performed from one take in the user's role, the first case that is.
   std::string naive_case = "improv-pause";
+  // Partner metrics (docs/evaluation.md "Partner metrics"): every case x take also runs the live
+  // loop with the "hmm" tracker once per partner_configs entry and scores the synthesized partner.
+  bool partner_metrics = false;
+  std::vector<PartnerConfig> partner_configs = standard_partner_configs();
+  PartnerMetricsOptions partner;
 };
 
 // A case x tracker, pooled over the performed takes, and per take.
@@ -77,6 +84,16 @@ struct EvalRow {
   std::string tracker;
   Metrics metrics;
   std::vector<std::pair<int, Metrics>> per_take;  // (take index, metrics)
+};
+
+// A case x configuration of the corrections, pooled over the performed takes, and per take.
+struct PartnerRow {
+  std::string case_name;
+  std::string config;
+  bool aligned = true;  // align was on: joint and hand errors are in the user's frame
+  PartnerMetrics metrics;
+  std::vector<std::pair<int, PartnerMetrics>> per_take;
+  double loop_step_us = 0.0;  // mean LiveLoop::step with the real tracker (same for the case)
 };
 
 struct EvalTrace {
@@ -107,6 +124,8 @@ struct EvalReport {
   std::vector<EvalRow> rows;
   std::vector<EvalTrace> traces;
   NaiveCheck naive;
+  std::vector<PartnerRow> partner_rows;  // when EvalOptions::partner_metrics
+  PartnerMetricsOptions partner_options;
   std::vector<std::string> take_names;  // of the library, by index
   int library_states = 0;
 };
