@@ -3,10 +3,11 @@
 //
 //   response pose at frame f
 //   -> align     root placed relative to the user's heading frame (5.1)
-//   -> blend     inertialization when the follower jumped (5.3)
 //   -> smooth    per-joint exponential smoothing in quaternion space (5.3)
 //   -> footlock  planted feet held by a horizontal root shift (5.3)
 //   -> contact   two-bone IK of each arm whose hand holds the user's (5.2)
+//   -> blend     inertialization of the finished pose when the follower jumped (5.3); last, so
+//                a jump's change made by any stage is blended (the IK would snap the arms)
 //   -> partner pose, root in the user's world frame
 //
 // Offline: PartnerModel (per duet take; may allocate and fail with a message).
@@ -121,7 +122,8 @@ struct PartnerParams {
   // contact: the IK target is kept continuous (5.3 blending applied to the target): when the
   // follower jumps, when a hand changes the hand it holds, or when the target moves faster than
   // this (the user's wrist teleported: a sensor glitch, or a synthetic performance's cut), the
-  // jump of the target is absorbed by an offset that decays like the blend (blend_half_life_s).
+  // jump of the target is absorbed by an offset that decays like the blend (blend_half_life_s);
+  // at a follower jump with blend on, the blend takes it instead.
   // Without it the IK snaps the arm in one frame (measured: ~5000 deg/s at salsa jumps,
   // docs/evaluation.md "Partner metrics"). Hands move at most ~3-4 m/s in the salsa takes; 10 m/s
   // stays above a noisy sensor's wrist jitter (3 deg per joint at 30 Hz: ~3 m/s RMS). The
