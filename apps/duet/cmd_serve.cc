@@ -14,6 +14,7 @@
 #include "duet/live/source_spec.h"
 #include "duet/net/live_server.h"
 #include "library_options.h"
+#include "partner_options.h"
 #include "tracker_options.h"
 
 namespace duet::app {
@@ -25,8 +26,7 @@ namespace fs = std::filesystem;
 struct ServeArgs {
   LibraryArgs library;
   TrackerArgs tracker;
-  bool no_align = false, no_contact = false, no_smooth = false, no_footlock = false,
-       no_blend = false;
+  PartnerArgs partner;
   std::string source = "ws";
   std::string source_skeleton;
   std::optional<double> source_fps;
@@ -219,12 +219,7 @@ int run_serve(const ServeArgs& args) {
   }
   const SourceSkeleton user = source.value()->source_skeleton();
 
-  PartnerParams params;
-  params.align = !args.no_align;
-  params.contact = !args.no_contact;
-  params.smooth = !args.no_smooth;
-  params.foot_lock = !args.no_footlock;
-  params.blend = !args.no_blend;
+  const PartnerParams params = make_partner_params(args.partner);
   Result<std::unique_ptr<LiveLoop>> loop = make_loop(library, args.tracker, user, params);
   if (!loop) {
     fail(loop.error().message);
@@ -312,11 +307,7 @@ Command register_serve(CLI::App& app) {
   auto args = std::make_shared<ServeArgs>();
   add_library_options(app, args->library);
   add_tracker_options(app, args->tracker);
-  app.add_flag("--no-align", args->no_align, "Do not place the partner relative to the user");
-  app.add_flag("--no-contact", args->no_contact, "No hand-contact IK");
-  app.add_flag("--no-smooth", args->no_smooth, "No temporal smoothing of the partner");
-  app.add_flag("--no-footlock", args->no_footlock, "No foot locking");
-  app.add_flag("--no-blend", args->no_blend, "No blending at jumps (cut instead)");
+  add_partner_options(app, args->partner);
   app.add_option("--source", args->source,
                  "Where the user's motion comes from: replay:FILE.bvh[?speed=S&loop=1&start=SEC], "
                  "neuron-tcp:HOST:PORT, neuron-udp:[ADDR:]PORT, ws[:SKELETON.bvh]")

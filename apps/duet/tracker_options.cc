@@ -30,7 +30,7 @@ void add_tracker_options(CLI::App& app, TrackerArgs& args) {
       ->check(CLI::PositiveNumber);
   app.add_flag("--fixed-band", args.fixed_band,
                "Keep the HMM's band at the template's tempo instead of centring it on the "
-               "dancer's tempo (the paper preset always does)");
+               "dancer's tempo (the paper preset always keeps it fixed)");
 }
 
 Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args,
