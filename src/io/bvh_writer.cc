@@ -14,37 +14,59 @@ namespace duet {
 
 namespace {
 
-class Writer {
- public:
-  explicit Writer(int decimals) : decimals_(std::clamp(decimals, 0, 17)) {}
+// Fixed notation of any double fits: at most 309 integer digits, a sign, a point, 17 decimals.
+void append_fixed(std::string& out, double value, int decimals) {
+  char buffer[400];
+  const auto result =
+      std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed, decimals);
+  std::string_view text(buffer, static_cast<std::size_t>(result.ptr - buffer));
+  // "-0.000000" reads back the same but looks like a bug in the file.
+  if (text.starts_with('-') && text.find_first_not_of("0.", 1) == std::string_view::npos) {
+    text.remove_prefix(1);
+  }
+  out += text;
+}
 
-  std::string& out() { return out_; }
+void append_shortest(std::string& out, double value) {
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  out.append(buffer, static_cast<std::size_t>(result.ptr - buffer));
+}
 
-  void fixed(double value) {
-    // Fixed notation of any double fits: at most 309 integer digits, a sign, a point, 17 decimals.
-    char buffer[400];
-    const auto result =
-        std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed, decimals_);
-    std::string_view text(buffer, static_cast<std::size_t>(result.ptr - buffer));
-    // "-0.000000" reads back the same but looks like a bug in the file.
-    if (text.starts_with('-') && text.find_first_not_of("0.", 1) == std::string_view::npos) {
-      text.remove_prefix(1);
+int clamp_decimals(int decimals) { return std::clamp(decimals, 0, 17); }
+
+// Children of every joint, in index order.
+std::vector<std::vector<int>> children_of(const Skeleton& skeleton) {
+  std::vector<std::vector<int>> children(skeleton.joints.size());
+  for (std::size_t j = 1; j < skeleton.joints.size(); ++j) {
+    const int parent = skeleton.joints[j].parent;
+    if (parent >= 0) children[static_cast<std::size_t>(parent)].push_back(static_cast<int>(j));
+  }
+  return children;
+}
+
+// Joints depth first, children in index order: the order the hierarchy lists them. For a
+// skeleton the reader made this is the index order itself, so a read-write-read cycle keeps
+// every joint's index.
+std::vector<int> hierarchy_order(const Skeleton& skeleton) {
+  std::vector<int> order;
+  if (skeleton.joints.empty()) return order;
+  const std::vector<std::vector<int>> children = children_of(skeleton);
+  std::vector<std::pair<int, std::size_t>> stack = {{0, 0}};  // (joint, next child to visit)
+  order.push_back(0);
+  while (!stack.empty()) {
+    auto& [j, next] = stack.back();
+    const auto& kids = children[static_cast<std::size_t>(j)];
+    if (next < kids.size()) {
+      const int child = kids[next++];
+      order.push_back(child);
+      stack.emplace_back(child, 0);
+    } else {
+      stack.pop_back();
     }
-    out_ += text;
   }
-
-  void shortest(double value) {
-    char buffer[64];
-    const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-    out_.append(buffer, static_cast<std::size_t>(result.ptr - buffer));
-  }
-
-  void indent(int depth) { out_.append(static_cast<std::size_t>(depth), '\t'); }
-
- private:
-  int decimals_;
-  std::string out_;
-};
+  return order;
+}
 
 // The Euler order a joint's rotation channels are written in. For a joint that lists all three
 // rotation axes this is Joint::rotation_order(); for one that lists fewer (not produced by the
@@ -68,47 +90,73 @@ EulerOrder write_order(const Joint& joint) {
 
 }  // namespace
 
+BvhFrameFormatter::BvhFrameFormatter(const Skeleton& skeleton, const BvhWriteOptions& options)
+    : skeleton_(&skeleton),
+      order_(hierarchy_order(skeleton)),
+      units_per_metre_(options.units_per_metre),
+      decimals_(clamp_decimals(options.decimals)) {
+  euler_.reserve(skeleton.joints.size());
+  for (const Joint& joint : skeleton.joints) euler_.push_back(write_order(joint));
+}
+
+void BvhFrameFormatter::append(std::span<const Vec3> translations_ls,
+                               std::span<const Quat> rotations_ls, std::string& out) const {
+  bool first = true;
+  for (const int jj : order_) {
+    const auto j = static_cast<std::size_t>(jj);
+    const Joint& joint = skeleton_->joints[j];
+    if (joint.channels.empty()) continue;
+    Vec3 degrees = Vec3::Zero();
+    bool have_angles = false;
+    for (const Channel c : joint.channels) {
+      if (!first) out += ' ';
+      first = false;
+      if (is_position_channel(c)) {
+        append_fixed(out, translations_ls[j][static_cast<int>(c)] * units_per_metre_, decimals_);
+        continue;
+      }
+      if (!have_angles) {
+        degrees = euler_from_quat(rotations_ls[j], euler_[j]) * (180.0 / kPi);
+        have_angles = true;
+      }
+      const Axis axis = static_cast<Axis>(static_cast<int>(c) - 3);
+      const auto k = std::find(euler_[j].begin(), euler_[j].end(), axis) - euler_[j].begin();
+      append_fixed(out, degrees[static_cast<int>(k)], decimals_);
+    }
+  }
+}
+
 std::string format_bvh(const Clip& clip, const BvhWriteOptions& options) {
   const Skeleton& skeleton = clip.skeleton();
   const std::size_t n = skeleton.joints.size();
   const double units = options.units_per_metre;
+  const int decimals = clamp_decimals(options.decimals);
+  const std::vector<std::vector<int>> children = children_of(skeleton);
 
-  // Depth-first order, children in index order. For a skeleton the reader made this is the index
-  // order itself, so a read-write-read cycle keeps every joint's index.
-  std::vector<std::vector<int>> children(n);
-  for (std::size_t j = 1; j < n; ++j) {
-    const int parent = skeleton.joints[j].parent;
-    if (parent >= 0) children[static_cast<std::size_t>(parent)].push_back(static_cast<int>(j));
-  }
-  std::vector<int> order;
-  order.reserve(n);
-
-  Writer w(options.decimals);
-  std::string& out = w.out();
-  out += "HIERARCHY\n";
+  std::string out = "HIERARCHY\n";
+  auto indent = [&out](int depth) { out.append(static_cast<std::size_t>(depth), '\t'); };
   if (n > 0) {
-    // Explicit stack: (joint, next child to visit).
+    // Explicit stack: (joint, next child to visit); the same walk as hierarchy_order().
     std::vector<std::pair<int, std::size_t>> stack = {{0, 0}};
     auto open_joint = [&](int j, int depth) {
       const Joint& joint = skeleton.joints[static_cast<std::size_t>(j)];
       const bool as_end_site =
           j != 0 && joint.end_site && children[static_cast<std::size_t>(j)].empty();
-      order.push_back(j);
-      w.indent(depth);
+      indent(depth);
       out += j == 0 ? "ROOT " : (as_end_site ? "End Site" : "JOINT ");
       if (!as_end_site) out += joint.name;
       out += '\n';
-      w.indent(depth);
+      indent(depth);
       out += "{\n";
-      w.indent(depth + 1);
+      indent(depth + 1);
       out += "OFFSET";
       for (int axis = 0; axis < 3; ++axis) {
         out += ' ';
-        w.fixed(joint.offset[axis] * units);
+        append_fixed(out, joint.offset[axis] * units, decimals);
       }
       out += '\n';
       if (!as_end_site) {
-        w.indent(depth + 1);
+        indent(depth + 1);
         out += "CHANNELS ";
         out += std::to_string(joint.channels.size());
         for (const Channel c : joint.channels) {
@@ -128,7 +176,7 @@ std::string format_bvh(const Clip& clip, const BvhWriteOptions& options) {
         open_joint(child, depth);
         stack.emplace_back(child, 0);
       } else {
-        w.indent(depth - 1);
+        indent(depth - 1);
         out += "}\n";
         stack.pop_back();
       }
@@ -138,40 +186,15 @@ std::string format_bvh(const Clip& clip, const BvhWriteOptions& options) {
   out += "MOTION\nFrames: ";
   out += std::to_string(clip.frame_count());
   out += "\nFrame Time: ";
-  w.shortest(clip.frame_time());
+  append_shortest(out, clip.frame_time());
   out += '\n';
 
-  std::vector<EulerOrder> orders(n);
-  for (std::size_t j = 0; j < n; ++j) orders[j] = write_order(skeleton.joints[j]);
+  const BvhFrameFormatter formatter(skeleton, options);
   for (int f = 0; f < clip.frame_count(); ++f) {
-    const auto translations = clip.translations_ls(f);
-    const auto rotations = clip.rotations_ls(f);
-    bool first = true;
-    for (const int jj : order) {
-      const auto j = static_cast<std::size_t>(jj);
-      const Joint& joint = skeleton.joints[j];
-      if (joint.channels.empty()) continue;
-      Vec3 degrees = Vec3::Zero();
-      bool have_angles = false;
-      for (const Channel c : joint.channels) {
-        if (!first) out += ' ';
-        first = false;
-        if (is_position_channel(c)) {
-          w.fixed(translations[j][static_cast<int>(c)] * units);
-          continue;
-        }
-        if (!have_angles) {
-          degrees = euler_from_quat(rotations[j], orders[j]) * (180.0 / kPi);
-          have_angles = true;
-        }
-        const Axis axis = static_cast<Axis>(static_cast<int>(c) - 3);
-        const auto k = std::find(orders[j].begin(), orders[j].end(), axis) - orders[j].begin();
-        w.fixed(degrees[static_cast<int>(k)]);
-      }
-    }
+    formatter.append(clip.translations_ls(f), clip.rotations_ls(f), out);
     out += '\n';
   }
-  return std::move(out);
+  return out;
 }
 
 Status write_bvh(const Clip& clip, const std::string& path, const BvhWriteOptions& options) {

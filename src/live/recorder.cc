@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <charconv>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
@@ -27,62 +26,6 @@ namespace {
 constexpr int kFramesFieldWidth = 12;
 
 std::string errno_text() { return std::strerror(errno); }
-
-// The Euler order the writer uses for a joint (duet/io/bvh_writer.cc): the rotation channels in
-// the order listed, missing axes after them in X, Y, Z order.
-EulerOrder write_order(const Joint& joint) {
-  EulerOrder order{};
-  bool used[3] = {false, false, false};
-  std::size_t n = 0;
-  for (const Channel c : joint.channels) {
-    if (is_position_channel(c)) continue;
-    const int axis = static_cast<int>(c) - 3;
-    if (used[axis] || n == 3) continue;
-    used[axis] = true;
-    order[n++] = static_cast<Axis>(axis);
-  }
-  for (int axis = 0; axis < 3; ++axis) {
-    if (!used[axis]) order[n++] = static_cast<Axis>(axis);
-  }
-  return order;
-}
-
-// Joints in the order format_bvh() lists them: depth first, children in index order.
-std::vector<int> hierarchy_order(const Skeleton& skeleton) {
-  const std::size_t n = skeleton.joints.size();
-  std::vector<std::vector<int>> children(n);
-  for (std::size_t j = 1; j < n; ++j) {
-    const int parent = skeleton.joints[j].parent;
-    if (parent >= 0) children[static_cast<std::size_t>(parent)].push_back(static_cast<int>(j));
-  }
-  std::vector<int> order;
-  if (n == 0) return order;
-  std::vector<std::pair<int, std::size_t>> stack = {{0, 0}};
-  order.push_back(0);
-  while (!stack.empty()) {
-    auto& [j, next] = stack.back();
-    const auto& kids = children[static_cast<std::size_t>(j)];
-    if (next < kids.size()) {
-      const int child = kids[next++];
-      order.push_back(child);
-      stack.emplace_back(child, 0);
-    } else {
-      stack.pop_back();
-    }
-  }
-  return order;
-}
-
-void append_fixed(std::string& out, double value) {
-  char buffer[400];
-  const auto result =
-      std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed, 6);
-  std::string_view text(buffer, static_cast<std::size_t>(result.ptr - buffer));
-  if (text.starts_with('-') && text.find_first_not_of("0.", 1) == std::string_view::npos) {
-    text.remove_prefix(1);  // "-0.000000"
-  }
-  out += text;
-}
 
 std::string frames_field(long long frames) {
   std::string field = std::to_string(frames);
@@ -119,8 +62,7 @@ BvhStreamWriter& BvhStreamWriter::operator=(BvhStreamWriter&& other) noexcept {
     path_ = std::move(other.path_);
     part_path_ = std::move(other.part_path_);
     skeleton_ = std::move(other.skeleton_);
-    order_ = std::move(other.order_);
-    euler_ = std::move(other.euler_);
+    formatter_ = std::move(other.formatter_);
     file_ = std::exchange(other.file_, nullptr);
     frames_field_offset_ = other.frames_field_offset_;
     frames_ = other.frames_;
@@ -166,8 +108,8 @@ Result<BvhStreamWriter> BvhStreamWriter::open(const std::string& path,
   }
   writer.frames_field_offset_ = static_cast<long>(at + std::string_view("\nFrames: ").size());
   writer.skeleton_ = std::move(skeleton);
-  writer.order_ = hierarchy_order(*writer.skeleton_);
-  for (const Joint& joint : writer.skeleton_->joints) writer.euler_.push_back(write_order(joint));
+  // The same values, order and precision as format_bvh(), so the file reads back like one.
+  writer.formatter_ = BvhFrameFormatter(*writer.skeleton_);
   writer.pending_.reserve(1 << 16);
   return writer;
 }
@@ -175,29 +117,7 @@ Result<BvhStreamWriter> BvhStreamWriter::open(const std::string& path,
 void BvhStreamWriter::append(std::span<const Vec3> translations_ls,
                              std::span<const Quat> rotations_ls) {
   if (file_ == nullptr) return;
-  bool first = true;
-  for (const int jj : order_) {
-    const auto j = static_cast<std::size_t>(jj);
-    const Joint& joint = skeleton_->joints[j];
-    if (joint.channels.empty()) continue;
-    Vec3 degrees = Vec3::Zero();
-    bool have_angles = false;
-    for (const Channel c : joint.channels) {
-      if (!first) pending_ += ' ';
-      first = false;
-      if (is_position_channel(c)) {
-        append_fixed(pending_, translations_ls[j][static_cast<int>(c)]);
-        continue;
-      }
-      if (!have_angles) {
-        degrees = euler_from_quat(rotations_ls[j], euler_[j]) * (180.0 / kPi);
-        have_angles = true;
-      }
-      const auto axis = static_cast<Axis>(static_cast<int>(c) - 3);
-      const auto k = std::find(euler_[j].begin(), euler_[j].end(), axis) - euler_[j].begin();
-      append_fixed(pending_, degrees[static_cast<int>(k)]);
-    }
-  }
+  formatter_.append(translations_ls, rotations_ls, pending_);
   pending_ += '\n';
   ++frames_;
 }

@@ -7,10 +7,13 @@
 #pragma once
 
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "duet/base/result.h"
+#include "duet/math/rotation.h"
 #include "duet/motion/clip.h"
 
 namespace duet {
@@ -37,6 +40,27 @@ struct BvhWriteOptions {
 };
 
 std::string format_bvh(const Clip& clip, const BvhWriteOptions& options = {});
+
+// One frame's MOTION line as format_bvh writes it: channel values in hierarchy order (depth
+// first, children in index order), angles in each joint's write order. For writers that stream
+// frames (live/recorder.h) so that their files read back exactly like format_bvh's. Set-up
+// allocates; append() does not beyond the growth of `out`.
+class BvhFrameFormatter {
+ public:
+  BvhFrameFormatter() = default;
+  explicit BvhFrameFormatter(const Skeleton& skeleton, const BvhWriteOptions& options = {});
+  // Appends the values of one pose (local translations in metres, local rotations; one per
+  // joint of the skeleton), separated by spaces, without the newline.
+  void append(std::span<const Vec3> translations_ls, std::span<const Quat> rotations_ls,
+              std::string& out) const;
+
+ private:
+  const Skeleton* skeleton_ = nullptr;
+  std::vector<int> order_;         // joints in the order the hierarchy lists them
+  std::vector<EulerOrder> euler_;  // per joint, the Euler order its angles are written in
+  double units_per_metre_ = 1.0;
+  int decimals_ = 6;
+};
 Status write_bvh(const Clip& clip, const std::string& path, const BvhWriteOptions& options = {});
 
 }  // namespace duet

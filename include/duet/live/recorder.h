@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "duet/base/result.h"
+#include "duet/io/bvh.h"
 #include "duet/live/live_loop.h"
 #include "duet/motion/skeleton.h"
 
@@ -56,8 +57,7 @@ class BvhStreamWriter {
   std::string path_;
   std::string part_path_;
   std::shared_ptr<const Skeleton> skeleton_;
-  std::vector<int> order_;         // joints in the order the hierarchy lists them
-  std::vector<EulerOrder> euler_;  // per joint, the Euler order its angles are written in
+  BvhFrameFormatter formatter_;  // points into *skeleton_
   std::FILE* file_ = nullptr;
   long frames_field_offset_ = 0;  // where the Frames: digits start
   long long frames_ = 0;
