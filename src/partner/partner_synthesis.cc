@@ -170,6 +170,9 @@ std::string PartnerParams::validate() const {
       return std::string(name) + " must be finite and >= 0 (got " + std::to_string(value) + ")";
     }
   }
+  if (const std::string_view problem = user_filter.validate(); !problem.empty()) {
+    return "user_filter: " + std::string(problem);
+  }
   return {};
 }
 
@@ -256,6 +259,8 @@ void PartnerContext::reset() noexcept {
   smoother_.reset();
   foot_locker_.reset();
   user_heading_ = Transform();
+  user_root_filter_.reset();
+  user_facing_filter_.reset();
   ik_ramp_ = {0.0, 0.0};
   ik_pair_ = {-1, -1};
   ik_target_valid_ = {false, false};
@@ -307,14 +312,33 @@ bool PartnerSynthesisJob::run() const noexcept {
     std::copy(rotations_ls.begin(), rotations_ls.end(), out_r.begin());
   }
 
+  // 0. The user's heading frame, through the 1-euro filter when smoothing.
+  const bool user_root_finite = user != nullptr && user->root_position_ws.allFinite() &&
+                                user->root_rotation_ws.coeffs().allFinite() &&
+                                user->root_rotation_ws.norm() > 0.0;
+  Transform user_heading = ctx.user_heading_;
+  if (user_root_finite) {
+    user_heading = heading_frame(user->root_position_ws, user->root_rotation_ws.normalized());
+    if (p.smooth) {
+      const Vec3 facing = user_heading.rotation * Vec3::UnitZ();
+      const Vec3 smooth_facing = ctx.user_facing_filter_.filter(facing, dt, p.user_filter);
+      const Vec3 smooth_position =
+          ctx.user_root_filter_.filter(user_heading.translation, dt, p.user_filter);
+      if (smooth_facing.norm() > 1e-6) {
+        user_heading = {yaw_rotation(std::atan2(smooth_facing.x(), smooth_facing.z())),
+                        smooth_position};
+      }
+    }
+  }
+  if (!p.smooth) {
+    ctx.user_root_filter_.reset();
+    ctx.user_facing_filter_.reset();
+  }
+
   // 1. Align (5.1): the root relative to the user's heading frame.
   Transform heading;
   if (p.align) {
-    if (user->root_position_ws.allFinite() && user->root_rotation_ws.coeffs().allFinite() &&
-        user->root_rotation_ws.norm() > 0.0) {
-      ctx.user_heading_ =
-          heading_frame(user->root_position_ws, user->root_rotation_ws.normalized());
-    }
+    if (user_root_finite) ctx.user_heading_ = user_heading;
     heading = ctx.user_heading_;
     const RootPlacement& placement = model->alignment().placement(frame);
     const Transform root = heading * Transform{placement.rotation_hs, placement.position_hs};
