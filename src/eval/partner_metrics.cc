@@ -301,12 +301,19 @@ PartnerMetrics PartnerMetricsAccumulator::summary() const {
     m.captured_windows_over_reference =
         static_cast<double>(over) / static_cast<double>(reference_.window_max_rad_s.size());
   }
+  const double window_reference_rad_s =
+      reference_.window_max_rad_s.empty()
+          ? reference_rad_s
+          : quantile(reference_.window_max_rad_s, options_.reference_percentile);
+  m.window_reference_speed_deg_s = rad_to_deg(window_reference_rad_s);
   m.jumps = static_cast<long long>(jump_max_rad_s_.size());
   if (!jump_max_rad_s_.empty()) {
     m.max_jump_speed_deg_s = rad_to_deg(*std::ranges::max_element(jump_max_rad_s_));
     m.median_jump_speed_deg_s = rad_to_deg(median(jump_max_rad_s_));
     m.jumps_over_reference = std::ranges::count_if(
         jump_max_rad_s_, [&](double s) { return s > reference_rad_s; });
+    m.jumps_over_window_reference = std::ranges::count_if(
+        jump_max_rad_s_, [&](double s) { return s > window_reference_rad_s; });
     for (std::size_t k = 0; k < jump_max_rad_s_.size(); ++k) {
       m.jumps_over_truth +=
           jump_max_rad_s_[k] > std::max(reference_rad_s, jump_true_max_rad_s_[k]) ? 1 : 0;

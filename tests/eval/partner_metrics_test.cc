@@ -213,6 +213,11 @@ TEST(PartnerMetricsAccumulator, PoolsFramesHandsSlipsAndJumpWindows) {
   EXPECT_NEAR(m.median_true_jump_speed_deg_s, rad_to_deg(30.0), 1e-9);
   EXPECT_NEAR(m.ground_speed_cm_s, 30.0, 1e-9);
   EXPECT_NEAR(m.captured_windows_over_reference, 0.5, 1e-12);
+  // The like-for-like reference: p99 of the window maxima {1, 5, 9.95, 10} lies in (9.95, 10];
+  // the jump window's 20 rad/s is above it.
+  EXPECT_GT(m.window_reference_speed_deg_s, rad_to_deg(9.95));
+  EXPECT_LE(m.window_reference_speed_deg_s, rad_to_deg(10.0) + 1e-9);
+  EXPECT_EQ(m.jumps_over_window_reference, 1);
   EXPECT_NEAR(m.mean_step_us, 10.0, 1e-12);
 
   // Merging is pooling.

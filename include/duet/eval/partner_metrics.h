@@ -156,6 +156,11 @@ struct PartnerMetrics {
   double captured_ground_speed_cm_s = 0.0;
   double reference_speed_deg_s = 0.0;  // its reference_percentile angular speed
   double captured_windows_over_reference = 0.0;  // fraction of its windows over that
+  // The like-for-like reference: the reference_percentile of the captured response's largest
+  // speed per post_jump_window_s window (the statistic a jump window is measured with), and the
+  // jumps whose window exceeds it.
+  double window_reference_speed_deg_s = 0.0;
+  long long jumps_over_window_reference = 0;
 };
 
 // Pools the records of performances (frames and jumps weigh equally across performances) and
