@@ -108,7 +108,7 @@ TEST(ServeSources, NeuronOverTcp) {
   tcp::socket again(io);
   axis.accept(again);
   asio::write(again, asio::buffer(records[0]));
-  EXPECT_TRUE(viewer.read_type("frame", 5s));
+  EXPECT_TRUE(viewer.read_type("frame", 20s));
   EXPECT_EQ(server.stop(SIGTERM), 0) << server.log();
   EXPECT_NE(server.log().find("neuron-tcp: connected"), std::string::npos) << server.log();
 }

@@ -197,7 +197,9 @@ class WsClient {
   }
 
   // The next message of `type` (others are skipped), or nullopt.
-  std::optional<Json> read_type(const std::string& type, std::chrono::milliseconds timeout = 5s) {
+  // The default wait is generous: a working server answers in milliseconds, but a sanitizer
+  // build on a loaded 2-core machine was seen to take over 5 s to turn a message around.
+  std::optional<Json> read_type(const std::string& type, std::chrono::milliseconds timeout = 20s) {
     const auto deadline = std::chrono::steady_clock::now() + timeout;
     while (std::chrono::steady_clock::now() < deadline) {
       auto left = std::chrono::duration_cast<std::chrono::milliseconds>(

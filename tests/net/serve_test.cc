@@ -130,7 +130,7 @@ TEST(Serve, ServesFramesSurvivesBadClientsAndRecordsEverything) {
   const std::string oversized =
       "{\"type\": \"set\", \"pad\": \"" + std::string(1536 * 1024, 'x') + "\"}";
   ASSERT_TRUE(rogue.write(oversized));
-  const std::optional<Json> too_big = rogue.read_type("error", 10s);
+  const std::optional<Json> too_big = rogue.read_type("error", 20s);
   ASSERT_TRUE(too_big);
   EXPECT_NE((*too_big)["reason"].get<std::string>().find("larger"), std::string::npos);
   // Text that is not UTF-8 breaks the WebSocket protocol itself: that connection is failed (RFC
@@ -172,7 +172,7 @@ TEST(Serve, ServesFramesSurvivesBadClientsAndRecordsEverything) {
     switched = (*frame)["corrections"]["contact"] == false;
   }
   EXPECT_TRUE(switched);
-  const std::optional<Json> stats = rogue.read_type("stats", 3s);
+  const std::optional<Json> stats = rogue.read_type("stats", 20s);
   ASSERT_TRUE(stats);
   EXPECT_GE((*stats)["rejected"].get<int>(), rejected_sent);
   EXPECT_GE((*stats)["clients"].get<int>(), 2);

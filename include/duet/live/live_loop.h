@@ -1,7 +1,7 @@
 // The run-time loop of method.md 6, one input frame at a time:
 //
 //   user's local pose -> features -> forward step -> estimated state
-//   -> response pose at that state -> alignment -> blend -> smoothing -> foot lock -> hand IK
+//   -> response pose at that state -> alignment -> smoothing -> foot lock -> hand IK -> blend
 //   -> world transforms of both dancers
 //
 // LiveLoop owns everything the loop needs (follow session, partner models, partner context, output
