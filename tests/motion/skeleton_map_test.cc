@@ -1,6 +1,7 @@
 #include "duet/motion/skeleton_map.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -40,7 +41,11 @@ TEST(SkeletonMap, UnknownSkeletonListsMissingRoles) {
 class MapFileTest : public ::testing::Test {
  protected:
   std::string write(const std::string& text) {
-    path_ = (std::filesystem::temp_directory_path() / "duet_map_test.json").string();
+    // One file per test and process: ctest runs the tests of this fixture in parallel.
+    path_ = (std::filesystem::temp_directory_path() /
+             ("duet_map_test_" + std::to_string(::getpid()) + "_" +
+              ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".json"))
+                .string();
     std::ofstream(path_) << text;
     return path_;
   }

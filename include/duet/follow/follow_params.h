@@ -1,5 +1,6 @@
-// Parameters of the follower HMM (method.md 4). Plain named fields; the defaults are a starting
-// point to be replaced by measured values (method.md 7), the `paper` preset reproduces [4.2].
+// Parameters of the follower HMM (method.md 4). Plain named fields; the defaults were chosen by
+// measurement with `duet eval` (method.md 7, docs/evaluation.md), the `paper` preset reproduces
+// [4.2].
 #pragma once
 
 #include <vector>
