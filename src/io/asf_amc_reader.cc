@@ -737,7 +737,10 @@ bool AmcParser::start_frame(std::string_view token) {
   }
   if (ec == std::errc::result_out_of_range)
     return fail("frame number " + quoted(token) + " is out of range");
-  if (number < 0) return fail("frame number " + quoted(token) + " is negative");
+  // A frame number is plain digits: "-0" is 0 to from_chars, but no AMC writer emits a sign.
+  if (number < 0 || token.front() == '-') {
+    return fail("frame number " + quoted(token) + " is negative");
+  }
   if (frame_number_ >= 0) {
     if (!end_frame()) return false;
     if (number != frame_number_ + 1) {

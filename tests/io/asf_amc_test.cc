@@ -514,6 +514,8 @@ TEST(AsfAmcErrors, FrameNumbersOutOfOrderOrWithGaps) {
   EXPECT_EQ(amc_error(amc), "t.amc:6: frame number '99999999999999999999999' is out of range");
   amc[5] = "-2";
   EXPECT_EQ(amc_error(amc), "t.amc:6: frame number '-2' is negative");
+  amc[5] = "-0";  // found by the fuzzer: from_chars reads it as 0
+  EXPECT_EQ(amc_error(amc), "t.amc:6: frame number '-0' is negative");
   amc[5] = "2x";
   EXPECT_EQ(amc_error(amc), "t.amc:6: expected a frame number, found '2x'");
   amc = mini_amc();
