@@ -1,6 +1,7 @@
 #include "duet/eval/partner_run.h"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <map>
 
@@ -58,36 +59,23 @@ void load_frame(const Performance& performance, int f, SourceFrame& frame) {
 }  // namespace
 
 std::vector<PartnerConfig> standard_partner_configs(const PartnerParams& base) {
+  // Each configuration names the corrections that are on, in parse_corrections()'s syntax.
+  static constexpr std::pair<const char*, const char*> kConfigs[] = {
+      {"all", "all"},
+      {"no-contact", "align,smooth,footlock,blend"},
+      {"no-footlock", "align,contact,smooth,blend"},
+      {"no-blend", "align,contact,smooth,footlock"},
+      {"no-smooth", "align,contact,footlock,blend"},
+      {"align-only", "align"},
+      {"none", "none"}};
   std::vector<PartnerConfig> configs;
-  auto add = [&](std::string name, auto&& edit) {
-    PartnerParams p = base;
-    edit(p);
-    configs.push_back({std::move(name), p});
-  };
-  add("all", [](PartnerParams& p) { p.align = p.contact = p.smooth = p.foot_lock = p.blend = true; });
-  add("no-contact", [](PartnerParams& p) {
-    p.align = p.smooth = p.foot_lock = p.blend = true;
-    p.contact = false;
-  });
-  add("no-footlock", [](PartnerParams& p) {
-    p.align = p.contact = p.smooth = p.blend = true;
-    p.foot_lock = false;
-  });
-  add("no-blend", [](PartnerParams& p) {
-    p.align = p.contact = p.smooth = p.foot_lock = true;
-    p.blend = false;
-  });
-  add("no-smooth", [](PartnerParams& p) {
-    p.align = p.contact = p.foot_lock = p.blend = true;
-    p.smooth = false;
-  });
-  add("align-only", [](PartnerParams& p) {
-    p.align = true;
-    p.contact = p.smooth = p.foot_lock = p.blend = false;
-  });
-  add("none", [](PartnerParams& p) {
-    p.align = p.contact = p.smooth = p.foot_lock = p.blend = false;
-  });
+  for (const auto& [name, corrections] : kConfigs) {
+    PartnerParams params = base;
+    const Status parsed = parse_corrections(corrections, params);
+    assert(parsed.ok() && "the list above names only known corrections");
+    (void)parsed;
+    configs.push_back({name, params});
+  }
   return configs;
 }
 
