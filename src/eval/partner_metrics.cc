@@ -52,8 +52,7 @@ double angular_speed_rad_s(const Quat& previous, const Quat& current, double dt_
 double max_joint_angular_speed_rad_s(const Skeleton& skeleton, std::span<const Quat> previous_ls,
                                      std::span<const Quat> current_ls, double dt_s) {
   double largest = 0.0;
-  const std::size_t n =
-      std::min({previous_ls.size(), current_ls.size(), skeleton.joints.size()});
+  const std::size_t n = std::min({previous_ls.size(), current_ls.size(), skeleton.joints.size()});
   for (std::size_t j = 0; j < n; ++j) {
     if (skeleton.joints[j].end_site) continue;
     largest = std::max(largest, angular_speed_rad_s(previous_ls[j], current_ls[j], dt_s));
@@ -62,7 +61,7 @@ double max_joint_angular_speed_rad_s(const Skeleton& skeleton, std::span<const Q
 }
 
 bool foot_near_ground(const Vec3& previous_ws, const Vec3& current_ws, double ground_height_m,
-                      const FootLockParams& thresholds) {
+                      const FootSlipThresholds& thresholds) {
   const double margin = thresholds.height_margin_m;
   return previous_ws.y() - ground_height_m <= margin && current_ws.y() - ground_height_m <= margin;
 }
@@ -74,9 +73,9 @@ double horizontal_speed_mps(const Vec3& previous_ws, const Vec3& current_ws, dou
 }
 
 bool foot_slips(const Vec3& previous_ws, const Vec3& current_ws, double ground_height_m,
-                double dt_s, const FootLockParams& thresholds) {
+                double dt_s, const FootSlipThresholds& thresholds) {
   return valid_dt(dt_s) && foot_near_ground(previous_ws, current_ws, ground_height_m, thresholds) &&
-         horizontal_speed_mps(previous_ws, current_ws, dt_s) > thresholds.speed_threshold_mps;
+         horizontal_speed_mps(previous_ws, current_ws, dt_s) > thresholds.speed_mps;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -166,8 +165,8 @@ void add_captured_reference(const Clip& response, const JointRoles& roles,
       const auto toe = static_cast<std::size_t>(roles[kToes[side]]);
       const Vec3& a = positions[(fs - 1) * joints + toe];
       const Vec3& b = positions[fs * joints + toe];
-      slip = slip || foot_slips(a, b, ground_heights[side], dt, options.foot);
-      if (foot_near_ground(a, b, ground_heights[side], options.foot)) {
+      slip = slip || foot_slips(a, b, ground_heights[side], dt, options.slip);
+      if (foot_near_ground(a, b, ground_heights[side], options.slip)) {
         reference.ground_speed_sum_mps += horizontal_speed_mps(a, b, dt);
         ++reference.ground_feet;
       }
@@ -184,8 +183,7 @@ void add_captured_reference(const Clip& response, const JointRoles& roles,
     }
   }
   // Non-overlapping windows of the post-jump length, from the second frame on.
-  const int window =
-      std::max(1, static_cast<int>(std::lround(options.post_jump_window_s / dt)));
+  const int window = std::max(1, static_cast<int>(std::lround(options.post_jump_window_s / dt)));
   for (int begin = 1; begin + window <= frames; begin += window) {
     reference.window_max_rad_s.push_back(
         *std::max_element(frame_max.begin() + begin, frame_max.begin() + begin + window));
@@ -285,8 +283,8 @@ PartnerMetrics PartnerMetricsAccumulator::summary() const {
     m.ground_speed_cm_s = 100.0 * ground_speed_sum_mps_ / static_cast<double>(ground_feet_);
   }
   if (reference_.ground_feet > 0) {
-    m.captured_ground_speed_cm_s = 100.0 * reference_.ground_speed_sum_mps /
-                                   static_cast<double>(reference_.ground_feet);
+    m.captured_ground_speed_cm_s =
+        100.0 * reference_.ground_speed_sum_mps / static_cast<double>(reference_.ground_feet);
   }
   if (reference_.frames > 0) {
     m.captured_slip_rate =
@@ -310,13 +308,15 @@ PartnerMetrics PartnerMetricsAccumulator::summary() const {
   if (!jump_max_rad_s_.empty()) {
     m.max_jump_speed_deg_s = rad_to_deg(*std::ranges::max_element(jump_max_rad_s_));
     m.median_jump_speed_deg_s = rad_to_deg(median(jump_max_rad_s_));
-    m.jumps_over_reference = std::ranges::count_if(
-        jump_max_rad_s_, [&](double s) { return s > reference_rad_s; });
+    m.jumps_over_reference =
+        std::ranges::count_if(jump_max_rad_s_, [&](double s) { return s > reference_rad_s; });
     m.jumps_over_window_reference = std::ranges::count_if(
         jump_max_rad_s_, [&](double s) { return s > window_reference_rad_s; });
     for (std::size_t k = 0; k < jump_max_rad_s_.size(); ++k) {
       m.jumps_over_truth +=
           jump_max_rad_s_[k] > std::max(reference_rad_s, jump_true_max_rad_s_[k]) ? 1 : 0;
+      m.jumps_over_window_reference_and_truth +=
+          jump_max_rad_s_[k] > std::max(window_reference_rad_s, jump_true_max_rad_s_[k]) ? 1 : 0;
     }
     m.median_true_jump_speed_deg_s = rad_to_deg(median(jump_true_max_rad_s_));
   }

@@ -90,8 +90,8 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
   const int takes = static_cast<int>(library.takes().size());
   for (const TruthFrame& t : performance.truth) {
     if (t.take < 0 || t.take >= takes) {
-      return Error{"partner metrics: the performance's truth names take " +
-                   std::to_string(t.take) + ", not in the library"};
+      return Error{"partner metrics: the performance's truth names take " + std::to_string(t.take) +
+                   ", not in the library"};
     }
   }
 
@@ -127,12 +127,13 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
     if (samplers.contains(t.take)) continue;
     const DuetTake& take = library.takes()[static_cast<std::size_t>(t.take)];
     const PartnerModel& model = loop.partner_model(t.take);
-    samplers.emplace(t.take, CapturedDuetSampler(take.template_motion.clip, take.template_motion.roles,
-                                                 take.response_motion.clip, model));
-    add_captured_reference(take.response_motion.clip, take.response_motion.roles,
-                           {model.foot_ground_height(Side::kLeft),
-                            model.foot_ground_height(Side::kRight)},
-                           options, reference);
+    samplers.emplace(t.take,
+                     CapturedDuetSampler(take.template_motion.clip, take.template_motion.roles,
+                                         take.response_motion.clip, model));
+    add_captured_reference(
+        take.response_motion.clip, take.response_motion.roles,
+        {model.foot_ground_height(Side::kLeft), model.foot_ground_height(Side::kRight)}, options,
+        reference);
   }
 
   const Skeleton& partner_skeleton = *loop.partner_skeleton();
@@ -158,8 +159,8 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
       const TruthFrame& truth = performance.truth[fs];
       CapturedDuetSampler& sampler = samplers.at(truth.take);
       sampler.compute(truth.template_frame, out.user_positions_ws[0], out.user_rotations_ws[0]);
-      r.joint_error_m = mean_joint_distance_m(out.partner_positions_ws,
-                                              sampler.placed_positions_ws());
+      r.joint_error_m =
+          mean_joint_distance_m(out.partner_positions_ws, sampler.placed_positions_ws());
 
       const PartnerModel& model = loop.partner_model(out.partner_take);
       const JointRoles& partner_roles = model.response_roles();
@@ -187,8 +188,8 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
             std::max(performance.times_s[fs] - performance.times_s[fs - 1], nominal_period);
         for (std::size_t side = 0; side < 2; ++side) {
           const double ground = model.foot_ground_height(static_cast<Side>(side));
-          r.slip = r.slip || foot_slips(previous_toes[side], toes[side], ground, dt, options.foot);
-          if (foot_near_ground(previous_toes[side], toes[side], ground, options.foot)) {
+          r.slip = r.slip || foot_slips(previous_toes[side], toes[side], ground, dt, options.slip);
+          if (foot_near_ground(previous_toes[side], toes[side], ground, options.slip)) {
             r.ground_speed_sum_mps += horizontal_speed_mps(previous_toes[side], toes[side], dt);
             ++r.ground_feet;
           }

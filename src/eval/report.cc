@@ -55,16 +55,18 @@ void append_partner_table(std::string& out, const EvalReport& report) {
       "response, docs/evaluation.md):\n";
   constexpr const char* kHeader =
       "{:<18} {:<12} {:>7} {:>8} {:>8} {:>8} {:>7} {:>7} {:>7} {:>9} {:>9} {:>9} {:>7} "
-      "{:>7} {:>7} {:>8}\n";
+      "{:>7} {:>7} {:>7} {:>8}\n";
   fmt::format_to(std::back_inserter(out), kHeader, "case", "corrections", "frames", "joint cm",
                  "hand med", "hand avg", "hand n", "slip", "skate", "jump max", "jump med",
-                 "true med", ">p99", ">true", ">win99", "us/frame");
+                 "true med", ">p99", ">true", ">win99", ">w99&t", "us/frame");
   std::string previous_case;
   const auto case_footer = [&](const PartnerRow& row) {
     const PartnerMetrics& m = row.metrics;
     fmt::format_to(std::back_inserter(out),
-                   "  {}: captured partner slip {}, skate {:.1f} cm/s, p{:g} angular speed {:.0f} deg/s (its own {:g} s "
-                   "windows above it: {}; p{:g} of their largest per window: {:.0f} deg/s); loop step with the tracker {:.0f} us/frame\n",
+                   "  {}: captured partner slip {}, skate {:.1f} cm/s, p{:g} angular speed {:.0f} "
+                   "deg/s (its own {:g} s "
+                   "windows above it: {}; p{:g} of their largest per window: {:.0f} deg/s); loop "
+                   "step with the tracker {:.0f} us/frame\n",
                    row.case_name, percent(m.captured_slip_rate), m.captured_ground_speed_cm_s,
                    100.0 * report.partner_options.reference_percentile, m.reference_speed_deg_s,
                    report.partner_options.post_jump_window_s,
@@ -90,9 +92,11 @@ void append_partner_table(std::string& out, const EvalReport& report) {
                    partner_cell(m.jumps > 0, m.median_jump_speed_deg_s, 0),
                    partner_cell(row.aligned && m.jumps > 0, m.median_true_jump_speed_deg_s, 0),
                    m.jumps ? fmt::format("{}/{}", m.jumps_over_reference, m.jumps) : "-",
-                   row.aligned && m.jumps ? fmt::format("{}/{}", m.jumps_over_truth, m.jumps)
-                                          : "-",
+                   row.aligned && m.jumps ? fmt::format("{}/{}", m.jumps_over_truth, m.jumps) : "-",
                    m.jumps ? fmt::format("{}/{}", m.jumps_over_window_reference, m.jumps) : "-",
+                   row.aligned && m.jumps
+                       ? fmt::format("{}/{}", m.jumps_over_window_reference_and_truth, m.jumps)
+                       : "-",
                    fmt::format("{:.1f}", m.mean_step_us));
   }
   case_footer(report.partner_rows.back());
@@ -103,15 +107,15 @@ void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::
   fmt::format_to(std::back_inserter(out),
                  "{},{},{},{},{},{},{:.4f},{},{:.4f},{:.4f},{:.5f},{:.5f},{:.3f},{:.3f},{},{:.2f},"
                  "{:.2f},{},"
-                 "{:.2f},{},{:.2f},{:.5f},{:.3f},{:.2f},{:.2f},{}\n",
+                 "{:.2f},{},{:.2f},{:.5f},{:.3f},{:.2f},{:.2f},{},{}\n",
                  row.case_name, row.config, take, take_name, row.aligned ? 1 : 0, m.frames,
                  m.mean_joint_error_cm, m.hand_samples, m.median_hand_error_cm,
                  m.mean_hand_error_cm, m.slip_rate, m.captured_slip_rate, m.ground_speed_cm_s,
-                 m.captured_ground_speed_cm_s, m.jumps,
-                 m.max_jump_speed_deg_s, m.median_jump_speed_deg_s, m.jumps_over_reference,
-                 m.median_true_jump_speed_deg_s, m.jumps_over_truth, m.reference_speed_deg_s,
-                 m.captured_windows_over_reference, m.mean_step_us, row.loop_step_us,
-                 m.window_reference_speed_deg_s, m.jumps_over_window_reference);
+                 m.captured_ground_speed_cm_s, m.jumps, m.max_jump_speed_deg_s,
+                 m.median_jump_speed_deg_s, m.jumps_over_reference, m.median_true_jump_speed_deg_s,
+                 m.jumps_over_truth, m.reference_speed_deg_s, m.captured_windows_over_reference,
+                 m.mean_step_us, row.loop_step_us, m.window_reference_speed_deg_s,
+                 m.jumps_over_window_reference, m.jumps_over_window_reference_and_truth);
 }
 
 }  // namespace
@@ -121,10 +125,11 @@ std::string format_partner_csv(const EvalReport& report) {
       "case,corrections,take,take_name,aligned,frames,mean_joint_error_cm,hand_samples,"
       "median_hand_error_cm,mean_hand_error_cm,slip_rate,captured_slip_rate,skate_speed_cm_s,"
       "captured_skate_speed_cm_s,jumps,"
-      "max_jump_speed_deg_s,median_jump_speed_deg_s,jumps_over_reference,median_true_jump_speed_deg_s,"
+      "max_jump_speed_deg_s,median_jump_speed_deg_s,jumps_over_reference,median_true_jump_speed_"
+      "deg_s,"
       "jumps_over_truth,reference_speed_deg_s,"
       "captured_windows_over_reference,mean_step_us,loop_step_us,window_reference_speed_deg_s,"
-      "jumps_over_window_reference\n";
+      "jumps_over_window_reference,jumps_over_window_reference_and_truth\n";
   for (const PartnerRow& row : report.partner_rows) {
     for (const auto& [take, metrics] : row.per_take) {
       append_partner_csv_row(out, row, std::to_string(take), take_name(report, take), metrics);

@@ -1,7 +1,6 @@
 #include "duet/partner/foot_lock.h"
 
 #include <cmath>
-#include <limits>
 
 #include "duet/partner/smoothing.h"
 
@@ -14,26 +13,20 @@ Vec3 horizontal(const Vec3& v) { return {v.x(), 0.0, v.z()}; }
 
 void FootLocker::reset() noexcept { *this = FootLocker(); }
 
-Vec3 FootLocker::update(const std::array<Vec3, 2>& feet_ws,
-                        const std::array<double, 2>& ground_heights, const FootLockParams& params,
-                        double dt_s) noexcept {
-  const bool timed = primed_ && dt_s > 0.0 && std::isfinite(dt_s);
+Vec3 FootLocker::update(const std::array<Vec3, 2>& feet_ws, const std::array<bool, 2>& planted,
+                        const FootLockParams& params, double dt_s) noexcept {
   Vec3 target = Vec3::Zero();
   int locked_count = 0;
   bool changed = false;
   for (std::size_t i = 0; i < 2; ++i) {
     const Vec3& foot = feet_ws[i];
-    const double speed = timed ? horizontal(foot - previous_feet_[i]).norm() / dt_s
-                               : std::numeric_limits<double>::infinity();
-    const bool near = foot.y() - ground_heights[i] <= params.height_margin_m;
-    const bool slow = speed <= params.speed_threshold_mps;
     if (locked_[i]) {
       const double shift = horizontal(lock_points_[i] - foot).norm();
-      if (!near || !slow || !(shift <= params.max_offset_m)) {
+      if (!planted[i] || !(shift <= params.max_offset_m)) {
         locked_[i] = false;
         changed = true;
       }
-    } else if (near && slow && foot.allFinite() &&
+    } else if (planted[i] && foot.allFinite() &&
                horizontal(applied_).norm() <= 0.5 * params.max_offset_m) {
       // Lock where the foot is shown now, so locking moves nothing. After a lock hit the limit,
       // new locks wait until the shift has decayed to half of it, so the partner returns to its
@@ -46,9 +39,7 @@ Vec3 FootLocker::update(const std::array<Vec3, 2>& feet_ws,
       target += horizontal(lock_points_[i] - foot);
       ++locked_count;
     }
-    previous_feet_[i] = foot;
   }
-  primed_ = true;
   if (locked_count > 0) target /= locked_count;
 
   if (changed) {

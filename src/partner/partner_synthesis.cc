@@ -131,7 +131,31 @@ Result<PartnerModel> PartnerModel::build(const Clip& template_clip,
                      heights.end());
     model.ground_heights_[side] = heights[k];
   }
+
+  // The captured feet, for the foot lock's plants.
+  const int frames = response_clip.frame_count();
+  model.captured_feet_.resize(static_cast<std::size_t>(frames) * 2);
+  for (int f = 0; f < frames; ++f) {
+    const int other = f > 0 ? f - 1 : std::min(1, frames - 1);
+    for (std::size_t side = 0; side < 2; ++side) {
+      const auto toe = static_cast<std::size_t>(response_roles[kToes[side]]);
+      const Vec3& here = positions[static_cast<std::size_t>(f) * joints + toe];
+      const Vec3& there = positions[static_cast<std::size_t>(other) * joints + toe];
+      CapturedFoot& foot = model.captured_feet_[static_cast<std::size_t>(f) * 2 + side];
+      foot.height_above_ground_m = static_cast<float>(here.y() - model.ground_heights_[side]);
+      foot.speed_mps = static_cast<float>(std::hypot(here.x() - there.x(), here.z() - there.z()) *
+                                          response_clip.frame_rate());
+    }
+  }
   return model;
+}
+
+bool PartnerModel::foot_planted(int frame, Side side,
+                                const FootLockParams& thresholds) const noexcept {
+  const CapturedFoot& foot =
+      captured_feet_[static_cast<std::size_t>(frame) * 2 + static_cast<std::size_t>(side)];
+  return foot.height_above_ground_m <= thresholds.height_margin_m &&
+         foot.speed_mps <= thresholds.speed_threshold_mps;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -158,6 +182,7 @@ std::string PartnerParams::validate() const {
       {"smooth_translation_half_life_s", smooth_translation_half_life_s},
       {"blend_half_life_s", blend_half_life_s},
       {"blend_max_speed_rad_s", blend_max_speed_rad_s},
+      {"blend_max_root_speed_mps", blend_max_root_speed_mps},
       {"ik_target_max_blend_speed_mps", ik_target_max_blend_speed_mps},
       {"ik_fade_s", ik_fade_s},
       {"ik_target_jump_speed_mps", ik_target_jump_speed_mps},
@@ -365,9 +390,9 @@ bool PartnerSynthesisJob::run() const noexcept {
   if (p.foot_lock) {
     const std::array<Vec3, 2> feet = {ctx.positions_ws_[static_cast<std::size_t>(roles[kToes[0]])],
                                       ctx.positions_ws_[static_cast<std::size_t>(roles[kToes[1]])]};
-    const std::array<double, 2> ground = {model->foot_ground_height(Side::kLeft),
-                                          model->foot_ground_height(Side::kRight)};
-    const Vec3 shift = ctx.foot_locker_.update(feet, ground, p.foot, dt);
+    const std::array<bool, 2> planted = {model->foot_planted(frame, Side::kLeft, p.foot),
+                                         model->foot_planted(frame, Side::kRight, p.foot)};
+    const Vec3 shift = ctx.foot_locker_.update(feet, planted, p.foot, dt);
     out_t[0] += shift;
     for (Vec3& position : ctx.positions_ws_) position += shift;
     diagnostics.foot_locked = {ctx.foot_locker_.locked(0), ctx.foot_locker_.locked(1)};
@@ -394,6 +419,12 @@ bool PartnerSynthesisJob::run() const noexcept {
       if (pair >= 0) ctx.ik_pair_[r] = pair;
       double ramp = ctx.ik_ramp_[r] + (pair >= 0 ? step : -step);
       ramp = ramp < 1e-9 ? 0.0 : (ramp > 1.0 - 1e-9 ? 1.0 : ramp);  // land exactly on 0 and 1
+      // At a jump the blend (stage 5) takes the change of the finished pose, so the IK goes
+      // straight to the new frame's state. A fade would play on after the blend started: a
+      // contact left by a jump kept pulling the wrist towards a target made of the new frame's
+      // captured offset (the dancers apart: far from the arm's pose) while the weight fell, and
+      // swung the forearm at up to 3000 deg/s (docs/evaluation.md, "Partner metrics").
+      if (p.blend && jumped) ramp = pair >= 0 ? 1.0 : 0.0;
       ctx.ik_ramp_[r] = ramp;
       const double weight = smoothstep(ctx.ik_ramp_[r]);
       if (weight <= 0.0 || ctx.ik_pair_[r] < 0) {
@@ -484,11 +515,14 @@ bool PartnerSynthesisJob::run() const noexcept {
   if (p.blend) {
     if (jumped && ctx.primed_) {
       ctx.inertializer_.transition(ctx.blend_translations_, ctx.blend_rotations_, out_t, out_r);
-      ctx.blend_half_life_ = capped_half_life(
-          p.blend_half_life_s, ctx.inertializer_.max_rotation_offset(), p.blend_max_speed_rad_s);
+      ctx.blend_half_life_ =
+          std::max(capped_half_life(p.blend_half_life_s, ctx.inertializer_.max_rotation_offset(),
+                                    p.blend_max_speed_rad_s),
+                   capped_half_life(p.blend_half_life_s, ctx.inertializer_.max_translation_offset(),
+                                    p.blend_max_root_speed_mps));
     }
-    ctx.inertializer_.update(out_t, out_r, std::max(ctx.blend_half_life_, p.blend_half_life_s),
-                             dt, out_t, out_r);
+    ctx.inertializer_.update(out_t, out_r, std::max(ctx.blend_half_life_, p.blend_half_life_s), dt,
+                             out_t, out_r);
     diagnostics.blend_offset_rad = ctx.inertializer_.max_rotation_offset();
   } else {
     ctx.inertializer_.reset();

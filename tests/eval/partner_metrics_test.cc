@@ -57,7 +57,7 @@ TEST(PartnerGeometry, AngularSpeedIsTheShorterAngleOverDt) {
 }
 
 TEST(PartnerGeometry, FootSlipsOnlyNearTheGroundAndAboveTheSpeed) {
-  const FootLockParams thresholds;  // 0.03 m, 0.2 m/s
+  const FootSlipThresholds thresholds;  // 0.03 m, 0.2 m/s
   const double ground = 0.05;
   const double dt = 0.1;
   // 3 cm per 0.1 s = 0.3 m/s on the ground: slip; 1 cm = 0.1 m/s: no slip.
@@ -218,6 +218,7 @@ TEST(PartnerMetricsAccumulator, PoolsFramesHandsSlipsAndJumpWindows) {
   EXPECT_GT(m.window_reference_speed_deg_s, rad_to_deg(9.95));
   EXPECT_LE(m.window_reference_speed_deg_s, rad_to_deg(10.0) + 1e-9);
   EXPECT_EQ(m.jumps_over_window_reference, 1);
+  EXPECT_EQ(m.jumps_over_window_reference_and_truth, 0);  // the true response reaches 30
   EXPECT_NEAR(m.mean_step_us, 10.0, 1e-12);
 
   // Merging is pooling.

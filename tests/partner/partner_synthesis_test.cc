@@ -386,6 +386,36 @@ TEST(PartnerSynthesis, BlendCoversTheContactIkAtAJump) {
   EXPECT_LT(run.info.blend_offset_rad, 1e-4);
 }
 
+TEST(PartnerSynthesis, AJumpOutOfAContactDropsTheIkAndTheBlendTakesIt) {
+  // In contact in frames [0, 100); the follower stands 2 m away after. The follower jumps from
+  // frame 50 (in contact) to frame 150 (apart). With blend on, the IK is off from the jump on
+  // (the blend fades its change out); without blend, the IK fades out over ik_fade_s.
+  Duet duet(220, 0, 100, Vec3(0.0, 0.0, 0.04));
+  for (const bool blend : {true, false}) {
+    Runner run(duet.model, only(true, true, false, false, blend));
+    std::vector<double> weights;
+    Vec3 previous = Vec3::Zero();
+    double fastest = 0.0;
+    for (int i = 0; i < 100; ++i) {
+      const int frame = i < 50 ? i : 100 + i;
+      run.step(duet.follower, frame, user_from(duet.leader, i, duet.roles), i == 50);
+      weights.push_back(run.info.ik_weight[1]);
+      const Vec3 now = run.world().positions[duet.wrist(Role::kRightWrist)];
+      if (i > 20) fastest = std::max(fastest, (now - previous).norm());
+      previous = now;
+    }
+    EXPECT_EQ(weights[49], 1.0);
+    if (blend) {
+      EXPECT_EQ(weights[50], 0.0);
+      EXPECT_LT(fastest, 0.05);  // the 2 m move is blended: well under 3 m/s
+    } else {
+      EXPECT_GT(weights[50], 0.9);  // fading out
+      EXPECT_GT(weights[60], 0.0);
+      EXPECT_EQ(weights[66], 0.0);  // 0.25 s = 15 frames
+    }
+  }
+}
+
 TEST(PartnerSynthesis, ContactTargetStaysContinuousWhenTheUsersWristTeleports) {
   const Vec3 grip(0.0, 0.0, 0.04);
   Duet duet(200, 0, 200, grip);
@@ -436,6 +466,56 @@ TEST(PartnerSynthesis, FootLockHoldsASlidingFoot) {
   }
   EXPECT_NEAR(travel[1], 0.1 * 59 * kDt, 1e-9);
   EXPECT_LT(travel[0], 0.1 * travel[1]);
+}
+
+TEST(PartnerModel, FeetArePlantedWhereTheCapturedFootIsLowAndSlow) {
+  Duet duet(60, 0, 0);
+  // The captured follower stands for 20 frames, slides at 0.5 m/s for 20, then lifts her left
+  // toe 10 cm (the whole body: the toes' ground heights come from the frames on the floor).
+  for (int f = 20; f < 60; ++f) {
+    const double x = 0.5 * std::min(f - 20, 20) * kDt;
+    duet.follower.translations_ls(f)[0] += Vec3(x, f >= 40 ? 0.1 : 0.0, 0);
+  }
+  duet.rebuild();
+  const FootLockParams thresholds;  // 0.03 m, 0.2 m/s
+  for (const Side side : {Side::kLeft, Side::kRight}) {
+    EXPECT_TRUE(duet.model.foot_planted(0, side, thresholds));
+    EXPECT_TRUE(duet.model.foot_planted(20, side, thresholds));  // still at 20, moving from 21
+    EXPECT_FALSE(duet.model.foot_planted(21, side, thresholds));
+    EXPECT_FALSE(duet.model.foot_planted(39, side, thresholds));
+    EXPECT_FALSE(duet.model.foot_planted(50, side, thresholds));  // lifted, still
+  }
+  FootLockParams loose = thresholds;
+  loose.speed_threshold_mps = 0.6;
+  EXPECT_TRUE(duet.model.foot_planted(30, Side::kLeft, loose));
+  loose.height_margin_m = 0.2;
+  EXPECT_TRUE(duet.model.foot_planted(50, Side::kLeft, loose));
+}
+
+TEST(PartnerSynthesis, FootLockHoldsPlantedFeetUnderAJitteringUserRoot) {
+  // The user stands still but the sensor jitters her root by 1 cm per frame; aligned to it, the
+  // standing partner's toes move at about 1 m/s. The captured partner's feet are planted, so the
+  // foot lock holds them.
+  Duet duet(120, 0, 0);
+  const std::size_t toe = static_cast<std::size_t>(duet.roles[Role::kLeftToe]);
+  std::mt19937 rng(9);
+  std::normal_distribution<double> jitter(0.0, 0.01);
+  double path[2] = {0, 0};
+  for (const bool lock : {true, false}) {
+    Runner run(duet.model, only(true, false, false, lock, false));
+    std::mt19937 same_noise = rng;
+    Vec3 previous = Vec3::Zero();
+    for (int f = 0; f < 120; ++f) {
+      UserPose user = user_from(duet.leader, f, duet.roles);
+      user.root_position_ws += Vec3(jitter(same_noise), 0.0, jitter(same_noise));
+      run.step(duet.follower, f, user);
+      const Vec3 foot = run.world().positions[toe];
+      if (f > 0) path[lock ? 0 : 1] += (foot - previous).norm();
+      previous = foot;
+    }
+  }
+  EXPECT_GT(path[1], 1.0);
+  EXPECT_LT(path[0], 0.05 * path[1]);
 }
 
 TEST(PartnerSynthesis, AllCorrectionsOnStayFiniteUnderRandomInput) {

@@ -8,9 +8,9 @@
 //                 user's frame;
 //   hand error    at frames whose true template frame has a hand contact (5.2), per contacting
 //                 pair: | output wrist-to-user-wrist distance - captured wrist-to-wrist distance |;
-//   foot slip     frames in which a toe near its ground height (FootLockParams margin, the
-//                 PartnerModel's ground heights) moves horizontally faster than the foot lock's
-//                 speed threshold (5.3); also for the captured response over its own takes;
+//   foot slip     frames in which a toe near its ground height (FootSlipThresholds, the
+//                 PartnerModel's ground heights) moves horizontally faster than a threshold
+//                 (5.3); also for the captured response over its own takes;
 //   jump speed    the largest local joint angular speed in the window after each true jump,
 //                 against the captured response's 99th percentile (5.3 blending).
 //
@@ -29,9 +29,15 @@
 
 namespace duet {
 
+// What counts as a slipping foot. Fixed here rather than taken from FootLockParams, so that
+// retuning the foot lock cannot move the yardstick it is measured with.
+struct FootSlipThresholds {
+  double height_margin_m = 0.03;  // toe above its ground height
+  double speed_mps = 0.2;         // horizontal toe speed above which it slips
+};
+
 struct PartnerMetricsOptions {
-  // Foot slip uses height_margin_m and speed_threshold_mps, the foot lock's own thresholds.
-  FootLockParams foot;
+  FootSlipThresholds slip;
   double post_jump_window_s = 0.5;  // frames with t_jump <= t < t_jump + window follow a jump
   double reference_percentile = 0.99;
 };
@@ -52,13 +58,13 @@ double max_joint_angular_speed_rad_s(const Skeleton& skeleton, std::span<const Q
 
 // A toe near the ground: both positions within the margin of its ground height.
 bool foot_near_ground(const Vec3& previous_ws, const Vec3& current_ws, double ground_height_m,
-                      const FootLockParams& thresholds);
+                      const FootSlipThresholds& thresholds);
 // Horizontal (x, z) speed between two positions; 0 when dt <= 0 or not finite.
 double horizontal_speed_mps(const Vec3& previous_ws, const Vec3& current_ws, double dt_s);
 // A toe near the ground that slides: foot_near_ground and the horizontal speed above the
 // threshold.
 bool foot_slips(const Vec3& previous_ws, const Vec3& current_ws, double ground_height_m,
-                double dt_s, const FootLockParams& thresholds);
+                double dt_s, const FootSlipThresholds& thresholds);
 
 // The captured duet of one take, sampled at a real template frame (Clip::sample: translations
 // lerped, rotations slerped). Sized once; compute() reuses its buffers.
@@ -103,8 +109,8 @@ struct PartnerFrameRecord {
   double joint_error_m = 0.0;
   // Hand error per pair, only for pairs in contact at the true template frame.
   std::array<double, kHandPairCount> hand_error_m{};
-  std::uint8_t hand_pairs = 0;   // bit p: hand_error_m[p] is set
-  bool slip = false;             // a foot slipped since the previous frame (false on frame 0)
+  std::uint8_t hand_pairs = 0;  // bit p: hand_error_m[p] is set
+  bool slip = false;            // a foot slipped since the previous frame (false on frame 0)
   // Horizontal speeds of the toes that stayed near the ground since the previous frame, summed,
   // and how many (0-2): the mean skating speed, which also sees sliding below the threshold.
   double ground_speed_sum_mps = 0.0;
@@ -112,16 +118,16 @@ struct PartnerFrameRecord {
   double max_angular_speed_rad_s = 0.0;  // since the previous frame (0 on frame 0)
   // The same for the true response (0 on frame 0 and at a true jump, where it is cut).
   double true_max_angular_speed_rad_s = 0.0;
-  double step_us = 0.0;          // wall-clock time of the loop step that made it
+  double step_us = 0.0;  // wall-clock time of the loop step that made it
 };
 
 // The captured response of the takes a performance was made from, at the take's own rate: the
 // references for foot slip and angular speed.
 struct CapturedReference {
-  long long slip_frames = 0;  // frames (from the second) in which a foot slipped
-  long long frames = 0;       // frames from the second
-  double ground_speed_sum_mps = 0.0;  // toes near the ground: speeds summed ...
-  long long ground_feet = 0;          // ... and counted
+  long long slip_frames = 0;                 // frames (from the second) in which a foot slipped
+  long long frames = 0;                      // frames from the second
+  double ground_speed_sum_mps = 0.0;         // toes near the ground: speeds summed ...
+  long long ground_feet = 0;                 // ... and counted
   std::vector<double> angular_speeds_rad_s;  // every animated joint, every frame from the second
   // Non-overlapping windows of post_jump_window_s over the take: how often the captured motion
   // itself exceeds its percentile inside such a window (context for the jump metric).
@@ -140,9 +146,9 @@ struct PartnerMetrics {
   long long hand_samples = 0;  // (frame, contacting pair) samples
   double median_hand_error_cm = 0.0;
   double mean_hand_error_cm = 0.0;
-  double slip_rate = 0.0;  // slipping frames / frames from the second
+  double slip_rate = 0.0;          // slipping frames / frames from the second
   double ground_speed_cm_s = 0.0;  // mean horizontal speed of toes near the ground
-  long long jumps = 0;     // true jumps whose window holds at least one frame after the first
+  long long jumps = 0;  // true jumps whose window holds at least one frame after the first
   double max_jump_speed_deg_s = 0.0;     // largest over every jump window
   double median_jump_speed_deg_s = 0.0;  // median over jumps of each window's largest
   long long jumps_over_reference = 0;    // windows whose largest exceeds the reference
@@ -154,13 +160,17 @@ struct PartnerMetrics {
   // The captured response's own numbers over the same takes.
   double captured_slip_rate = 0.0;
   double captured_ground_speed_cm_s = 0.0;
-  double reference_speed_deg_s = 0.0;  // its reference_percentile angular speed
+  double reference_speed_deg_s = 0.0;            // its reference_percentile angular speed
   double captured_windows_over_reference = 0.0;  // fraction of its windows over that
   // The like-for-like reference: the reference_percentile of the captured response's largest
   // speed per post_jump_window_s window (the statistic a jump window is measured with), and the
   // jumps whose window exceeds it.
   double window_reference_speed_deg_s = 0.0;
   long long jumps_over_window_reference = 0;
+  // Of those, the jumps whose window also exceeds the true response's largest in that window:
+  // spikes the dance itself does not have there (a captured take may itself spin a joint faster
+  // than the reference, e.g. 61_07's left hand at 4100 deg/s in its first frames).
+  long long jumps_over_window_reference_and_truth = 0;
 };
 
 // Pools the records of performances (frames and jumps weigh equally across performances) and

@@ -11,7 +11,7 @@ namespace duet {
 
 struct OneEuroParams {
   double min_cutoff_hz = 1.0;  // cutoff of a still signal
-  double beta = 10.0;  // cutoff increase per unit of speed (Hz per m/s for positions)
+  double beta = 10.0;          // cutoff increase per unit of speed (Hz per m/s for positions)
   double derivative_cutoff_hz = 1.0;  // low-pass of the speed estimate that sets the cutoff
 
   // Empty when valid, else which value is wrong.

@@ -2,7 +2,8 @@
 // estimated template frame, then the corrections, each switchable on its own:
 //
 //   response pose at frame f
-//   -> align     root placed relative to the user's heading frame (5.1; 1-euro filtered with smooth)
+//   -> align     root placed relative to the user's heading frame (5.1; 1-euro filtered with
+//   smooth)
 //   -> smooth    per-joint exponential smoothing in quaternion space (5.3)
 //   -> footlock  planted feet held by a horizontal root shift (5.3)
 //   -> contact   two-bone IK of each arm whose hand holds the user's (5.2)
@@ -71,6 +72,10 @@ class PartnerModel {
   double foot_ground_height(Side side) const noexcept {
     return ground_heights_[static_cast<std::size_t>(side)];
   }
+  // Whether the captured partner has that foot planted at `frame` (in [0, frame_count())): its
+  // toe within thresholds.height_margin_m of the ground height and moving horizontally at most
+  // thresholds.speed_threshold_mps since the previous frame (frame 0: towards the next one).
+  bool foot_planted(int frame, Side side, const FootLockParams& thresholds) const noexcept;
 
  private:
   std::shared_ptr<const Skeleton> response_skeleton_;
@@ -78,6 +83,13 @@ class PartnerModel {
   SpatialAlignment alignment_;
   HandContacts contacts_;
   std::array<double, 2> ground_heights_{0.0, 0.0};
+  // Per frame and foot (frame * 2 + side): the captured toe's height above its ground height and
+  // its horizontal speed, m and m/s.
+  struct CapturedFoot {
+    float height_above_ground_m = 0.0f;
+    float speed_mps = 0.0f;
+  };
+  std::vector<CapturedFoot> captured_feet_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -121,8 +133,14 @@ struct PartnerParams {
   // paper's velocity-based blending, 5.3: a critically damped offset x0 peaks at a speed of
   // x0 * 2 ln 2 / (e * half-life)). 4 rad/s (229 deg/s) is below the 99th percentile of the
   // captured salsa partners' joint angular speeds (about 300 deg/s).
+  // The same cap for translations (the root's place relative to the user, e.g. from holding hands
+  // to 2 m apart): 3 m/s, the captured partners' 99th percentile root speed (3.1 m/s over 61_*;
+  // median 1.2 m/s). Without it a 2 m change crossed the room at 10 m/s. Measured with
+  // `duet eval` (docs/evaluation.md): 1.5 m/s raised the joint error on `improv-pause` from 7.0
+  // to 9.8 cm, 3 m/s to 7.4 cm.
   double blend_half_life_s = 0.1;
   double blend_max_speed_rad_s = 4.0;
+  double blend_max_root_speed_mps = 3.0;
 
   // contact: IK target and the time the IK weight takes to go from 0 to 1 (and back) when a
   // contact starts (ends). The weight follows a smoothstep of that linear ramp.
@@ -196,7 +214,7 @@ class PartnerContext {
   std::vector<Quat> blend_rotations_;
   std::vector<Vec3> positions_ws_;  // forward kinematics scratch
   std::vector<Quat> rotations_ws_;
-  Transform user_heading_;                   // last finite user heading frame
+  Transform user_heading_;  // last finite user heading frame
   // The user's heading frame through the 1-euro filter (smooth): root position on the floor and
   // facing direction (a unit horizontal vector, so the yaw never wraps).
   OneEuroFilter3 user_root_filter_;
