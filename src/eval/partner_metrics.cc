@@ -79,6 +79,36 @@ bool foot_slips(const Vec3& previous_ws, const Vec3& current_ws, double ground_h
 }
 
 // ---------------------------------------------------------------------------------------------
+// JerkMeter
+
+JerkMeter::JerkMeter(std::size_t joints)
+    : position_(joints, Vec3::Zero()),
+      velocity_(joints, Vec3::Zero()),
+      acceleration_(joints, Vec3::Zero()) {}
+
+double JerkMeter::add(std::span<const Vec3> positions_ws, double dt_s) noexcept {
+  const std::size_t n = std::min(positions_ws.size(), position_.size());
+  if (known_ > 0 && !valid_dt(dt_s)) known_ = 0;
+  double sum = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const Vec3& p = positions_ws[j];
+    if (known_ >= 1) {
+      const Vec3 v = (p - position_[j]) / dt_s;
+      if (known_ >= 2) {
+        const Vec3 a = (v - velocity_[j]) / dt_s;
+        if (known_ >= 3) sum += ((a - acceleration_[j]) / dt_s).norm();
+        acceleration_[j] = a;
+      }
+      velocity_[j] = v;
+    }
+    position_[j] = p;
+  }
+  const bool has_jerk = known_ >= 3 && n > 0;
+  known_ = std::min(known_ + 1, 4);
+  return has_jerk ? sum / static_cast<double>(n) : -1.0;
+}
+
+// ---------------------------------------------------------------------------------------------
 // CapturedDuetSampler
 
 CapturedDuetSampler::CapturedDuetSampler(const Clip& template_clip,
@@ -208,6 +238,14 @@ void PartnerMetricsAccumulator::add(const Performance& performance,
         hand_errors_m_.push_back(r.hand_error_m[static_cast<std::size_t>(pair)]);
       }
     }
+    if (r.jerk_mps3 >= 0.0) {
+      jerk_sum_ += r.jerk_mps3;
+      ++jerk_frames_;
+    }
+    if (r.true_jerk_mps3 >= 0.0) {
+      true_jerk_sum_ += r.true_jerk_mps3;
+      ++true_jerk_frames_;
+    }
     if (f > 0) {
       ++slip_pairs_;
       slip_frames_ += r.slip ? 1 : 0;
@@ -253,6 +291,10 @@ void PartnerMetricsAccumulator::merge(const PartnerMetricsAccumulator& other) {
   ground_speed_sum_mps_ += other.ground_speed_sum_mps_;
   joint_error_sum_m_ += other.joint_error_sum_m_;
   step_us_sum_ += other.step_us_sum_;
+  jerk_sum_ += other.jerk_sum_;
+  jerk_frames_ += other.jerk_frames_;
+  true_jerk_sum_ += other.true_jerk_sum_;
+  true_jerk_frames_ += other.true_jerk_frames_;
   hand_errors_m_.insert(hand_errors_m_.end(), other.hand_errors_m_.begin(),
                         other.hand_errors_m_.end());
   jump_max_rad_s_.insert(jump_max_rad_s_.end(), other.jump_max_rad_s_.begin(),
@@ -268,6 +310,10 @@ PartnerMetrics PartnerMetricsAccumulator::summary() const {
   if (frames_ > 0) {
     m.mean_joint_error_cm = 100.0 * joint_error_sum_m_ / static_cast<double>(frames_);
     m.mean_step_us = step_us_sum_ / static_cast<double>(frames_);
+  }
+  if (jerk_frames_ > 0) m.mean_jerk_mps3 = jerk_sum_ / static_cast<double>(jerk_frames_);
+  if (true_jerk_frames_ > 0) {
+    m.true_mean_jerk_mps3 = true_jerk_sum_ / static_cast<double>(true_jerk_frames_);
   }
   m.hand_samples = static_cast<long long>(hand_errors_m_.size());
   if (!hand_errors_m_.empty()) {

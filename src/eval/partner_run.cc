@@ -141,11 +141,14 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
   std::vector<Quat> previous_rotations(partner_joints, Quat::Identity());
   std::vector<Quat> previous_true_rotations(partner_joints, Quat::Identity());
   std::vector<PartnerFrameRecord> records(static_cast<std::size_t>(frames));
+  JerkMeter jerk(partner_joints), true_jerk(partner_joints);
   const double nominal_period = 1.0 / performance.motion.frame_rate();
   for (const PartnerConfig& config : configs) {
     loop.set_params(config.params);
     loop.reset();  // rewinds the replay too
     std::array<Vec3, 2> previous_toes{Vec3::Zero(), Vec3::Zero()};
+    jerk.reset();
+    true_jerk.reset();
     for (int f = 0; f < frames; ++f) {
       const auto fs = static_cast<std::size_t>(f);
       load_frame(performance, f, frame);
@@ -181,11 +184,15 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
       for (std::size_t side = 0; side < 2; ++side) {
         toes[side] = out.partner_positions_ws[static_cast<std::size_t>(partner_roles[kToes[side]])];
       }
+      // Speeds over at least one nominal sensor period: a late frame followed by an early one
+      // (timestamps 1 ms apart) is shown at the next display refresh, not 1 ms later.
+      const double dt =
+          f > 0 ? std::max(performance.times_s[fs] - performance.times_s[fs - 1], nominal_period)
+                : 0.0;
+      r.jerk_mps3 = jerk.add(out.partner_positions_ws, dt);
+      if (truth.jump) true_jerk.reset();  // the true response is cut at a true jump
+      r.true_jerk_mps3 = true_jerk.add(sampler.placed_positions_ws(), dt);
       if (f > 0) {
-        // Speeds over at least one nominal sensor period: a late frame followed by an early one
-        // (timestamps 1 ms apart) is shown at the next display refresh, not 1 ms later.
-        const double dt =
-            std::max(performance.times_s[fs] - performance.times_s[fs - 1], nominal_period);
         for (std::size_t side = 0; side < 2; ++side) {
           const double ground = model.foot_ground_height(static_cast<Side>(side));
           r.slip = r.slip || foot_slips(previous_toes[side], toes[side], ground, dt, options.slip);

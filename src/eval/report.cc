@@ -55,10 +55,10 @@ void append_partner_table(std::string& out, const EvalReport& report) {
       "response, docs/evaluation.md):\n";
   constexpr const char* kHeader =
       "{:<18} {:<12} {:>7} {:>8} {:>8} {:>8} {:>7} {:>7} {:>7} {:>9} {:>9} {:>9} {:>7} "
-      "{:>7} {:>7} {:>7} {:>8}\n";
+      "{:>7} {:>7} {:>7} {:>9} {:>9} {:>8}\n";
   fmt::format_to(std::back_inserter(out), kHeader, "case", "corrections", "frames", "joint cm",
                  "hand med", "hand avg", "hand n", "slip", "skate", "jump max", "jump med",
-                 "true med", ">p99", ">true", ">win99", ">w99&t", "us/frame");
+                 "true med", ">p99", ">true", ">win99", ">w99&t", "jerk", "true jerk", "us/frame");
   std::string previous_case;
   const auto case_footer = [&](const PartnerRow& row) {
     const PartnerMetrics& m = row.metrics;
@@ -97,7 +97,8 @@ void append_partner_table(std::string& out, const EvalReport& report) {
                    row.aligned && m.jumps
                        ? fmt::format("{}/{}", m.jumps_over_window_reference_and_truth, m.jumps)
                        : "-",
-                   fmt::format("{:.1f}", m.mean_step_us));
+                   fmt::format("{:.0f}", m.mean_jerk_mps3),
+                   fmt::format("{:.0f}", m.true_mean_jerk_mps3), fmt::format("{:.1f}", m.mean_step_us));
   }
   case_footer(report.partner_rows.back());
 }
@@ -107,7 +108,7 @@ void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::
   fmt::format_to(std::back_inserter(out),
                  "{},{},{},{},{},{},{:.4f},{},{:.4f},{:.4f},{:.5f},{:.5f},{:.3f},{:.3f},{},{:.2f},"
                  "{:.2f},{},"
-                 "{:.2f},{},{:.2f},{:.5f},{:.3f},{:.2f},{:.2f},{},{}\n",
+                 "{:.2f},{},{:.2f},{:.5f},{:.3f},{:.2f},{:.2f},{},{},{:.2f},{:.2f}\n",
                  row.case_name, row.config, take, take_name, row.aligned ? 1 : 0, m.frames,
                  m.mean_joint_error_cm, m.hand_samples, m.median_hand_error_cm,
                  m.mean_hand_error_cm, m.slip_rate, m.captured_slip_rate, m.ground_speed_cm_s,
@@ -115,7 +116,8 @@ void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::
                  m.median_jump_speed_deg_s, m.jumps_over_reference, m.median_true_jump_speed_deg_s,
                  m.jumps_over_truth, m.reference_speed_deg_s, m.captured_windows_over_reference,
                  m.mean_step_us, row.loop_step_us, m.window_reference_speed_deg_s,
-                 m.jumps_over_window_reference, m.jumps_over_window_reference_and_truth);
+                 m.jumps_over_window_reference, m.jumps_over_window_reference_and_truth,
+                 m.mean_jerk_mps3, m.true_mean_jerk_mps3);
 }
 
 }  // namespace
@@ -129,7 +131,8 @@ std::string format_partner_csv(const EvalReport& report) {
       "deg_s,"
       "jumps_over_truth,reference_speed_deg_s,"
       "captured_windows_over_reference,mean_step_us,loop_step_us,window_reference_speed_deg_s,"
-      "jumps_over_window_reference,jumps_over_window_reference_and_truth\n";
+      "jumps_over_window_reference,jumps_over_window_reference_and_truth,mean_jerk_mps3,"
+      "true_mean_jerk_mps3\n";
   for (const PartnerRow& row : report.partner_rows) {
     for (const auto& [take, metrics] : row.per_take) {
       append_partner_csv_row(out, row, std::to_string(take), take_name(report, take), metrics);

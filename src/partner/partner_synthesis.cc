@@ -198,6 +198,9 @@ std::string PartnerParams::validate() const {
   if (const std::string_view problem = user_filter.validate(); !problem.empty()) {
     return "user_filter: " + std::string(problem);
   }
+  if (const std::string_view problem = ik_target_filter.validate(); !problem.empty()) {
+    return "ik_target_filter: " + std::string(problem);
+  }
   return {};
 }
 
@@ -286,6 +289,7 @@ void PartnerContext::reset() noexcept {
   user_heading_ = Transform();
   user_root_filter_.reset();
   user_facing_filter_.reset();
+  for (OneEuroFilter3& filter : ik_target_filter_) filter.reset();
   ik_ramp_ = {0.0, 0.0};
   ik_pair_ = {-1, -1};
   ik_target_valid_ = {false, false};
@@ -428,6 +432,7 @@ bool PartnerSynthesisJob::run() const noexcept {
       ctx.ik_ramp_[r] = ramp;
       const double weight = smoothstep(ctx.ik_ramp_[r]);
       if (weight <= 0.0 || ctx.ik_pair_[r] < 0) {
+        ctx.ik_target_filter_[r].reset();
         ctx.ik_target_valid_[r] = false;
         continue;
       }
@@ -436,6 +441,7 @@ bool PartnerSynthesisJob::run() const noexcept {
       // captured path while the weight falls.
       const Side ts = template_side(ctx.ik_pair_[r]);
       if (!finite_pose(*user, ts)) {
+        ctx.ik_target_filter_[r].reset();
         ctx.ik_target_valid_[r] = false;
         continue;
       }
@@ -468,7 +474,10 @@ bool PartnerSynthesisJob::run() const noexcept {
         ctx.ik_target_offset_[r] = Vec3::Zero();
         ctx.ik_target_offset_velocity_[r] = Vec3::Zero();
       }
-      const Vec3 target = raw_target + ctx.ik_target_offset_[r];
+      Vec3 target = raw_target + ctx.ik_target_offset_[r];
+      // Smooth: the target through the 1-euro filter, restarted where the blend takes a jump.
+      if (!p.smooth || (p.blend && jumped)) ctx.ik_target_filter_[r].reset();
+      if (p.smooth) target = ctx.ik_target_filter_[r].filter(target, dt, p.ik_target_filter);
       ctx.ik_target_valid_[r] = true;
       ctx.ik_raw_target_[r] = raw_target;
       ctx.ik_shown_target_[r] = target;
@@ -500,6 +509,7 @@ bool PartnerSynthesisJob::run() const noexcept {
     ctx.ik_ramp_ = {0.0, 0.0};
     ctx.ik_pair_ = {-1, -1};
     ctx.ik_target_valid_ = {false, false};
+    for (OneEuroFilter3& filter : ctx.ik_target_filter_) filter.reset();
   }
 
   // 5. Blend (5.3): inertialization of the finished pose, so a jump's change is blended whatever

@@ -91,6 +91,29 @@ struct SyntheticDuet {
   }
 };
 
+TEST(JerkMeter, ThirdDifferenceOfACubicPath) {
+  // Joint 0 moves along x = t^3 (jerk 6 m/s^3), joint 1 along z = 2 t^2 (jerk 0), at 10 Hz.
+  JerkMeter meter(2);
+  const double dt = 0.1;
+  for (int f = 0; f < 8; ++f) {
+    const double t = f * dt;
+    const std::vector<Vec3> positions = {Vec3(t * t * t, 0, 0), Vec3(0, 1, 2 * t * t)};
+    const double jerk = meter.add(positions, dt);
+    if (f < 3) {
+      EXPECT_EQ(jerk, -1.0) << f;  // velocity, acceleration and jerk need four frames
+    } else {
+      EXPECT_NEAR(jerk, (6.0 + 0.0) / 2, 1e-9) << f;
+    }
+  }
+  // A reset (a cut) and a bad dt both restart the count.
+  meter.reset();
+  EXPECT_EQ(meter.add(std::vector<Vec3>(2, Vec3::Zero()), dt), -1.0);
+  for (int f = 0; f < 3; ++f) meter.add(std::vector<Vec3>(2, Vec3::Zero()), dt);
+  EXPECT_EQ(meter.add(std::vector<Vec3>(2, Vec3::Zero()), dt), 0.0);
+  EXPECT_EQ(meter.add(std::vector<Vec3>(2, Vec3::Ones()), 0.0), -1.0);
+  EXPECT_EQ(meter.add(std::vector<Vec3>(2, Vec3::Ones()), std::nan("")), -1.0);
+}
+
 TEST(CapturedDuetSampler, PlacesTheTrueResponseRelativeToTheUser) {
   const SyntheticDuet duet;
   CapturedDuetSampler sampler(duet.template_clip, duet.roles, duet.response_clip, duet.model);
@@ -174,6 +197,9 @@ TEST(PartnerMetricsAccumulator, PoolsFramesHandsSlipsAndJumpWindows) {
       r.ground_speed_sum_mps = 0.3;  // one toe on the ground at 0.3 m/s
       r.ground_feet = 1;
     }
+    // Jerk known from frame 3 on: 10, 20, ..., 70 (mean 40); the truth's from frame 5: 1..5.
+    if (f >= 3) r.jerk_mps3 = 10.0 * (f - 2);
+    if (f >= 5) r.true_jerk_mps3 = f - 4;
   }
   records[0].ground_speed_sum_mps = 5.0;  // frame 0 is never counted
   records[0].ground_feet = 2;
@@ -220,6 +246,8 @@ TEST(PartnerMetricsAccumulator, PoolsFramesHandsSlipsAndJumpWindows) {
   EXPECT_EQ(m.jumps_over_window_reference, 1);
   EXPECT_EQ(m.jumps_over_window_reference_and_truth, 0);  // the true response reaches 30
   EXPECT_NEAR(m.mean_step_us, 10.0, 1e-12);
+  EXPECT_NEAR(m.mean_jerk_mps3, 40.0, 1e-12);
+  EXPECT_NEAR(m.true_mean_jerk_mps3, 3.0, 1e-12);
 
   // Merging is pooling.
   PartnerMetricsAccumulator twice;
@@ -230,6 +258,7 @@ TEST(PartnerMetricsAccumulator, PoolsFramesHandsSlipsAndJumpWindows) {
   EXPECT_EQ(m2.jumps, 2);
   EXPECT_NEAR(m2.median_hand_error_cm, 2.5, 1e-9);
   EXPECT_NEAR(m2.slip_rate, m.slip_rate, 1e-12);
+  EXPECT_NEAR(m2.mean_jerk_mps3, 40.0, 1e-12);
 }
 
 // The whole run on a real take: the user dances 60_10 exactly, so the true response is the
@@ -270,6 +299,11 @@ TEST(PartnerRun, RealTakeFollowedExactly) {
   EXPECT_LE(m["all"].median_hand_error_cm, m["no-contact"].median_hand_error_cm);
   // The take as captured, played at its own rate: the raw response slips exactly as captured.
   EXPECT_NEAR(m["none"].slip_rate, m["none"].captured_slip_rate, 0.01);
+  // Jerk: the raw pose at the exact estimate jerks like the true response; smoothing lowers it.
+  EXPECT_GT(m["align-only"].true_mean_jerk_mps3, 1.0);
+  EXPECT_NEAR(m["align-only"].mean_jerk_mps3, m["align-only"].true_mean_jerk_mps3,
+              0.2 * m["align-only"].true_mean_jerk_mps3);
+  EXPECT_LT(m["all"].mean_jerk_mps3, m["no-smooth"].mean_jerk_mps3);
   EXPECT_GT(m["all"].reference_speed_deg_s, 0.0);
   EXPECT_GT(run.value().loop_step_us, 0.0);
 }

@@ -266,6 +266,39 @@ TEST(PartnerSynthesis, ContactMovesThePartnersWristToTheUsersHand) {
   }
 }
 
+TEST(PartnerSynthesis, SmoothFiltersTheContactTargetsJitter) {
+  // Hands held throughout; the sensor jitters the user's left wrist by 1 cm per axis per frame.
+  // With smooth on, the IK target goes through the 1-euro filter: the partner's right wrist
+  // travels much less; once the jitter stops it settles on the unfiltered target.
+  const Vec3 grip(0.0, 0.0, 0.04);
+  Duet duet(240, 0, 240, grip);
+  const std::size_t wrist = duet.wrist(Role::kRightWrist);
+  double path[2] = {0, 0};
+  Vec3 settled[2];
+  for (const bool smooth : {true, false}) {
+    Runner run(duet.model, only(true, true, smooth, false, false));
+    std::mt19937 rng(4);
+    std::normal_distribution<double> jitter(0.0, 0.01);
+    Vec3 previous = Vec3::Zero();
+    for (int f = 0; f < 240; ++f) {
+      UserPose user = user_from(duet.leader, f, duet.roles);
+      if (f < 120) {
+        user.wrist_positions_ws[0] += Vec3(jitter(rng), jitter(rng), jitter(rng));
+      }
+      run.step(duet.follower, f, user);
+      const Vec3 now = run.world().positions[wrist];
+      if (f > 20 && f < 120) path[smooth ? 0 : 1] += (now - previous).norm();
+      previous = now;
+      ASSERT_TRUE(now.allFinite());
+    }
+    settled[smooth ? 0 : 1] = previous;
+    EXPECT_LT(run.info.ik_error_m[1], 1e-6);
+  }
+  EXPECT_GT(path[1], 1.0);  // ~1.6 cm per frame unfiltered
+  EXPECT_LT(path[0], 0.5 * path[1]);
+  EXPECT_LT((settled[0] - settled[1]).norm(), 1e-4);
+}
+
 TEST(PartnerSynthesis, SmoothDampsJitter) {
   Duet duet(120, 0, 0);
   const std::size_t elbow = static_cast<std::size_t>(duet.roles[Role::kLeftElbow]);

@@ -12,7 +12,9 @@
 //                 PartnerModel's ground heights) moves horizontally faster than a threshold
 //                 (5.3); also for the captured response over its own takes;
 //   jump speed    the largest local joint angular speed in the window after each true jump,
-//                 against the captured response's 99th percentile (5.3 blending).
+//                 against the captured response's 99th percentile (5.3 blending);
+//   jerk          mean over joints of |third derivative| of the world positions, against the
+//                 true response's over the same performance.
 //
 // Offline code: allocates freely (it is not on the live path; the synthesis it measures is).
 #pragma once
@@ -66,6 +68,24 @@ double horizontal_speed_mps(const Vec3& previous_ws, const Vec3& current_ws, dou
 bool foot_slips(const Vec3& previous_ws, const Vec3& current_ws, double ground_height_m,
                 double dt_s, const FootSlipThresholds& thresholds);
 
+// Jerk of a moving skeleton by backward differences of its world positions: velocity,
+// acceleration and jerk each over the step's dt (exact for a cubic path at a steady rate). Sized
+// once for a joint count; add() allocates nothing.
+class JerkMeter {
+ public:
+  explicit JerkMeter(std::size_t joints = 0);
+  // Forget the past (e.g. where the motion is cut): the next three frames give no jerk.
+  void reset() noexcept { known_ = 0; }
+  // Adds a frame dt_s after the previous one (ignored for the first frame after a reset) and
+  // returns the mean over joints of |jerk| (m/s^3) at it, or -1 while fewer than four frames are
+  // known or when dt_s is not positive and finite (which also resets).
+  double add(std::span<const Vec3> positions_ws, double dt_s) noexcept;
+
+ private:
+  std::vector<Vec3> position_, velocity_, acceleration_;
+  int known_ = 0;  // frames since the reset, up to 4
+};
+
 // The captured duet of one take, sampled at a real template frame (Clip::sample: translations
 // lerped, rotations slerped). Sized once; compute() reuses its buffers.
 class CapturedDuetSampler {
@@ -118,6 +138,10 @@ struct PartnerFrameRecord {
   double max_angular_speed_rad_s = 0.0;  // since the previous frame (0 on frame 0)
   // The same for the true response (0 on frame 0 and at a true jump, where it is cut).
   double true_max_angular_speed_rad_s = 0.0;
+  // Mean joint jerk (m/s^3) of the output and of the true response (JerkMeter; -1 where it is
+  // not known: the first frames, and the true response's first frames after a cut).
+  double jerk_mps3 = -1.0;
+  double true_jerk_mps3 = -1.0;
   double step_us = 0.0;  // wall-clock time of the loop step that made it
 };
 
@@ -156,6 +180,10 @@ struct PartnerMetrics {
   // that window (the dance itself may spin faster than the percentile right after a jump).
   long long jumps_over_truth = 0;
   double median_true_jump_speed_deg_s = 0.0;  // median over jumps of the true response's largest
+  // Mean over frames of the mean joint jerk, m/s^3: the output's and the true response's (each
+  // over the frames where it is known).
+  double mean_jerk_mps3 = 0.0;
+  double true_mean_jerk_mps3 = 0.0;
   double mean_step_us = 0.0;
   // The captured response's own numbers over the same takes.
   double captured_slip_rate = 0.0;
@@ -192,6 +220,8 @@ class PartnerMetricsAccumulator {
   long long frames_ = 0, slip_frames_ = 0, slip_pairs_ = 0, ground_feet_ = 0;
   double ground_speed_sum_mps_ = 0.0;
   double joint_error_sum_m_ = 0.0, step_us_sum_ = 0.0;
+  double jerk_sum_ = 0.0, true_jerk_sum_ = 0.0;
+  long long jerk_frames_ = 0, true_jerk_frames_ = 0;
   std::vector<double> hand_errors_m_;
   std::vector<double> jump_max_rad_s_;  // one per jump window
   std::vector<double> jump_true_max_rad_s_;
