@@ -145,16 +145,7 @@ void CapturedDuetSampler::compute(double template_frame, const Vec3& user_root_p
                      response_pose_.rotations_ls, response_positions_,
                      std::span(rotations_scratch_).first(rn));
 
-  // The placement of 5.1 at a real frame: lerp / slerp between the two nearest frames, as the
-  // clips themselves are sampled.
-  const int f0 = static_cast<int>(std::floor(frame));
-  const int f1 = std::min(f0 + 1, last);
-  const double w = frame - f0;
-  const RootPlacement& p0 = model_->alignment().placement(f0);
-  const RootPlacement& p1 = model_->alignment().placement(f1);
-  RootPlacement placement;
-  placement.position_hs = (1.0 - w) * p0.position_hs + w * p1.position_hs;
-  placement.rotation_hs = p0.rotation_hs.slerp(w, p1.rotation_hs).normalized();
+  const RootPlacement placement = model_->alignment().placement_at(frame);
   const Transform root = place_root(placement, user_root_position_ws, user_root_rotation_ws);
   placed_pose_.translations_ls = response_pose_.translations_ls;
   placed_pose_.rotations_ls = response_pose_.rotations_ls;

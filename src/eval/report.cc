@@ -98,7 +98,8 @@ void append_partner_table(std::string& out, const EvalReport& report) {
                        ? fmt::format("{}/{}", m.jumps_over_window_reference_and_truth, m.jumps)
                        : "-",
                    fmt::format("{:.0f}", m.mean_jerk_mps3),
-                   fmt::format("{:.0f}", m.true_mean_jerk_mps3), fmt::format("{:.1f}", m.mean_step_us));
+                   fmt::format("{:.0f}", m.true_mean_jerk_mps3),
+                   fmt::format("{:.1f}", m.mean_step_us));
   }
   case_footer(report.partner_rows.back());
 }

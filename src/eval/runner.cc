@@ -173,9 +173,9 @@ Result<NaiveCheck> run_naive_check(const DuetLibrary& library, const EvalCase& e
                  " states, more than the naive forward's limit " +
                  std::to_string(NaiveHmmFollower::kMaxStates)};
   }
-  Result<TemplateModel> one = TemplateModel::build(
-      FeatureMatrix(full.features().middleRows(begin, count)), {}, full.frame_rate_hz(),
-      full.velocity_dims());
+  Result<TemplateModel> one =
+      TemplateModel::build(FeatureMatrix(full.features().middleRows(begin, count)), {},
+                           full.frame_rate_hz(), full.velocity_dims());
   if (!one) return one.error();
   const TemplateModel& model = one.value();
   check.states = model.num_states();
@@ -387,8 +387,8 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
       }
       if (configs > 0) {
         // The synthesized partner, with the "hmm" tracker as `duet follow` runs it.
-        const std::string label =
-            eval_case.name + " / " + lib.takes()[static_cast<std::size_t>(take)].name + " / partner";
+        const std::string label = eval_case.name + " / " +
+                                  lib.takes()[static_cast<std::size_t>(take)].name + " / partner";
         if (progress) progress(done, total, label);
         Result<std::unique_ptr<Tracker>> tracker =
             make_eval_tracker(TrackerKind::kHmm, lib.model(), options);

@@ -95,6 +95,7 @@ LiveLoop::LiveLoop(std::shared_ptr<const DuetLibrary> library, const SourceSkele
   out_.partner_rotations_ls.assign(partner_n, Quat::Identity());
   out_.partner_positions_ws.assign(partner_n, Vec3::Zero());
   out_.partner_rotations_ws.assign(partner_n, Quat::Identity());
+  shown_pose_.resize(partner_joints);
   // Until the first frame, the partner stands in its first captured pose.
   const Clip& response = library_->takes()[0].response_motion.clip;
   std::ranges::copy(response.translations_ls(0), out_.partner_translations_ls.begin());
@@ -114,6 +115,7 @@ bool LiveLoop::set_correction(std::string_view name, bool enabled) noexcept {
 void LiveLoop::reset() noexcept {
   session_.reset();
   context_.reset();
+  playhead_.reset();
   previous_take_ = -1;
   previous_frame_ = 0;
   has_previous_ = false;
@@ -145,11 +147,22 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   PartnerSynthesisJob job;
   job.model = &model;
   job.params = &params_;
-  job.frame = frame_in_take;
   job.jumped = result.jumped || (previous_take_ >= 0 && take != previous_take_);
   job.dt_s = has_previous_ ? frame.time_s - previous_time_s_ : 0.0;
-  job.translations_ls = response.translations_ls(frame_in_take);
-  job.rotations_ls = response.rotations_ls(frame_in_take);
+  // The response at the playhead (smooth) or at the estimate itself.
+  double position = frame_in_take;
+  if (params_.smooth) {
+    position = playhead_.advance(frame_in_take, job.jumped, result.tempo, job.dt_s,
+                                 response.frame_rate(), params_.playhead);
+    position = std::clamp(position, 0.0, static_cast<double>(model.frame_count() - 1));
+  } else {
+    playhead_.reset();
+  }
+  job.frame = static_cast<int>(std::lround(position));
+  job.frame_position = position;
+  response.sample(position / response.frame_rate(), shown_pose_);
+  job.translations_ls = shown_pose_.translations_ls;
+  job.rotations_ls = shown_pose_.rotations_ls;
   job.user = &user_pose_;
   job.context = &context_;
   job.translations_ls_out = out_.partner_translations_ls;

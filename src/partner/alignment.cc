@@ -1,6 +1,8 @@
 #include "duet/partner/alignment.h"
 
+#include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <string>
 
 #include "duet/math/rotation.h"
@@ -55,6 +57,21 @@ Result<SpatialAlignment> SpatialAlignment::build(const Clip& template_clip,
 const RootPlacement& SpatialAlignment::placement(int frame) const noexcept {
   assert(frame >= 0 && frame < frame_count());
   return placements_[static_cast<std::size_t>(frame)];
+}
+
+RootPlacement SpatialAlignment::placement_at(double frame) const noexcept {
+  assert(frame_count() > 0);
+  const int last = frame_count() - 1;
+  const double position = std::isfinite(frame) ? std::clamp(frame, 0.0, double(last)) : 0.0;
+  const int f0 = static_cast<int>(std::floor(position));
+  const int f1 = std::min(f0 + 1, last);
+  const double w = position - f0;
+  const RootPlacement& p0 = placements_[static_cast<std::size_t>(f0)];
+  const RootPlacement& p1 = placements_[static_cast<std::size_t>(f1)];
+  RootPlacement placement;
+  placement.position_hs = (1.0 - w) * p0.position_hs + w * p1.position_hs;
+  placement.rotation_hs = p0.rotation_hs.slerp(w, p1.rotation_hs).normalized();
+  return placement;
 }
 
 }  // namespace duet

@@ -232,6 +232,15 @@ const Vec3& HandContacts::offset_ls(int frame, int pair) const noexcept {
   return offset_ls_[index(frame, pair)];
 }
 
+Vec3 HandContacts::offset_ls_at(double frame, int pair) const noexcept {
+  const int last = frame_count() - 1;
+  const double position = std::isfinite(frame) ? std::clamp(frame, 0.0, double(last)) : 0.0;
+  const int f0 = static_cast<int>(std::floor(position));
+  const int f1 = std::min(f0 + 1, last);
+  const double w = position - f0;
+  return (1.0 - w) * offset_ls(f0, pair) + w * offset_ls(f1, pair);
+}
+
 std::span<const ContactInterval> HandContacts::intervals(int pair) const noexcept {
   assert(pair >= 0 && pair < kHandPairCount);
   return intervals_[static_cast<std::size_t>(pair)];

@@ -201,6 +201,9 @@ std::string PartnerParams::validate() const {
   if (const std::string_view problem = ik_target_filter.validate(); !problem.empty()) {
     return "ik_target_filter: " + std::string(problem);
   }
+  if (const std::string_view problem = playhead.validate(); !problem.empty()) {
+    return "playhead: " + std::string(problem);
+  }
   return {};
 }
 
@@ -331,6 +334,8 @@ bool PartnerSynthesisJob::run() const noexcept {
   const double dt = dt_s > 0.0 && std::isfinite(dt_s) ? dt_s : 1.0 / model->frame_rate();
   const std::span<Vec3> out_t = translations_ls_out;
   const std::span<Quat> out_r = rotations_ls_out;
+  // The real frame the pose was sampled at, for what is interpolated between frames.
+  const bool has_position = frame_position >= 0.0 && std::isfinite(frame_position);
   PartnerFrameInfo diagnostics;
   diagnostics.contact_mask = model->contacts().mask(frame);
 
@@ -369,7 +374,8 @@ bool PartnerSynthesisJob::run() const noexcept {
   if (p.align) {
     if (user_root_finite) ctx.user_heading_ = user_heading;
     heading = ctx.user_heading_;
-    const RootPlacement& placement = model->alignment().placement(frame);
+    const RootPlacement placement = has_position ? model->alignment().placement_at(frame_position)
+                                                 : model->alignment().placement(frame);
     const Transform root = heading * Transform{placement.rotation_hs, placement.position_hs};
     out_t[0] = root.translation;
     out_r[0] = root.rotation.normalized();
@@ -448,8 +454,9 @@ bool PartnerSynthesisJob::run() const noexcept {
       const auto t = static_cast<std::size_t>(ts);
       Vec3 raw_target = user->wrist_positions_ws[t];
       if (p.ik_target == IkTarget::kCapturedOffset) {
-        raw_target +=
-            user->wrist_rotations_ws[t].normalized() * contacts.offset_ls(frame, ctx.ik_pair_[r]);
+        raw_target += user->wrist_rotations_ws[t].normalized() *
+                      (has_position ? contacts.offset_ls_at(frame_position, ctx.ik_pair_[r])
+                                    : contacts.offset_ls(frame, ctx.ik_pair_[r]));
       }
       // Keep the target continuous across jumps (5.3): the step of the raw target is absorbed
       // by an offset that decays like the blend. The speed test uses at least one model frame

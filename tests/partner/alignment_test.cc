@@ -42,6 +42,13 @@ TEST(SpatialAlignment, StoresTheResponseRootInTheTemplateHeadingFrame) {
     EXPECT_NEAR(p.position_hs.y(), 0.97 + 0.01 * f, 1e-12);  // height above the floor
     EXPECT_NEAR(std::abs(p.relative_yaw_rad()), kPi, 1e-9);
   }
+  // Between frames the placement is interpolated; outside the clip it is clamped.
+  const RootPlacement half = alignment.value().placement_at(1.5);
+  EXPECT_NEAR(half.position_hs.y(), 0.985, 1e-12);
+  EXPECT_NEAR(half.position_hs.z(), 0.8, 1e-12);
+  EXPECT_NEAR(alignment.value().placement_at(-3.0).position_hs.y(), 0.97, 1e-12);
+  EXPECT_NEAR(alignment.value().placement_at(9.0).position_hs.y(), 0.99, 1e-12);
+  EXPECT_NEAR(alignment.value().placement_at(std::nan("")).position_hs.y(), 0.97, 1e-12);
 }
 
 TEST(SpatialAlignment, PartnerKeepsItsRelativePlaceWhenTheUserMovesAndTurns) {

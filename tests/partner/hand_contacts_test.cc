@@ -139,6 +139,13 @@ TEST(HandContacts, OffsetIsInTheTemplateHandFrame) {
       EXPECT_LT((rebuilt - r.positions[rw]).norm(), 1e-12);
     }
   }
+  // Between frames: the lerp of the two nearest; clamped outside the clip.
+  for (int p = 0; p < kHandPairCount; ++p) {
+    const Vec3 mid = 0.75 * c.offset_ls(100, p) + 0.25 * c.offset_ls(101, p);
+    EXPECT_LT((c.offset_ls_at(100.25, p) - mid).norm(), 1e-12);
+    EXPECT_EQ(c.offset_ls_at(-5.0, p), c.offset_ls(0, p));
+    EXPECT_EQ(c.offset_ls_at(1e9, p), c.offset_ls(kFrames - 1, p));
+  }
 }
 
 TEST(HandContacts, BadInputIsAnError) {

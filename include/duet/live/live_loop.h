@@ -95,6 +95,8 @@ class LiveLoop {
   PartnerContext context_;
   LiveOutput out_;
   UserPose user_pose_;
+  ResponsePlayhead playhead_;
+  Pose shown_pose_;  // the response sampled at the playhead
   int previous_take_ = -1;
   int previous_frame_ = 0;
   double previous_time_s_ = 0.0;

@@ -52,6 +52,9 @@ class SpatialAlignment {
   int frame_count() const noexcept { return static_cast<int>(placements_.size()); }
   // frame in [0, frame_count()).
   const RootPlacement& placement(int frame) const noexcept;
+  // At a real frame (clamped to the clip): lerp / slerp between the two nearest frames, as the
+  // clips themselves are sampled (Clip::sample).
+  RootPlacement placement_at(double frame) const noexcept;
 
  private:
   std::vector<RootPlacement> placements_;

@@ -83,6 +83,8 @@ class HandContacts {
   // Captured response wrist position minus template wrist position, expressed in the template
   // hand joint's frame (metres). Stored for every frame, in contact or not.
   const Vec3& offset_ls(int frame, int pair) const noexcept;
+  // The same at a real frame (clamped to the clip): lerp between the two nearest frames.
+  Vec3 offset_ls_at(double frame, int pair) const noexcept;
 
   std::span<const ContactInterval> intervals(int pair) const noexcept;
   // Fraction of frames in which pair is in contact (after debouncing), in [0, 1].

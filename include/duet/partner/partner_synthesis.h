@@ -31,6 +31,7 @@
 #include "duet/partner/foot_lock.h"
 #include "duet/partner/hand_contacts.h"
 #include "duet/partner/one_euro_filter.h"
+#include "duet/partner/response_playhead.h"
 #include "duet/partner/smoothing.h"
 
 namespace duet {
@@ -134,6 +135,10 @@ struct PartnerParams {
   // response does not have 1/24 -> 0/24; for a median hand-relation error of 0.79 -> 1.18 cm
   // (0.21 -> 0.46 cm noise-free). Restarts at a jump (the blend takes the jump).
   OneEuroParams ik_target_filter{5.0, 20.0, 1.0};
+  // smooth: the response is shown at a real frame that advances at the dancer's tempo
+  // (response_playhead.h; used by LiveLoop, which samples the pose there and passes it as
+  // PartnerSynthesisJob::frame_position).
+  PlayheadParams playhead;
 
   // blend: half-life of the inertialization offset recorded at a jump; at least this, and long
   // enough that the decaying offset alone turns no joint faster than blend_max_speed_rad_s (the
@@ -261,6 +266,9 @@ struct PartnerSynthesisJob {
   const PartnerParams* params = nullptr;
   // Estimated template frame (FollowResult::frame_in_take), in [0, model->frame_count()).
   int frame = -1;
+  // The real frame the pose was sampled at (ResponsePlayhead), used for the root's placement;
+  // < 0 or not finite: `frame`.
+  double frame_position = -1.0;
   // The follower jumped this frame (FollowResult::jumped, or a change of take): blend starts.
   bool jumped = false;
   // Time since the previous frame, seconds; <= 0 or not finite counts as one model frame.

@@ -1,0 +1,42 @@
+// Where in the response clip the partner is shown, as a real frame (method.md 5.3 smoothness,
+// applied to time). The follower's estimate is a whole template frame that advances by 0, 1 or
+// 2 frames per input frame, so for a dancer at 0.7x the template's tempo the raw estimate holds
+// and steps (0, 1, 1, 2, 3, 3, ...): the partner moves in a staircase, which shows as jerk
+// (docs/evaluation.md, partner metrics). The playhead instead advances at the tempo the follower
+// measured (FollowResult::tempo) and is pulled towards the estimate with a half-life, never
+// further than max_offset_frames from it; at a jump, a change of take or the first frame it
+// starts on the estimate. The pose is then sampled at that real frame (Clip::sample).
+#pragma once
+
+namespace duet {
+
+// Chosen with `duet eval` (docs/evaluation.md, partner metrics): half-life / max offset 0.05 s /
+// 1 frame, 0.1 / 1, 0.03 / 0.5, 0.1 / 2, 0.2 / 2 gave joint jerk 1031, 997, 1133, 977, 951 m/s^3
+// on `tempo-slow` (1883 without the playhead) but post-jump spikes the true response does not
+// have on `improv-30hz-noisy` 2, 2, 0, 1, 0 of 24 and hand-relation medians 0.52, 0.57, 0.49,
+// 0.60, 0.71 cm on `improv-pause`: 0.03 s / 0.5 frame stays closest to the estimate.
+struct PlayheadParams {
+  double pull_half_life_s = 0.03;  // how fast a difference to the estimate is closed
+  double max_offset_frames = 0.5;  // the playhead stays within this of the estimate
+  // Empty when valid, else which value is wrong.
+  const char* validate() const noexcept;
+};
+
+class ResponsePlayhead {
+ public:
+  void reset() noexcept { primed_ = false; }
+  // estimate: the follower's frame; restart: a jump or another take (start on the estimate);
+  // tempo: template frames per template frame of input time (non-finite or <= 0: 1); dt_s: time
+  // since the previous call (<= 0 or non-finite: restart); frame_rate: the template's. Returns
+  // the real frame to show, within max_offset_frames of the estimate (the caller clamps it to
+  // the clip).
+  double advance(int estimate, bool restart, double tempo, double dt_s, double frame_rate,
+                 const PlayheadParams& params) noexcept;
+  double position() const noexcept { return position_; }
+
+ private:
+  bool primed_ = false;
+  double position_ = 0.0;
+};
+
+}  // namespace duet
