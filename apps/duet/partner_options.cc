@@ -6,8 +6,11 @@ void add_partner_options(CLI::App& app, PartnerArgs& args) {
   app.add_flag("--no-align", args.no_align,
                "Do not place the partner relative to the user (keep the capture's place)");
   app.add_flag("--no-contact", args.no_contact, "No hand-contact IK");
-  app.add_flag("--no-smooth", args.no_smooth, "No per-joint rotation smoothing");
-  app.add_flag("--no-footlock", args.no_footlock, "Do not keep planted feet in place");
+  app.add_flag("--no-smooth", args.no_smooth,
+               "No smoothing: per-joint rotations, the user's heading, the contact IK target, "
+               "the tempo playhead (the raw whole-frame estimate is shown)");
+  app.add_flag("--no-footlock", args.no_footlock,
+               "Do not hold the feet the captured partner has planted");
   app.add_flag("--no-blend", args.no_blend, "Cut instead of blending when the follower jumps");
   app.add_option("--ik-target", args.ik_target,
                  "Where a held hand goes: offset (the captured grip relative to the user's hand, "
