@@ -30,16 +30,24 @@ struct FollowArgs {
   std::string truth_path;
 };
 
+// The BVH files are written in the units of the files they come from (the partner in the
+// response takes', the user in the input's), so every duet command reads them back at the same
+// scale and a viewer shows them as it shows the originals.
 Status write_outputs(const FollowArgs& args, const std::string& trace, const Clip& partner,
-                     const Clip& user) {
+                     double partner_metres_per_unit, const Clip& user,
+                     double user_metres_per_unit) {
   if (!args.trace_path.empty()) {
     if (Status s = write_file_atomically(args.trace_path, trace); !s) return s;
   }
   if (!args.output_path.empty()) {
-    if (Status s = write_bvh(partner, args.output_path); !s) return s;
+    BvhWriteOptions options;
+    options.units_per_metre = 1.0 / partner_metres_per_unit;
+    if (Status s = write_bvh(partner, args.output_path, options); !s) return s;
   }
   if (!args.user_output_path.empty()) {
-    if (Status s = write_bvh(user, args.user_output_path); !s) return s;
+    BvhWriteOptions options;
+    options.units_per_metre = 1.0 / user_metres_per_unit;
+    if (Status s = write_bvh(user, args.user_output_path, options); !s) return s;
   }
   return Ok{};
 }
@@ -111,7 +119,10 @@ int run_follow(const FollowArgs& args) {
   bar.update(user.frame_count(), user.frame_count());
   bar.finish();
 
-  if (Status s = write_outputs(args, trace, partner, user); !s) {
+  if (Status s = write_outputs(args, trace, partner,
+                               library->takes()[0].response_motion.metres_per_unit, user,
+                               input.value().metres_per_unit);
+      !s) {
     fmt::print(stderr, "duet follow: {}\n", s.error().message);
     return kExitFailure;
   }
@@ -144,11 +155,11 @@ Command register_follow(CLI::App& app) {
                  "Write one CSV row per input frame: "
                  "frame,time_s,take,template_frame,confidence,jumped,lost");
   app.add_option("-o,--output", args->output_path,
-                 "Write the partner's motion: BVH in metres, in the user's world frame, at the "
-                 "input's rate and frame count");
+                 "Write the partner's motion: BVH in the response takes' units, in the user's "
+                 "world frame, at the input's rate and frame count");
   app.add_option("--user-output", args->user_output_path,
-                 "Also write the user's motion in metres, sharing the partner file's world frame "
-                 "(open both together to see the duet)");
+                 "Also write the user's motion (BVH in the input's units), sharing the partner "
+                 "file's world frame (open both together to see the duet)");
   app.add_option("--truth", args->truth_path,
                  "Ground truth CSV from `duet improvise`: print the follower's accuracy")
       ->check(CLI::ExistingFile);

@@ -9,8 +9,9 @@ REFERENCE.json is written by viewer_reference (tests/viewers/viewer_reference.cc
 positions (metres, BVH axes, y up) of every joint of both dancers at the checked frames, computed
 with duet's reader and forward kinematics, plus the contact frames.
 
-Both files are imported into one scene with the importer's defaults for a Y-up BVH in metres:
-global_scale 1 (duet writes metres), axis_forward -Z, axis_up Y (Blender is Z-up: a BVH point
+Both files are imported into one scene with the importer's settings for a Y-up BVH:
+global_scale = the file's metres per unit (duet writes in the source files' units; the reference
+gives the scale), axis_forward -Z, axis_up Y (Blender is Z-up: a BVH point
 (x, y, z) lands at (x, -z, y)), native Euler orders, one Blender frame per BVH frame
 (use_fps_scale off, the scene's rate set from the file's Frame Time). Debian's importer needs
 one shim to open files at all (patch_debian_importer). Checked:
@@ -64,12 +65,12 @@ def parse_args():
     return parser.parse_args(argv)
 
 
-def import_bvh(path):
+def import_bvh(path, metres_per_unit):
     before = set(bpy.data.objects)
     result = bpy.ops.import_anim.bvh(
         filepath=path,
         target='ARMATURE',
-        global_scale=1.0,
+        global_scale=metres_per_unit,
         frame_start=1,
         use_fps_scale=False,
         update_scene_fps=True,
@@ -103,7 +104,9 @@ def main():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     patch_debian_importer()
     scene = bpy.context.scene
-    arms = {"user": import_bvh(args.user), "partner": import_bvh(args.partner)}
+    scale = ref["metres_per_unit"]
+    arms = {"user": import_bvh(args.user, scale["user"]),
+            "partner": import_bvh(args.partner, scale["partner"])}
 
     fps = scene.render.fps / scene.render.fps_base
     if abs(fps - ref["fps"]) > 1e-6:

@@ -156,8 +156,9 @@ int main(int argc, char** argv) {
   const std::string out_path = opt["--out"];
   if (!out_path.ends_with(".json")) fail("--out " + out_path + ": the output must be a .json file");
   const int every = opt.contains("--every") ? std::max(1, std::stoi(opt["--every"])) : 10;
-  const LoadedMotion user_file = load(opt["--user"], 1.0);
-  const LoadedMotion partner = load(opt["--partner"], 1.0);
+  // duet writes in the source files' units; read back like any other file (its convention's).
+  const LoadedMotion user_file = load(opt["--user"], std::nullopt);
+  const LoadedMotion partner = load(opt["--partner"], std::nullopt);
   const LoadedMotion input = load(opt["--input"], std::nullopt);
   const std::vector<TraceRow> trace = read_trace(opt["--trace"]);
   const LoadedMotion leader = load(opt["--leader"], std::nullopt);
@@ -278,6 +279,9 @@ int main(int argc, char** argv) {
   json doc;
   doc["fps"] = fps;
   doc["frames"] = frames;
+  // Metres per file unit of the two files: the viewers import at this scale.
+  doc["metres_per_unit"] = {{"user", user_file.metres_per_unit},
+                            {"partner", partner.metres_per_unit}};
   doc["frames_checked"] = checked;
   doc["joints"] = {{"user", names_json(input.clip, user_joints)},
                    {"partner", names_json(partner.clip, partner_joints)}};

@@ -9,8 +9,9 @@
 // duet's reader and forward kinematics, plus the contact frames. Runs in plain Node (no DOM):
 // loader.parse(text) gives {skeleton, clip}; the clip is played on the skeleton's root bone with an
 // AnimationMixer (LoopOnce, clamped) set to each checked frame's time, and each bone's world
-// position is read after updateMatrixWorld. three is y-up like BVH: no axis conversion, scale 1
-// (duet writes metres). Checked, as in tests/viewers/blender_import_check.py:
+// position is read after updateMatrixWorld. three is y-up like BVH: no axis conversion; positions
+// are scaled by the file's metres per unit (duet writes in the source files' units; the reference
+// gives the scale). Checked, as in tests/viewers/blender_import_check.py:
 // - every track has the file's frame count, keyed every 1/fps seconds;
 // - at every checked frame, every bone's world position equals duet's within the tolerance;
 // - both dancers upright on the floor (hips 0.6-1.3 m high, lowest ankle below 0.25 m); hips
@@ -88,7 +89,8 @@ ref.frames_checked.forEach((frame, i) => {
       const bone = d.bones.get(name);
       if (!bone) return;
       bone.getWorldPosition(v);
-      const p = [v.x, v.y, v.z];
+      const s = ref.metres_per_unit[who];  // the file's units to metres
+      const p = [v.x * s, v.y * s, v.z * s];
       world.set(name, p);
       const diff = Math.hypot(...p.map((c, a) => c - ref[who][i][k][a]));
       if (diff > maxDiff[who]) {
