@@ -119,9 +119,9 @@ int run_follow(const FollowArgs& args) {
   bar.update(user.frame_count(), user.frame_count());
   bar.finish();
 
-  if (Status s = write_outputs(args, trace, partner,
-                               library->takes()[0].response_motion.metres_per_unit, user,
-                               input.value().metres_per_unit);
+  if (Status s =
+          write_outputs(args, trace, partner, library->takes()[0].response_motion.metres_per_unit,
+                        user, input.value().metres_per_unit);
       !s) {
     fmt::print(stderr, "duet follow: {}\n", s.error().message);
     return kExitFailure;
@@ -131,11 +131,11 @@ int run_follow(const FollowArgs& args) {
     jumps += r.jumped ? 1 : 0;
     lost += r.lost ? 1 : 0;
   }
-  fmt::print("followed {} frames ({:.1f} s) against {} take(s), {} states: {} jumps, {} lost "
-             "frames; corrections: {}\n",
-             user.frame_count(), user.duration(), library->takes().size(),
-             library->model().num_states(), jumps, lost,
-             corrections_string(loop.value().params()));
+  fmt::print(
+      "followed {} frames ({:.1f} s) against {} take(s), {} states: {} jumps, {} lost "
+      "frames; corrections: {}\n",
+      user.frame_count(), user.duration(), library->takes().size(), library->model().num_states(),
+      jumps, lost, corrections_string(loop.value().params()));
   if (truth) print_accuracy_summary(*truth, results, library->frame_rate());
   return kExitOk;
 }

@@ -78,7 +78,7 @@ BvhStreamWriter::~BvhStreamWriter() {
 
 Result<BvhStreamWriter> BvhStreamWriter::open(const std::string& path,
                                               std::shared_ptr<const Skeleton> skeleton,
-                                              double frame_rate) {
+                                              double frame_rate, const BvhWriteOptions& options) {
   if (!skeleton) return make_error(path, 0, "cannot record: no skeleton");
   if (const std::string problem = skeleton->validate(); !problem.empty()) {
     return make_error(path, 0, "cannot record: invalid skeleton: " + problem);
@@ -86,7 +86,10 @@ Result<BvhStreamWriter> BvhStreamWriter::open(const std::string& path,
   if (!(frame_rate > 0.0) || !std::isfinite(frame_rate)) {
     return make_error(path, 0, "cannot record: the frame rate must be positive");
   }
-  std::string header = format_bvh(Clip(skeleton, frame_rate, 0));
+  if (!(options.units_per_metre > 0.0) || !std::isfinite(options.units_per_metre)) {
+    return make_error(path, 0, "cannot record: units_per_metre must be positive and finite");
+  }
+  std::string header = format_bvh(Clip(skeleton, frame_rate, 0), options);
   const std::string marker = "\nFrames: 0\n";
   const std::size_t at = header.rfind(marker);
   if (at == std::string::npos) return make_error(path, 0, "cannot record: unexpected BVH header");
@@ -109,7 +112,7 @@ Result<BvhStreamWriter> BvhStreamWriter::open(const std::string& path,
   writer.frames_field_offset_ = static_cast<long>(at + std::string_view("\nFrames: ").size());
   writer.skeleton_ = std::move(skeleton);
   // The same values, order and precision as format_bvh(), so the file reads back like one.
-  writer.formatter_ = BvhFrameFormatter(*writer.skeleton_);
+  writer.formatter_ = BvhFrameFormatter(*writer.skeleton_, options);
   writer.pending_.reserve(1 << 16);
   return writer;
 }
@@ -180,11 +183,16 @@ Result<std::unique_ptr<SessionRecorder>> SessionRecorder::start(
   recorder->follow_path_ = (dir / (stem + "-follow.csv")).string();
   recorder->follow_part_path_ = recorder->follow_path_ + ".part";
 
-  Result<BvhStreamWriter> user_writer =
-      BvhStreamWriter::open(recorder->user_path_, user, frame_rate);
+  const auto units = [](double metres_per_unit) {
+    BvhWriteOptions write;
+    write.units_per_metre = 1.0 / metres_per_unit;
+    return write;
+  };
+  Result<BvhStreamWriter> user_writer = BvhStreamWriter::open(
+      recorder->user_path_, user, frame_rate, units(options.user_metres_per_unit));
   if (!user_writer) return user_writer.error();
-  Result<BvhStreamWriter> partner_writer =
-      BvhStreamWriter::open(recorder->partner_path_, partner, frame_rate);
+  Result<BvhStreamWriter> partner_writer = BvhStreamWriter::open(
+      recorder->partner_path_, partner, frame_rate, units(options.partner_metres_per_unit));
   if (!partner_writer) return partner_writer.error();
   recorder->user_ = std::move(user_writer).value();
   recorder->partner_ = std::move(partner_writer).value();

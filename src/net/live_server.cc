@@ -12,6 +12,7 @@
 #include <optional>
 #include <thread>
 
+#include "duet/io/motion_file.h"
 #include "duet/live/source_neuron.h"
 #include "duet/live/source_pose.h"
 #include "duet/net/neuron_receiver.h"
@@ -135,6 +136,11 @@ struct LiveServer::Impl {
     RecorderOptions r;
     r.directory = options.record_dir;
     r.stem = stem;
+    // In the units duet assumes for each skeleton's convention, so that any duet command reads
+    // the recordings back at the size they were danced (a WebSocket source sends metres).
+    r.user_metres_per_unit = default_metres_per_unit(source->source_skeleton().roles.convention);
+    r.partner_metres_per_unit =
+        default_metres_per_unit(loop->library().takes()[0].response_motion.roles.convention);
     Result<std::unique_ptr<SessionRecorder>> started =
         SessionRecorder::start(r, source->source_skeleton().skeleton, loop->partner_skeleton(),
                                source->source_skeleton().frame_rate);

@@ -83,6 +83,36 @@ TEST(Recorder, StreamWriterPatchesTheFrameCount) {
   expect_same_motion(clip, done.value(), 250);
 }
 
+TEST(Recorder, StreamWriterWritesInTheGivenUnits) {
+  // The salsa files' units (1.30208 m per unit): read back with that scale, the motion is the
+  // same; the hierarchy's offsets are in file units.
+  TempDir dir;
+  const Clip& clip = salsa_clip();
+  const std::string path = (dir.path / "units.bvh").string();
+  BvhWriteOptions units;
+  units.units_per_metre = 1.0 / 1.30208;
+  Result<BvhStreamWriter> opened = BvhStreamWriter::open(path, clip.skeleton_ptr(), 60.0, units);
+  ASSERT_TRUE(opened) << opened.error().message;
+  BvhStreamWriter writer = std::move(opened).value();
+  for (int f = 0; f < 50; ++f) writer.append(clip.translations_ls(f), clip.rotations_ls(f));
+  ASSERT_TRUE(writer.close());
+  BvhReadOptions read;
+  read.scale = 1.30208;
+  Result<Clip> done = read_bvh(path, read);
+  ASSERT_TRUE(done) << done.error().message;
+  expect_same_motion(clip, done.value(), 50);
+  Result<Clip> raw = read_bvh(path);
+  ASSERT_TRUE(raw);
+  EXPECT_NEAR(raw.value().skeleton().joints[1].offset.norm() * 1.30208,
+              clip.skeleton().joints[1].offset.norm(), 1e-5);
+
+  BvhWriteOptions bad;
+  bad.units_per_metre = 0.0;
+  EXPECT_FALSE(
+      BvhStreamWriter::open((dir.path / "bad.bvh").string(), clip.skeleton_ptr(), 60.0, bad));
+  EXPECT_FALSE(fs::exists(dir.path / "bad.bvh.part"));
+}
+
 TEST(Recorder, EmptyRecordingParses) {
   TempDir dir;
   const std::string path = (dir.path / "empty.bvh").string();

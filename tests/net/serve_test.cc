@@ -311,6 +311,14 @@ TEST(Serve, WebSocketPoseSource) {
   Result<Clip> recorded = read_bvh(users[0].string());
   ASSERT_TRUE(recorded) << recorded.error().message;
   EXPECT_EQ(recorded.value().frame_count(), poses);
+  // Written in the salsa convention's units: duet reads it back at the size it was danced.
+  Result<LoadedMotion> reloaded = load_motion({users[0].string()}, MotionLoadOptions{});
+  ASSERT_TRUE(reloaded) << reloaded.error().message;
+  for (const int f : {0, 60, poses - 1}) {
+    EXPECT_LT((reloaded.value().clip.translations_ls(f)[0] - clip.translations_ls(f)[0]).norm(),
+              1e-4)
+        << f;
+  }
 }
 
 }  // namespace

@@ -37,9 +37,11 @@ class BvhStreamWriter {
   BvhStreamWriter& operator=(const BvhStreamWriter&) = delete;
   ~BvhStreamWriter();  // closes (as close()) if still open
 
-  // Creates "<path>.part" with the hierarchy of `skeleton` (lengths in metres) and an empty motion.
+  // Creates "<path>.part" with the hierarchy of `skeleton` and an empty motion. Poses are given
+  // in metres and written in options.units_per_metre (as format_bvh writes them).
   static Result<BvhStreamWriter> open(const std::string& path,
-                                      std::shared_ptr<const Skeleton> skeleton, double frame_rate);
+                                      std::shared_ptr<const Skeleton> skeleton, double frame_rate,
+                                      const BvhWriteOptions& options = {});
 
   // One motion line; the spans have the skeleton's joint count. Buffered in memory until the next
   // checkpoint.
@@ -71,6 +73,10 @@ struct RecorderOptions {
   // to the stem when such files exist already.
   std::string stem = "session";
   int ring_frames = 2048;  // frames the loop may run ahead of the disk (17 s at 120 Hz)
+  // The units the two BVH files are written in (metres per file unit): the source's and the
+  // response takes', so duet reads the recordings back at the size they were danced.
+  double user_metres_per_unit = 1.0;
+  double partner_metres_per_unit = 1.0;
   double checkpoint_interval_s = 1.0;
 };
 
