@@ -40,14 +40,12 @@ Status write_outputs(const FollowArgs& args, const std::string& trace, const Cli
     if (Status s = write_file_atomically(args.trace_path, trace); !s) return s;
   }
   if (!args.output_path.empty()) {
-    BvhWriteOptions options;
-    options.units_per_metre = 1.0 / partner_metres_per_unit;
-    if (Status s = write_bvh(partner, args.output_path, options); !s) return s;
+    const BvhWriteOptions units = BvhWriteOptions::in_file_units(partner_metres_per_unit);
+    if (Status s = write_bvh(partner, args.output_path, units); !s) return s;
   }
   if (!args.user_output_path.empty()) {
-    BvhWriteOptions options;
-    options.units_per_metre = 1.0 / user_metres_per_unit;
-    if (Status s = write_bvh(user, args.user_output_path, options); !s) return s;
+    const BvhWriteOptions units = BvhWriteOptions::in_file_units(user_metres_per_unit);
+    if (Status s = write_bvh(user, args.user_output_path, units); !s) return s;
   }
   return Ok{};
 }

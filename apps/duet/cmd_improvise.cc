@@ -148,9 +148,8 @@ int run_improvise(const ImproviseArgs& args) {
   const Performance& performance = made.value();
 
   // In the source file's units, so `duet follow` reads it back with the same scale as the pairs.
-  BvhWriteOptions write;
-  write.units_per_metre = 1.0 / motions[0].metres_per_unit;
-  if (Status s = write_bvh(performance.motion, args.output_path, write); !s) {
+  const BvhWriteOptions units = BvhWriteOptions::in_file_units(motions[0].metres_per_unit);
+  if (Status s = write_bvh(performance.motion, args.output_path, units); !s) {
     fmt::print(stderr, "{}: {}\n", kCommand, s.error().message);
     return kExitFailure;
   }

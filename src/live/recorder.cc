@@ -183,16 +183,13 @@ Result<std::unique_ptr<SessionRecorder>> SessionRecorder::start(
   recorder->follow_path_ = (dir / (stem + "-follow.csv")).string();
   recorder->follow_part_path_ = recorder->follow_path_ + ".part";
 
-  const auto units = [](double metres_per_unit) {
-    BvhWriteOptions write;
-    write.units_per_metre = 1.0 / metres_per_unit;
-    return write;
-  };
-  Result<BvhStreamWriter> user_writer = BvhStreamWriter::open(
-      recorder->user_path_, user, frame_rate, units(options.user_metres_per_unit));
+  Result<BvhStreamWriter> user_writer =
+      BvhStreamWriter::open(recorder->user_path_, user, frame_rate,
+                            BvhWriteOptions::in_file_units(options.user_metres_per_unit));
   if (!user_writer) return user_writer.error();
-  Result<BvhStreamWriter> partner_writer = BvhStreamWriter::open(
-      recorder->partner_path_, partner, frame_rate, units(options.partner_metres_per_unit));
+  Result<BvhStreamWriter> partner_writer =
+      BvhStreamWriter::open(recorder->partner_path_, partner, frame_rate,
+                            BvhWriteOptions::in_file_units(options.partner_metres_per_unit));
   if (!partner_writer) return partner_writer.error();
   recorder->user_ = std::move(user_writer).value();
   recorder->partner_ = std::move(partner_writer).value();

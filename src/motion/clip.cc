@@ -6,6 +6,14 @@
 
 namespace duet {
 
+FrameBracket bracket_frame(double frame, int frame_count) noexcept {
+  assert(frame_count > 0);
+  const int last = frame_count - 1;
+  const double position = std::isfinite(frame) ? std::clamp(frame, 0.0, double(last)) : 0.0;
+  const int first = static_cast<int>(std::floor(position));
+  return {first, std::min(first + 1, last), position - first};
+}
+
 void Pose::resize(int joint_count) {
   translations_ls.resize(static_cast<std::size_t>(joint_count));
   rotations_ls.resize(static_cast<std::size_t>(joint_count));
@@ -56,10 +64,7 @@ void Clip::pose_at(int frame, Pose& pose) const {
 
 void Clip::sample(double time_s, Pose& pose) const {
   assert(frame_count_ > 0);
-  const double position = std::clamp(time_s * frame_rate_, 0.0, double(frame_count_ - 1));
-  const int f0 = static_cast<int>(std::floor(position));
-  const int f1 = std::min(f0 + 1, frame_count_ - 1);
-  const double w = position - f0;
+  const auto [f0, f1, w] = bracket_frame(time_s * frame_rate_, frame_count_);
   pose.resize(joint_count());
   const auto t0 = translations_ls(f0), t1 = translations_ls(f1);
   const auto r0 = rotations_ls(f0), r1 = rotations_ls(f1);

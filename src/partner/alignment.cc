@@ -1,8 +1,6 @@
 #include "duet/partner/alignment.h"
 
-#include <algorithm>
 #include <cassert>
-#include <cmath>
 #include <string>
 
 #include "duet/math/rotation.h"
@@ -60,12 +58,7 @@ const RootPlacement& SpatialAlignment::placement(int frame) const noexcept {
 }
 
 RootPlacement SpatialAlignment::placement_at(double frame) const noexcept {
-  assert(frame_count() > 0);
-  const int last = frame_count() - 1;
-  const double position = std::isfinite(frame) ? std::clamp(frame, 0.0, double(last)) : 0.0;
-  const int f0 = static_cast<int>(std::floor(position));
-  const int f1 = std::min(f0 + 1, last);
-  const double w = position - f0;
+  const auto [f0, f1, w] = bracket_frame(frame, frame_count());
   const RootPlacement& p0 = placements_[static_cast<std::size_t>(f0)];
   const RootPlacement& p1 = placements_[static_cast<std::size_t>(f1)];
   RootPlacement placement;

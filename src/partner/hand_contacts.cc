@@ -233,11 +233,7 @@ const Vec3& HandContacts::offset_ls(int frame, int pair) const noexcept {
 }
 
 Vec3 HandContacts::offset_ls_at(double frame, int pair) const noexcept {
-  const int last = frame_count() - 1;
-  const double position = std::isfinite(frame) ? std::clamp(frame, 0.0, double(last)) : 0.0;
-  const int f0 = static_cast<int>(std::floor(position));
-  const int f1 = std::min(f0 + 1, last);
-  const double w = position - f0;
+  const auto [f0, f1, w] = bracket_frame(frame, frame_count());
   return (1.0 - w) * offset_ls(f0, pair) + w * offset_ls(f1, pair);
 }
 

@@ -37,6 +37,13 @@ struct BvhWriteOptions {
   // File units per metre; the default writes metres.
   double units_per_metre = 1.0;
   int decimals = 6;
+
+  // Written in the units of a file read with that scale (LoadedMotion::metres_per_unit).
+  static BvhWriteOptions in_file_units(double metres_per_unit) {
+    BvhWriteOptions options;
+    options.units_per_metre = 1.0 / metres_per_unit;
+    return options;
+  }
 };
 
 std::string format_bvh(const Clip& clip, const BvhWriteOptions& options = {});

@@ -18,6 +18,17 @@ struct Pose {
   void resize(int joint_count);
 };
 
+// A real frame position between two stored frames: sample `first` and `second` and mix them
+// with weight `weight` on `second` (translations lerped, rotations slerped). Per-frame tables that
+// are sampled like a clip (SpatialAlignment, HandContacts) use it too.
+struct FrameBracket {
+  int first = 0;
+  int second = 0;
+  double weight = 0.0;
+};
+// `frame` clamped to [0, frame_count - 1] (a non-finite frame gives frame 0); frame_count > 0.
+FrameBracket bracket_frame(double frame, int frame_count) noexcept;
+
 class Clip {
  public:
   Clip() = default;

@@ -2,8 +2,7 @@
 // estimated template frame, then the corrections, each switchable on its own:
 //
 //   response pose at frame f
-//   -> align     root placed relative to the user's heading frame (5.1; 1-euro filtered with
-//   smooth)
+//   -> align     root placed relative to the user's heading frame (5.1; filtered by smooth)
 //   -> smooth    per-joint exponential smoothing in quaternion space (5.3)
 //   -> footlock  planted feet held by a horizontal root shift (5.3)
 //   -> contact   two-bone IK of each arm whose hand holds the user's (5.2)
