@@ -2,6 +2,9 @@
 #include <fmt/format.h>
 
 #include <iostream>
+#include <limits>
+#include <string>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
@@ -19,16 +22,41 @@ struct InspectArgs {
   bool json = false;
 };
 
+// Why this file cannot drive the follower (empty when it can): roles missing, or a body whose
+// height says the units are wrong.
+std::vector<std::string> follower_problems(const LoadedMotion& m) {
+  std::vector<std::string> problems;
+  if (!m.role_detection.complete()) {
+    std::string missing;
+    for (Role r : m.role_detection.missing_roles()) {
+      missing += (missing.empty() ? "" : ", ") + std::string(role_name(r));
+    }
+    problems.push_back("roles missing: " + missing + " (give a skeleton map with --map)");
+  }
+  if (!m.units_warning.empty()) problems.push_back(m.units_warning);
+  return problems;
+}
+
+std::string joint_name(const Skeleton& skeleton, int joint) {
+  return joint >= 0 && joint < skeleton.joint_count()
+             ? skeleton.joints[static_cast<std::size_t>(joint)].name
+             : std::string("-");
+}
+
 int run_inspect(const InspectArgs& args) {
   MotionLoadOptions load_options;
   if (!make_load_options(args.motion, load_options)) return kExitFailure;
+  load_options.require_roles = false;  // an unknown rig is still inspectable
   Result<LoadedMotion> loaded = load_motion(args.files, load_options);
   if (!loaded) {
     fmt::print(stderr, "duet inspect: {}\n", loaded.error().message);
     return kExitFailure;
   }
-  const Clip& clip = loaded.value().clip;
+  const LoadedMotion& motion = loaded.value();
+  const Clip& clip = motion.clip;
   const Skeleton& skeleton = clip.skeleton();
+  const std::vector<std::string> problems = follower_problems(motion);
+  const BodyDimensions& body = motion.body;
 
   Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity());
   Vec3 high = -low;
@@ -41,15 +69,38 @@ int run_inspect(const InspectArgs& args) {
 
   if (args.json) {
     nlohmann::json doc;
-    doc["file"] = loaded.value().description;
+    doc["file"] = motion.description;
     doc["joints"] = skeleton.animated_joint_count();
     doc["end_sites"] = skeleton.joint_count() - skeleton.animated_joint_count();
     doc["frames"] = clip.frame_count();
     doc["fps"] = clip.frame_rate();
     doc["duration_s"] = clip.duration();
     doc["channels"] = skeleton.channel_count();
-    doc["convention"] = loaded.value().roles.convention;
-    doc["metres_per_unit"] = loaded.value().metres_per_unit;
+    doc["convention"] = motion.roles.convention;
+    doc["metres_per_unit"] = motion.metres_per_unit;
+    doc["units"] = {{"name", motion.units_name},
+                    {"source", motion.units_source},
+                    {"warning", motion.units_warning}};
+    if (body.valid()) {
+      doc["body_m"] = {{"standing_height", body.standing_height_m},
+                       {"leg_length", body.leg_length_m},
+                       {"arm_length", body.arm_length_m},
+                       {"trunk_length", body.trunk_length_m},
+                       {"hip_width", body.hip_width_m}};
+    } else {
+      doc["body_m"] = nullptr;
+    }
+    nlohmann::json roles = nlohmann::json::object();
+    for (int r = 0; r < kRoleCount; ++r) {
+      const int joint = motion.roles.joints[static_cast<std::size_t>(r)];
+      roles[std::string(role_name(static_cast<Role>(r)))] = {
+          {"joint", joint >= 0 ? nlohmann::json(joint_name(skeleton, joint)) : nlohmann::json()},
+          {"how", motion.role_detection.notes[static_cast<std::size_t>(r)]}};
+    }
+    doc["roles"] = roles;
+    doc["roles_problem"] = motion.role_detection.problem;
+    doc["can_drive_follower"] = problems.empty();
+    doc["follower_problems"] = problems;
     doc["bounding_box_m"] = {{"min", {low.x(), low.y(), low.z()}},
                              {"max", {high.x(), high.y(), high.z()}}};
     nlohmann::json names = nlohmann::json::array();
@@ -60,9 +111,20 @@ int run_inspect(const InspectArgs& args) {
     std::cout << doc.dump(2) << "\n";
     return kExitOk;
   }
-  fmt::print("file:        {}\n", loaded.value().description);
-  fmt::print("convention:  {} ({:.6g} m per file unit)\n", loaded.value().roles.convention,
-             loaded.value().metres_per_unit);
+  fmt::print("file:        {}\n", motion.description);
+  fmt::print("convention:  {} ({:.6g} m per file unit)\n", motion.roles.convention,
+             motion.metres_per_unit);
+  fmt::print("units:       {}{}\n",
+             motion.units_name.empty() ? fmt::format("{:.6g} m", motion.metres_per_unit)
+                                       : motion.units_name,
+             motion.units_source.empty() ? "" : ", " + motion.units_source);
+  if (body.valid()) {
+    fmt::print("height:      {:.2f} m estimated (legs {:.2f} m, arms {:.2f} m, trunk {:.2f} m)\n",
+               body.standing_height_m, body.leg_length_m, body.arm_length_m,
+               body.trunk_length_m);
+  } else {
+    fmt::print("height:      unknown (needs the roles)\n");
+  }
   fmt::print("joints:      {} (+{} end sites)\n", skeleton.animated_joint_count(),
              skeleton.joint_count() - skeleton.animated_joint_count());
   fmt::print("channels:    {}\n", skeleton.channel_count());
@@ -71,13 +133,24 @@ int run_inspect(const InspectArgs& args) {
   fmt::print("duration:    {:.3f} s\n", clip.duration());
   fmt::print("extent (m):  x [{:.3f}, {:.3f}]  y [{:.3f}, {:.3f}]  z [{:.3f}, {:.3f}]\n", low.x(),
              high.x(), low.y(), high.y(), low.z(), high.z());
-  fmt::print("roles:      ");
+  fmt::print("roles ({}):\n", motion.roles.convention == "names"       ? "from the joint names"
+                              : motion.roles.convention == "hierarchy" ? "from the hierarchy"
+                              : motion.roles.convention == "none"      ? "not found"
+                                                                       : motion.roles.convention);
   for (int r = 0; r < kRoleCount; ++r) {
-    const int joint = loaded.value().roles.joints[static_cast<std::size_t>(r)];
-    fmt::print(" {}={}", role_name(static_cast<Role>(r)),
-               skeleton.joints[static_cast<std::size_t>(joint)].name);
+    const int joint = motion.roles.joints[static_cast<std::size_t>(r)];
+    fmt::print("  {:<15} {:<16} {}\n", role_name(static_cast<Role>(r)),
+               joint_name(skeleton, joint), motion.role_detection.notes[static_cast<std::size_t>(r)]);
   }
-  fmt::print("\n");
+  if (problems.empty()) {
+    fmt::print("follower:    this file can drive the follower\n");
+  } else {
+    fmt::print("follower:    this file cannot drive the follower:\n");
+    for (const std::string& p : problems) fmt::print("  - {}\n", p);
+    if (!motion.role_detection.complete()) {
+      fmt::print("why:         {}\n", motion.role_detection.problem);
+    }
+  }
   return kExitOk;
 }
 
@@ -85,6 +158,11 @@ int run_inspect(const InspectArgs& args) {
 
 Command register_inspect(CLI::App& app) {
   auto args = std::make_shared<InspectArgs>();
+  app.footer(
+      "Prints joints, frames, frame rate, units and how they were decided, the estimated body height, "
+      "each role's joint and how it was found (built-in map, joint names or hierarchy), and "
+      "whether the file can drive the follower (and why not). Exits 0 even when roles are "
+      "missing.");
   app.add_option("files", args->files, "A .bvh file, or an .asf and an .amc file")
       ->required()
       ->expected(1, 2)

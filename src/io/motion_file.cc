@@ -1,8 +1,12 @@
 #include "duet/io/motion_file.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include "duet/io/asf_amc.h"
 #include "duet/io/bvh.h"
@@ -10,6 +14,9 @@
 namespace duet {
 
 namespace {
+
+// Standing heights (metres) a captured adult can have; the unit guess and the warnings use it.
+constexpr std::array<double, 2> kPlausibleHeightM = {0.9, 2.3};
 
 std::string lowercase_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -19,10 +26,51 @@ std::string lowercase_extension(const std::string& path) {
 
 }  // namespace
 
-double default_metres_per_unit(const std::string& convention) {
+std::optional<double> known_metres_per_unit(const std::string& convention) {
   if (convention == "daz") return 1.0 / 0.768;
   if (convention == "cmu-bvh" || convention == "cmu-asf") return 0.0254 / 0.45;
-  return 1.0;
+  return std::nullopt;
+}
+
+double default_metres_per_unit(const std::string& convention) {
+  return known_metres_per_unit(convention).value_or(1.0);
+}
+
+UnitGuess guess_units_from_height(double height_in_file_units) {
+  struct Unit {
+    const char* name;
+    double metres;
+  };
+  static constexpr std::array<Unit, 5> kUnits = {{{"metres", 1.0},
+                                                   {"centimetres", 0.01},
+                                                   {"millimetres", 0.001},
+                                                   {"inches", 0.0254},
+                                                   {"CMU units", 0.0254 / 0.45}}};
+  UnitGuess guess{1.0, "metres", ""};
+  if (!(height_in_file_units > 0.0) || !std::isfinite(height_in_file_units)) {
+    guess.warning = "cannot guess the units: the body has no height";
+    return guess;
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (const Unit& unit : kUnits) {
+    const double height = height_in_file_units * unit.metres;
+    if (height < kPlausibleHeightM[0] || height > kPlausibleHeightM[1]) continue;
+    // Closest in ratio: 1.53 m and 1.89 m are equally far from 1.7 m.
+    const double distance = std::abs(std::log(height / 1.7));
+    if (distance < best) {
+      best = distance;
+      guess.metres_per_unit = unit.metres;
+      guess.name = unit.name;
+    }
+  }
+  if (!std::isfinite(best)) {
+    guess.warning = fmt::format(
+        "cannot guess the units: the body is {:.4g} file units tall, an implausible adult "
+        "height ({}-{} m) in metres, centimetres, millimetres, inches and CMU units; kept "
+        "metres (give --scale)",
+        height_in_file_units, kPlausibleHeightM[0], kPlausibleHeightM[1]);
+  }
+  return guess;
 }
 
 Result<LoadedMotion> load_motion(const std::vector<std::string>& paths,
@@ -55,23 +103,66 @@ Result<LoadedMotion> load_motion(const std::vector<std::string>& paths,
     return Error{"expected a .bvh file, or an .asf and an .amc file"};
   }
 
-  std::string error;
+  const Skeleton& skeleton = loaded.clip.skeleton();
+  RoleDetection& detection = loaded.role_detection;
   if (options.map) {
-    if (!resolve_roles(loaded.clip.skeleton(), *options.map, loaded.roles, error)) {
+    std::string missing;
+    detection.roles.joints.fill(-1);
+    if (!resolve_roles(skeleton, *options.map, detection.roles, missing)) {
       return Error{loaded.description + ": skeleton map '" + options.map->name +
-                   "' does not fit: missing " + error};
+                   "' does not fit: missing " + missing};
     }
-  } else if (!detect_roles(loaded.clip.skeleton(), loaded.roles, error)) {
-    return Error{loaded.description + ": " + error};
+    for (int r = 0; r < kRoleCount; ++r) {
+      detection.notes[static_cast<std::size_t>(r)] =
+          "map " + options.map->name + ": '" +
+          options.map->joint_names[static_cast<std::size_t>(r)] + "'";
+    }
+  } else {
+    detection = detect_roles_report(skeleton);
+    if (!detection.complete() && options.require_roles) {
+      return Error{loaded.description + ": " + detection.problem};
+    }
   }
+  loaded.roles = detection.roles;
+  const bool have_roles = detection.complete();
 
+  // Units: --scale, else the ASF file's own, else the convention's, else the body's height.
+  if (options.metres_per_unit) {
+    loaded.units_source = "given (--scale)";
+  } else if (lengths_in_metres) {
+    loaded.units_source = "ASF file";
+  } else if (const std::optional<double> known = known_metres_per_unit(loaded.roles.convention)) {
+    loaded.metres_per_unit = *known;
+    loaded.units_source = "convention " + loaded.roles.convention;
+  } else if (have_roles) {
+    const UnitGuess guess =
+        guess_units_from_height(measure_body(skeleton, loaded.roles, 1.0).standing_height_m);
+    loaded.metres_per_unit = guess.metres_per_unit;
+    loaded.units_name = guess.name;
+    loaded.units_warning = guess.warning;
+    loaded.units_source = guess.warning.empty() ? "guessed from height" : "default (metres)";
+  } else {
+    loaded.units_name = "metres";
+    loaded.units_source = "default (metres)";
+    loaded.units_warning = "cannot guess the units without the body's roles; kept metres";
+  }
   if (!lengths_in_metres) {
-    loaded.metres_per_unit =
-        options.metres_per_unit.value_or(default_metres_per_unit(loaded.roles.convention));
+    if (options.metres_per_unit) loaded.metres_per_unit = *options.metres_per_unit;
     if (!(loaded.metres_per_unit > 0.0) || !std::isfinite(loaded.metres_per_unit)) {
       return Error{"scale must be a positive number of metres per file unit"};
     }
     loaded.clip.scale_lengths(loaded.metres_per_unit);
+  }
+  if (have_roles) {
+    loaded.body = measure_body(loaded.clip.skeleton(), loaded.roles, 1.0);
+    const double height = loaded.body.standing_height_m;
+    if (loaded.units_warning.empty() &&
+        !(height >= kPlausibleHeightM[0] && height <= kPlausibleHeightM[1])) {
+      loaded.units_warning = fmt::format(
+          "the body is {:.3g} m tall, not a plausible adult height ({}-{} m): are the units "
+          "right? (--scale)",
+          height, kPlausibleHeightM[0], kPlausibleHeightM[1]);
+    }
   }
   return loaded;
 }

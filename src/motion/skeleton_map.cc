@@ -2,7 +2,8 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
+
+#include "duet/motion/role_detection.h"
 
 namespace duet {
 
@@ -66,14 +67,10 @@ bool resolve_roles(const Skeleton& skeleton, const SkeletonMap& map, JointRoles&
 }
 
 bool detect_roles(const Skeleton& skeleton, JointRoles& roles, std::string& error) {
-  std::ostringstream why;
-  why << "the skeleton matches no known convention (give a skeleton map file with --map):";
-  for (const SkeletonMap& map : builtin_skeleton_maps()) {
-    std::string missing;
-    if (resolve_roles(skeleton, map, roles, missing)) return true;
-    why << "\n  " << map.name << ": missing roles " << missing;
-  }
-  error = why.str();
+  RoleDetection detection = detect_roles_report(skeleton);
+  roles = detection.roles;
+  if (detection.complete()) return true;
+  error = std::move(detection.problem);
   return false;
 }
 

@@ -1,5 +1,6 @@
 // One entry point for motion files: a BVH file, or an ASF skeleton plus an AMC motion. Detects
-// the skeleton convention (joint roles) and applies its known units, so every clip is in metres.
+// the skeleton convention (joint roles) and applies its known units, or guesses the units from the
+// body's height when no convention says, so every clip is in metres.
 #pragma once
 
 #include <optional>
@@ -7,7 +8,9 @@
 #include <vector>
 
 #include "duet/base/result.h"
+#include "duet/motion/body_space.h"
 #include "duet/motion/clip.h"
+#include "duet/motion/role_detection.h"
 #include "duet/motion/skeleton_map.h"
 
 namespace duet {
@@ -16,18 +19,39 @@ struct MotionLoadOptions {
   std::optional<double> frame_rate;       // overrides the file's rate
   std::optional<double> metres_per_unit;  // overrides the convention's known units
   std::optional<SkeletonMap> map;         // a user's map instead of detection
+  // When false, a skeleton whose roles cannot all be found still loads (for duet inspect):
+  // `roles` then holds -1 for the missing roles and `role_detection.problem` says why.
+  bool require_roles = true;
 };
 
 struct LoadedMotion {
   Clip clip;             // in metres
   JointRoles roles;      // which joint plays each role
+  RoleDetection role_detection;  // how each role was found (notes), or what is missing
   double metres_per_unit = 1.0;  // the scale that was applied to the file's lengths
-  std::string description;       // "a.bvh" or "a.asf + b.amc"
+  // How the units were decided: "convention daz", "ASF file", "guessed from height",
+  // "given (--scale)", or "default (metres)" when nothing could tell.
+  std::string units_source;
+  std::string units_name;     // "metres", "centimetres", ... or "" when given as a number
+  std::string units_warning;  // non-empty when the units are doubtful (body height implausible)
+  BodyDimensions body;        // in metres; invalid (zeros) when roles are missing
+  std::string description;    // "a.bvh" or "a.asf + b.amc"
 };
 
 // Known units per convention: the DAZ-style salsa BVH are about 0.768 units per metre; CMU
-// BVH/ASF units are 0.056444 m (inches / 0.45).
+// BVH/ASF units are 0.056444 m (inches / 0.45). 1 for conventions with no known units.
 double default_metres_per_unit(const std::string& convention);
+std::optional<double> known_metres_per_unit(const std::string& convention);
+
+// The units of a skeleton with no known convention, from its body height: among metres,
+// centimetres, millimetres, inches and CMU units (0.056444 m), the one that makes the standing
+// height (measure_body in file units) closest to 1.7 m (in ratio) within 0.9-2.3 m.
+struct UnitGuess {
+  double metres_per_unit = 1.0;
+  std::string name;     // "centimetres", ...; "metres" when nothing was plausible
+  std::string warning;  // why the guess failed, empty when one unit was plausible
+};
+UnitGuess guess_units_from_height(double height_in_file_units);
 
 // `paths` is {file.bvh} or {skeleton.asf, motion.amc} (in either order).
 Result<LoadedMotion> load_motion(const std::vector<std::string>& paths,

@@ -47,6 +47,8 @@ struct SkeletonMap {
 
 // The joint index of every role in one skeleton.
 struct JointRoles {
+  // How the roles were found: a built-in map's name ("daz", ...), a user map's name, "names"
+  // (from the joint names) or "hierarchy" (from the tree and the rest pose); see role_detection.h.
   std::string convention;
   std::array<int, kRoleCount> joints{};
   int operator[](Role role) const { return joints[static_cast<int>(role)]; }
@@ -61,7 +63,8 @@ const std::vector<SkeletonMap>& builtin_skeleton_maps();
 bool resolve_roles(const Skeleton& skeleton, const SkeletonMap& map, JointRoles& roles,
                    std::string& missing);
 
-// Tries every built-in map. On failure, `error` says which roles each map lacked.
+// Tries every built-in map, then the joint names, then the hierarchy (detect_roles_report in
+// role_detection.h). On failure, `error` says which roles each way lacked.
 bool detect_roles(const Skeleton& skeleton, JointRoles& roles, std::string& error);
 
 // Loads a map from a JSON file: {"name": "...", "roles": {"hips": "Hips", ...}}. Every role must
