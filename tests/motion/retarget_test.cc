@@ -1,0 +1,252 @@
+// Retargeting between rigs on real captures: the salsa DAZ rig, the MotionBuilder CMU rig of the
+// handshake trial, the CMU ASF rig, and a proportioned rig of our own (A-pose, other lengths).
+#include "duet/motion/retarget.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "duet/io/motion_file.h"
+#include "duet/math/rotation.h"
+#include "duet/motion/body_space.h"
+#include "duet/motion/forward_kinematics.h"
+#include "duet/motion/rig_variants.h"
+
+namespace duet {
+namespace {
+
+std::string data(const std::string& relative) { return std::string(DUET_DATA_DIR) + "/" + relative; }
+
+LoadedMotion load(const std::vector<std::string>& paths) {
+  MotionLoadOptions options;
+  options.frame_rate = 60.0;
+  Result<LoadedMotion> loaded = load_motion(paths, options);
+  EXPECT_TRUE(loaded.ok()) << (loaded.ok() ? "" : loaded.error().message);
+  return std::move(loaded.value());
+}
+
+const LoadedMotion& salsa() {
+  static const LoadedMotion motion = load({data("cmu-salsa/bvh/60/60_01_scaled.bvh")});
+  return motion;
+}
+const LoadedMotion& handshake() {
+  static const LoadedMotion motion = load({data("cmu-handshake/18_01.bvh")});
+  return motion;
+}
+const LoadedMotion& asf() {
+  static const LoadedMotion motion =
+      load({data("cmu-salsa/asf-amc/60.asf"), data("cmu-salsa/asf-amc/60_01.amc")});
+  return motion;
+}
+
+// The bones the tests compare: upper arms, forearms, thighs, shins, and pelvis centre -> head.
+struct Bone {
+  Role from, to;
+};
+constexpr Bone kLimbs[] = {
+    {Role::kLeftShoulder, Role::kLeftElbow}, {Role::kLeftElbow, Role::kLeftWrist},
+    {Role::kRightShoulder, Role::kRightElbow}, {Role::kRightElbow, Role::kRightWrist},
+    {Role::kLeftHip, Role::kLeftKnee},       {Role::kLeftKnee, Role::kLeftAnkle},
+    {Role::kRightHip, Role::kRightKnee},     {Role::kRightKnee, Role::kRightAnkle},
+    {Role::kSpine, Role::kChest},            {Role::kNeck, Role::kHead},
+    {Role::kLeftAnkle, Role::kLeftToe},      {Role::kRightAnkle, Role::kRightToe},
+};
+
+double angle_deg(const Vec3& a, const Vec3& b) {
+  return rad_to_deg(std::atan2(a.cross(b).norm(), a.dot(b)));
+}
+
+struct Stats {
+  double max = 0.0, median = 0.0;
+};
+Stats stats(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return {v.back(), v[v.size() / 2]};
+}
+
+// Per frame, the largest angle between the two clips' role bones (and, with `pelvis_to_head`,
+// the pelvis-centre -> head line).
+std::vector<double> direction_errors(const Clip& a, const JointRoles& ra, const Clip& b,
+                                     const JointRoles& rb, bool pelvis_to_head) {
+  const std::vector<Vec3> pa = world_positions(a), pb = world_positions(b);
+  const auto na = static_cast<std::size_t>(a.joint_count()), nb = static_cast<std::size_t>(b.joint_count());
+  std::vector<double> errors;
+  for (int f = 0; f < a.frame_count(); ++f) {
+    const std::span<const Vec3> fa(pa.data() + static_cast<std::size_t>(f) * na, na);
+    const std::span<const Vec3> fb(pb.data() + static_cast<std::size_t>(f) * nb, nb);
+    auto at = [](std::span<const Vec3> p, const JointRoles& r, Role role) {
+      return p[static_cast<std::size_t>(r[role])];
+    };
+    double worst = 0.0;
+    for (const Bone& bone : kLimbs) {
+      worst = std::max(worst, angle_deg(at(fa, ra, bone.to) - at(fa, ra, bone.from),
+                                        at(fb, rb, bone.to) - at(fb, rb, bone.from)));
+    }
+    if (pelvis_to_head) {
+      worst = std::max(worst, angle_deg(at(fa, ra, Role::kHead) - pelvis_centre(fa, ra),
+                                        at(fb, rb, Role::kHead) - pelvis_centre(fb, rb)));
+    }
+    errors.push_back(worst);
+  }
+  return errors;
+}
+
+double lowest_foot(std::span<const Vec3> p, const JointRoles& r) {
+  double low = 1e9;
+  for (Role foot : {Role::kLeftAnkle, Role::kLeftToe, Role::kRightAnkle, Role::kRightToe}) {
+    low = std::min(low, p[static_cast<std::size_t>(r[foot])].y());
+  }
+  return low;
+}
+
+Clip retarget_or_fail(const Clip& source, const JointRoles& source_roles,
+                      std::shared_ptr<const Skeleton> target, const JointRoles& target_roles) {
+  Result<Clip> out = retarget_clip(source, source_roles, std::move(target), target_roles);
+  EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().message);
+  return std::move(out.value());
+}
+
+void expect_directions(const char* what, const std::vector<double>& errors, double limit_deg) {
+  const Stats s = stats(errors);
+  std::printf("%s: role directions max %.3g deg, median %.3g deg over %zu frames\n", what, s.max,
+              s.median, errors.size());
+  EXPECT_LT(s.max, limit_deg) << what;
+}
+
+TEST(Retarget, RoundTripThroughTheHandshakeRigKeepsTheRoleDirections) {
+  const LoadedMotion& src = salsa();
+  const Clip there =
+      retarget_or_fail(src.clip, src.roles, handshake().clip.skeleton_ptr(), handshake().roles);
+  const Clip back = retarget_or_fail(there, handshake().roles, src.clip.skeleton_ptr(), src.roles);
+  ASSERT_EQ(back.frame_count(), src.clip.frame_count());
+  expect_directions("salsa -> handshake rig", direction_errors(src.clip, src.roles, there, handshake().roles, false), 2.0);
+  expect_directions("salsa -> handshake rig -> salsa",
+                    direction_errors(src.clip, src.roles, back, src.roles, true), 2.0);
+}
+
+TEST(Retarget, OntoTheAsfRigKeepsTheRoleDirections) {
+  const LoadedMotion& src = salsa();
+  const Clip out = retarget_or_fail(src.clip, src.roles, asf().clip.skeleton_ptr(), asf().roles);
+  expect_directions("salsa -> ASF rig", direction_errors(src.clip, src.roles, out, asf().roles, false), 2.0);
+  // Pelvis -> head is a sum of trunk bones whose lengths differ between the rigs: reported only.
+  const Stats trunk = stats(direction_errors(src.clip, src.roles, out, asf().roles, true));
+  std::printf("salsa -> ASF rig, with pelvis -> head: max %.3f deg, median %.3f deg\n", trunk.max,
+              trunk.median);
+}
+
+TEST(Retarget, OntoAProportionedRigKeepsDirectionsFeetAndScaledStrides) {
+  const LoadedMotion& src = salsa();
+  const RigProportions proportions = RigProportions::evaluation_variant();
+  auto rig = std::make_shared<const Skeleton>(
+      make_proportioned_rig(src.clip.skeleton(), src.roles, proportions));
+  ASSERT_EQ(rig->validate(), "");
+  // The rig really is another one: its rest upper arm points elsewhere, its legs are shorter.
+  const BodyDimensions body = measure_body(*rig, src.roles);
+  const BodyDimensions original = measure_body(src.clip.skeleton(), src.roles);
+  EXPECT_NEAR(body.leg_length_m / original.leg_length_m, 0.92, 1e-9);
+  EXPECT_NEAR(body.arm_length_m / original.arm_length_m, 1.1, 1e-9);
+
+  const Clip out = retarget_or_fail(src.clip, src.roles, rig, src.roles);
+  expect_directions("salsa -> proportioned rig",
+                    direction_errors(src.clip, src.roles, out, src.roles, true), 2.0);
+
+  // Copying the local rotations instead would not follow the rig: the check can fail.
+  Clip copied(rig, src.clip.frame_rate(), src.clip.frame_count());
+  for (int f = 0; f < src.clip.frame_count(); ++f) {
+    std::copy_n(src.clip.rotations_ls(f).begin(), src.clip.joint_count(), copied.rotations_ls(f).begin());
+    copied.translations_ls(f)[0] = src.clip.translations_ls(f)[0];
+  }
+  EXPECT_GT(stats(direction_errors(src.clip, src.roles, copied, src.roles, false)).max, 20.0);
+
+  const double k = body.leg_length_m / original.leg_length_m;
+  const std::vector<Vec3> ps = world_positions(src.clip), pt = world_positions(out);
+  const auto n = static_cast<std::size_t>(src.clip.joint_count());
+  auto frame = [n](const std::vector<Vec3>& p, int f) {
+    return std::span<const Vec3>(p.data() + static_cast<std::size_t>(f) * n, n);
+  };
+  double worst_foot = 0.0, worst_path = 0.0, worst_step = 0.0, previous_lift = 0.0;
+  const Vec3 start_s = pelvis_centre(frame(ps, 0), src.roles), start_t = pelvis_centre(frame(pt, 0), src.roles);
+  for (int f = 0; f < src.clip.frame_count(); ++f) {
+    worst_foot = std::max(worst_foot, std::abs(lowest_foot(frame(pt, f), src.roles) -
+                                               k * lowest_foot(frame(ps, f), src.roles)));
+    Vec3 moved_s = pelvis_centre(frame(ps, f), src.roles) - start_s;
+    Vec3 moved_t = pelvis_centre(frame(pt, f), src.roles) - start_t;
+    moved_s.y() = moved_t.y() = 0.0;
+    worst_path = std::max(worst_path, (moved_t - k * moved_s).norm());
+    // Smoothness: the pelvis height minus the scaled source's changes little from frame to frame.
+    const double lift = pelvis_centre(frame(pt, f), src.roles).y() - k * pelvis_centre(frame(ps, f), src.roles).y();
+    if (f > 0) worst_step = std::max(worst_step, std::abs(lift - previous_lift));
+    previous_lift = lift;
+  }
+  std::printf("proportioned rig: lowest foot off by at most %.2g m; pelvis floor path off by at "
+              "most %.2g m; height correction changes by at most %.2f mm per frame\n",
+              worst_foot, worst_path, 1000.0 * worst_step);
+  EXPECT_LT(worst_foot, 0.02);
+  EXPECT_LT(worst_path, 1e-6);
+  EXPECT_LT(worst_step, 0.01);
+}
+
+TEST(Retarget, SameRigIsTheIdentityOnTheRoleJoints) {
+  const LoadedMotion& src = salsa();
+  const Clip out = retarget_or_fail(src.clip, src.roles, src.clip.skeleton_ptr(), src.roles);
+  const std::vector<Vec3> ps = world_positions(src.clip), pt = world_positions(out);
+  const auto n = static_cast<std::size_t>(src.clip.joint_count());
+  double worst = 0.0;
+  for (int f = 0; f < src.clip.frame_count(); ++f) {
+    for (int joint : src.roles.joints) {
+      const std::size_t i = static_cast<std::size_t>(f) * n + static_cast<std::size_t>(joint);
+      worst = std::max(worst, (pt[i] - ps[i]).norm());
+    }
+  }
+  std::printf("same rig: role joints moved by at most %.3g m\n", worst);
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(Retarget, FramesAreFiniteAndBadRolesAreNamed) {
+  const LoadedMotion& src = salsa();
+  const Clip out = retarget_or_fail(src.clip, src.roles, handshake().clip.skeleton_ptr(), handshake().roles);
+  for (int f = 0; f < out.frame_count(); ++f) {
+    for (const Quat& q : out.rotations_ls(f)) ASSERT_TRUE(q.coeffs().allFinite()) << f;
+    for (const Vec3& t : out.translations_ls(f)) ASSERT_TRUE(t.allFinite()) << f;
+  }
+  JointRoles broken = handshake().roles;
+  broken.joints[static_cast<std::size_t>(Role::kLeftKnee)] = 999;
+  Result<Clip> bad = retarget_clip(src.clip, src.roles, handshake().clip.skeleton_ptr(), broken,
+                                   {}, "salsa.bvh", "rig.bvh");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("rig.bvh"), std::string::npos) << bad.error().message;
+  EXPECT_NE(bad.error().message.find("left_knee"), std::string::npos) << bad.error().message;
+  // Legs of no length: strides cannot be scaled.
+  JointRoles flat = handshake().roles;
+  for (Role r : {Role::kLeftKnee, Role::kLeftAnkle, Role::kRightHip, Role::kRightKnee, Role::kRightAnkle}) {
+    flat.joints[static_cast<std::size_t>(r)] = flat[Role::kLeftHip];
+  }
+  bad = retarget_clip(src.clip, src.roles, handshake().clip.skeleton_ptr(), flat, {}, "salsa.bvh", "rig.bvh");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("rig.bvh: the legs have no length"), std::string::npos)
+      << bad.error().message;
+}
+
+TEST(RigProportions, ParsesKeysAndRejectsNonsense) {
+  RigProportions p;
+  std::string error;
+  ASSERT_TRUE(parse_rig_proportions("arms=1.1,legs=0.92,trunk=1.05,arms_down=40", p, error)) << error;
+  EXPECT_DOUBLE_EQ(p.arms, 1.1);
+  EXPECT_DOUBLE_EQ(p.legs, 0.92);
+  EXPECT_DOUBLE_EQ(p.trunk, 1.05);
+  EXPECT_DOUBLE_EQ(p.arms_down_deg, 40.0);
+  EXPECT_FALSE(parse_rig_proportions("arms=-1", p, error));
+  EXPECT_NE(error.find("arms=-1"), std::string::npos) << error;
+  EXPECT_FALSE(parse_rig_proportions("wings=2", p, error));
+  EXPECT_NE(error.find("unknown key"), std::string::npos) << error;
+  EXPECT_FALSE(parse_rig_proportions("legs", p, error));
+  EXPECT_FALSE(parse_rig_proportions("legs=abc", p, error));
+  EXPECT_DOUBLE_EQ(p.arms, 1.1);  // a failed parse changes nothing
+}
+
+}  // namespace
+}  // namespace duet
