@@ -244,19 +244,24 @@ struct Detector {
       set(Role::kChest, tree.lowest_common_ancestor(ls, rs), "where the two arms meet");
     }
     const int hips = get(Role::kHips), chest = get(Role::kChest);
-    if (hips < 0 || chest < 0) return;
-    if (chest != hips && !tree.is_ancestor(hips, chest)) {
-      out.notes[at(static_cast<int>(Role::kChest))] =
-          "the arms meet at " + quoted(tree, chest) + ", which is not above the legs' " +
-          quoted(tree, hips);
-      out.roles.joints[at(static_cast<int>(Role::kChest))] = kNone;
-      return;
-    }
-    const int above = joint_above(tree, chest, names);
-    if (chest != hips && above >= 0 && above != hips && tree.is_ancestor(hips, above)) {
-      set(Role::kSpine, above, "the spine joint below the chest");
+    if (chest < 0) return;
+    if (hips >= 0) {  // the spine lies between the two; without legs only the top is found
+      if (chest != hips && !tree.is_ancestor(hips, chest)) {
+        out.notes[at(static_cast<int>(Role::kChest))] =
+            "the arms meet at " + quoted(tree, chest) + ", which is not above the legs' " +
+            quoted(tree, hips);
+        out.roles.joints[at(static_cast<int>(Role::kChest))] = kNone;
+        return;
+      }
+      const int above = joint_above(tree, chest, names);
+      if (chest != hips && above >= 0 && above != hips && tree.is_ancestor(hips, above)) {
+        set(Role::kSpine, above, "the spine joint below the chest");
+      } else {
+        set(Role::kSpine, chest, "no spine joint between hips and chest: the chest's");
+      }
     } else {
-      set(Role::kSpine, chest, "no spine joint between hips and chest: the chest's");
+      out.notes[at(static_cast<int>(Role::kHips))] = "no legs to meet";
+      out.notes[at(static_cast<int>(Role::kSpine))] = "no hips to start from";
     }
     // Head: by name below the chest, else the end of the branch that holds neither arm.
     int head = kNone, best = -1;
