@@ -11,7 +11,8 @@ void add_motion_file_options(CLI::App& app, MotionFileOptions& options, const st
       ->check(CLI::PositiveNumber);
   app.add_option("--" + prefix + "scale", options.scale,
                  "Metres per file unit (default: known per skeleton convention: salsa DAZ BVH "
-                 "1/0.768, CMU 0.056444, otherwise 1)")
+                 "1/0.768, CMU 0.056444; otherwise guessed from the body's height: m, cm, mm, "
+                 "inches or CMU units)")
       ->check(CLI::PositiveNumber);
   if (prefix.empty()) {
     app.add_option("--map", options.map_path,
