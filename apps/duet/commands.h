@@ -20,5 +20,6 @@ Command register_serve(CLI::App& app);
 Command register_eval(CLI::App& app);
 Command register_improvise(CLI::App& app);
 Command register_contacts(CLI::App& app);
+Command register_retarget(CLI::App& app);
 
 }  // namespace duet::app

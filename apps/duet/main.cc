@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
       duet::app::register_improvise);
   add("contacts", "Print the hand-contact intervals of a captured duet, per hand pair",
       duet::app::register_contacts);
+  add("retarget", "Put a motion onto another skeleton, keeping the body's directions and feet",
+      duet::app::register_retarget);
 
   try {
     app.parse(argc, argv);

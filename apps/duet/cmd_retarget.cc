@@ -1,0 +1,172 @@
+// duet retarget INPUT... --rig RIG.bvh -o OUT.bvh: a motion put onto another skeleton
+// (docs/retarget.md).
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "duet/io/bvh.h"
+#include "duet/io/motion_file.h"
+#include "duet/motion/retarget.h"
+#include "duet/motion/rig_variants.h"
+#include "motion_options.h"
+
+namespace duet::app {
+
+namespace {
+
+struct RetargetArgs {
+  std::vector<std::string> inputs;
+  std::vector<std::string> rig;
+  std::string output;
+  MotionFileOptions input;
+  std::optional<double> rig_scale;
+  std::string rig_map_path;
+  std::string proportions;
+  std::optional<double> stride_scale;
+  bool no_feet = false;
+};
+
+// The rig as a BVH file can carry it: a root with position channels and three rotation channels
+// on every joint (a rig read from a file with fewer would drop the retargeted rotations).
+Skeleton writable(Skeleton skeleton) {
+  for (Joint& joint : skeleton.joints) {
+    if (joint.end_site) continue;
+    std::vector<Channel> channels;
+    if (joint.parent < 0 || joint.has_position_channels()) {
+      channels = {Channel::kXposition, Channel::kYposition, Channel::kZposition};
+    }
+    int rotations = 0;
+    for (const Channel c : joint.channels) rotations += is_position_channel(c) ? 0 : 1;
+    if (rotations == 3) {
+      for (const Channel c : joint.channels) {
+        if (!is_position_channel(c)) channels.push_back(c);
+      }
+    } else {
+      channels.insert(channels.end(), {Channel::kZrotation, Channel::kXrotation, Channel::kYrotation});
+    }
+    joint.channels = std::move(channels);
+  }
+  return skeleton;
+}
+
+// Metres per unit of the BVH written for a rig loaded from `paths`: the file's own units; an ASF
+// skeleton (read in metres) is written in its convention's BVH units, which is how a BVH with its
+// joint names reads back.
+double written_units(const LoadedMotion& loaded, const std::vector<std::string>& paths) {
+  if (paths.size() == 2) return default_metres_per_unit(loaded.roles.convention);
+  return loaded.metres_per_unit;
+}
+
+int run_retarget(const RetargetArgs& args) {
+  if (args.rig.empty() && args.proportions.empty()) {
+    fmt::print(stderr, "duet retarget: give the target skeleton with --rig, or --proportions to "
+                       "retarget onto a proportioned copy of the input's own skeleton\n");
+    return kExitUsage;
+  }
+  RigProportions proportions;
+  if (std::string error; !args.proportions.empty() &&
+                         !parse_rig_proportions(args.proportions, proportions, error)) {
+    fmt::print(stderr, "duet retarget: --proportions {}\n", error);
+    return kExitUsage;
+  }
+
+  MotionLoadOptions load_options;
+  if (!make_load_options(args.input, load_options)) return kExitFailure;
+  Result<LoadedMotion> source = load_motion(args.inputs, load_options);
+  if (!source) {
+    fmt::print(stderr, "duet retarget: {}\n", source.error().message);
+    return kExitFailure;
+  }
+
+  // The target: the rig file's skeleton (its motion is not used), or the input's own.
+  Skeleton rig_skeleton = source.value().clip.skeleton();
+  JointRoles rig_roles = source.value().roles;
+  double rig_metres_per_unit = written_units(source.value(), args.inputs);
+  std::string rig_name = source.value().description;
+  if (!args.rig.empty()) {
+    MotionFileOptions rig_input;
+    rig_input.scale = args.rig_scale;
+    rig_input.map_path = args.rig_map_path;
+    MotionLoadOptions rig_options;
+    if (!make_load_options(rig_input, rig_options)) return kExitFailure;
+    Result<LoadedMotion> rig = load_motion(args.rig, rig_options);
+    if (!rig) {
+      fmt::print(stderr, "duet retarget: rig: {}\n", rig.error().message);
+      return kExitFailure;
+    }
+    rig_skeleton = rig.value().clip.skeleton();
+    rig_roles = rig.value().roles;
+    rig_metres_per_unit = written_units(rig.value(), args.rig);
+    rig_name = rig.value().description;
+  }
+  if (!args.proportions.empty()) {
+    rig_skeleton = make_proportioned_rig(rig_skeleton, rig_roles, proportions);
+    rig_name += " (proportioned: " + args.proportions + ")";
+  }
+  auto target = std::make_shared<const Skeleton>(writable(std::move(rig_skeleton)));
+
+  RetargetOptions options;
+  options.stride_scale = args.stride_scale;
+  options.feet_on_floor = !args.no_feet;
+  Result<Retargeter> retargeter =
+      Retargeter::create(source.value().clip.skeleton_ptr(), source.value().roles, target,
+                         rig_roles, options, source.value().description, rig_name);
+  if (!retargeter) {
+    fmt::print(stderr, "duet retarget: {}\n", retargeter.error().message);
+    return kExitFailure;
+  }
+  const Clip& in = source.value().clip;
+  Clip out(target, in.frame_rate(), in.frame_count());
+  for (int f = 0; f < in.frame_count(); ++f) {
+    retargeter.value().retarget_frame(in.translations_ls(f), in.rotations_ls(f),
+                                      out.translations_ls(f), out.rotations_ls(f));
+  }
+  Status written =
+      write_bvh(out, args.output, BvhWriteOptions::in_file_units(rig_metres_per_unit));
+  if (!written) {
+    fmt::print(stderr, "duet retarget: {}\n", written.error().message);
+    return kExitFailure;
+  }
+  fmt::print(stderr,
+             "wrote {}: {} frames at {:.6g} fps on {} ({} joints, {:.6g} m per unit), stride "
+             "scale {:.4f}\n",
+             args.output, out.frame_count(), out.frame_rate(), rig_name,
+             target->animated_joint_count(), rig_metres_per_unit,
+             retargeter.value().stride_scale());
+  return kExitOk;
+}
+
+}  // namespace
+
+Command register_retarget(CLI::App& app) {
+  auto args = std::make_shared<RetargetArgs>();
+  app.add_option("inputs", args->inputs, "The motion: a .bvh file, or an .asf and an .amc file")
+      ->required()
+      ->expected(1, 2)
+      ->check(CLI::ExistingFile);
+  app.add_option("--rig", args->rig,
+                 "The target skeleton: a .bvh file (its motion is ignored), or an .asf and an "
+                 ".amc file; the output is written in its units")
+      ->expected(1, 2)
+      ->check(CLI::ExistingFile);
+  app.add_option("-o,--output", args->output, "Output BVH file (written atomically)")->required();
+  add_motion_file_options(app, args->input);
+  app.add_option("--rig-scale", args->rig_scale,
+                 "Metres per unit of the rig file (default: known per skeleton convention)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--rig-map", args->rig_map_path,
+                 "Skeleton map JSON naming the joint of each role in the rig")
+      ->check(CLI::ExistingFile);
+  app.add_option("--proportions", args->proportions,
+                 "Retarget onto a proportioned copy of the rig (of the input's skeleton without "
+                 "--rig): arms=F,legs=F,trunk=F length factors, arms_down=DEG (A-pose), "
+                 "legs_apart=DEG, lean=DEG, toes_out=DEG; e.g. arms=1.1,legs=0.92,trunk=1.05");
+  app.add_option("--stride-scale", args->stride_scale,
+                 "Scale of the root's path (default: rig leg length / input leg length)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--no-feet", args->no_feet,
+               "Do not put the rig's lowest foot at the input's (scaled) height every frame; "
+               "scale the pelvis height instead");
+  return [args] { return run_retarget(*args); };
+}
+
+}  // namespace duet::app
