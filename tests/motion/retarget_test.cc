@@ -138,6 +138,18 @@ TEST(Retarget, OntoTheAsfRigKeepsTheRoleDirections) {
               trunk.median);
 }
 
+TEST(Retarget, ToAndFromTheBandaiRig) {
+  // A third-party rig in centimetres whose roles are found from its joint names.
+  const LoadedMotion bandai = load({data("bandai/dataset-1_dance-short_normal_001.bvh")});
+  const LoadedMotion& src = salsa();
+  const Clip there = retarget_or_fail(src.clip, src.roles, bandai.clip.skeleton_ptr(), bandai.roles);
+  expect_directions("salsa -> Bandai rig", direction_errors(src.clip, src.roles, there, bandai.roles, false), 2.0);
+  const Clip back = retarget_or_fail(there, bandai.roles, src.clip.skeleton_ptr(), src.roles);
+  expect_directions("salsa -> Bandai rig -> salsa", direction_errors(src.clip, src.roles, back, src.roles, true), 2.0);
+  const Clip dance = retarget_or_fail(bandai.clip, bandai.roles, src.clip.skeleton_ptr(), src.roles);
+  expect_directions("Bandai dance -> salsa rig", direction_errors(bandai.clip, bandai.roles, dance, src.roles, false), 2.0);
+}
+
 TEST(Retarget, OntoAProportionedRigKeepsDirectionsFeetAndScaledStrides) {
   const LoadedMotion& src = salsa();
   const RigProportions proportions = RigProportions::evaluation_variant();
