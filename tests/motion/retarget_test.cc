@@ -194,6 +194,26 @@ TEST(Retarget, OntoAProportionedRigKeepsDirectionsFeetAndScaledStrides) {
     if (f > 0) worst_step = std::max(worst_step, std::abs(lift - previous_lift));
     previous_lift = lift;
   }
+  // Foot skate: while a source toe is planted (low and still), how far the target's toe slides.
+  // (The salsa toe End Sites sit 4-5 cm up when the foot is flat.)
+  double slide_sum = 0.0, slide_max = 0.0;
+  int planted = 0;
+  for (int f = 1; f < src.clip.frame_count(); ++f) {
+    for (Role toe : {Role::kLeftToe, Role::kRightToe}) {
+      const auto j = static_cast<std::size_t>(src.roles[toe]);
+      Vec3 step_s = frame(ps, f)[j] - frame(ps, f - 1)[j];
+      Vec3 step_t = frame(pt, f)[j] - frame(pt, f - 1)[j];
+      step_s.y() = step_t.y() = 0.0;
+      if (frame(ps, f)[j].y() > 0.06 || step_s.norm() > 0.001) continue;
+      slide_sum += step_t.norm();
+      slide_max = std::max(slide_max, step_t.norm());
+      ++planted;
+    }
+  }
+  std::printf("proportioned rig: planted toes (%d toe-frames) slide %.2f mm per frame on average, "
+              "at most %.2f mm\n", planted, 1000.0 * slide_sum / std::max(planted, 1), 1000.0 * slide_max);
+  EXPECT_GT(planted, 100);
+  EXPECT_LT(slide_sum / planted, 0.002);
   std::printf("proportioned rig: lowest foot off by at most %.2g m; pelvis floor path off by at "
               "most %.2g m; height correction changes by at most %.2f mm per frame\n",
               worst_foot, worst_path, 1000.0 * worst_step);
