@@ -145,13 +145,15 @@ Command register_retarget(CLI::App& app) {
       ->check(CLI::ExistingFile);
   app.add_option("--rig", args->rig,
                  "The target skeleton: a .bvh file (its motion is ignored), or an .asf and an "
-                 ".amc file; the output is written in its units")
+                 ".amc file; the output is written in its units. Put it after the input (it takes "
+                 "up to two files)")
       ->expected(1, 2)
       ->check(CLI::ExistingFile);
   app.add_option("-o,--output", args->output, "Output BVH file (written atomically)")->required();
   add_motion_file_options(app, args->input);
   app.add_option("--rig-scale", args->rig_scale,
-                 "Metres per unit of the rig file (default: known per skeleton convention)")
+                 "Metres per unit of the rig file, and of the output (default: known per skeleton "
+                 "convention, else guessed from the body's height)")
       ->check(CLI::PositiveNumber);
   app.add_option("--rig-map", args->rig_map_path,
                  "Skeleton map JSON naming the joint of each role in the rig")

@@ -172,7 +172,10 @@ TEST(Retarget, OntoAProportionedRigKeepsDirectionsFeetAndScaledStrides) {
     std::copy_n(src.clip.rotations_ls(f).begin(), src.clip.joint_count(), copied.rotations_ls(f).begin());
     copied.translations_ls(f)[0] = src.clip.translations_ls(f)[0];
   }
-  EXPECT_GT(stats(direction_errors(src.clip, src.roles, copied, src.roles, false)).max, 20.0);
+  const Stats copy = stats(direction_errors(src.clip, src.roles, copied, src.roles, false));
+  std::printf("copying local rotations onto the proportioned rig instead: max %.1f deg, median "
+              "%.1f deg\n", copy.max, copy.median);
+  EXPECT_GT(copy.max, 20.0);
 
   const double k = body.leg_length_m / original.leg_length_m;
   const std::vector<Vec3> ps = world_positions(src.clip), pt = world_positions(out);
