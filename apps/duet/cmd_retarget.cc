@@ -41,7 +41,8 @@ Skeleton writable(Skeleton skeleton) {
         if (!is_position_channel(c)) channels.push_back(c);
       }
     } else {
-      channels.insert(channels.end(), {Channel::kZrotation, Channel::kXrotation, Channel::kYrotation});
+      channels.insert(channels.end(),
+                      {Channel::kZrotation, Channel::kXrotation, Channel::kYrotation});
     }
     joint.channels = std::move(channels);
   }
@@ -58,13 +59,14 @@ double written_units(const LoadedMotion& loaded, const std::vector<std::string>&
 
 int run_retarget(const RetargetArgs& args) {
   if (args.rig.empty() && args.proportions.empty()) {
-    fmt::print(stderr, "duet retarget: give the target skeleton with --rig, or --proportions to "
-                       "retarget onto a proportioned copy of the input's own skeleton\n");
+    fmt::print(stderr,
+               "duet retarget: give the target skeleton with --rig, or --proportions to "
+               "retarget onto a proportioned copy of the input's own skeleton\n");
     return kExitUsage;
   }
   RigProportions proportions;
-  if (std::string error; !args.proportions.empty() &&
-                         !parse_rig_proportions(args.proportions, proportions, error)) {
+  if (std::string error;
+      !args.proportions.empty() && !parse_rig_proportions(args.proportions, proportions, error)) {
     fmt::print(stderr, "duet retarget: --proportions {}\n", error);
     return kExitUsage;
   }
@@ -120,8 +122,7 @@ int run_retarget(const RetargetArgs& args) {
     retargeter.value().retarget_frame(in.translations_ls(f), in.rotations_ls(f),
                                       out.translations_ls(f), out.rotations_ls(f));
   }
-  Status written =
-      write_bvh(out, args.output, BvhWriteOptions::in_file_units(rig_metres_per_unit));
+  Status written = write_bvh(out, args.output, BvhWriteOptions::in_file_units(rig_metres_per_unit));
   if (!written) {
     fmt::print(stderr, "duet retarget: {}\n", written.error().message);
     return kExitFailure;

@@ -41,7 +41,8 @@ Vec3 chain_vector(const Skeleton& skeleton, int ancestor, int joint,
   Vec3 v = translations_ls[static_cast<std::size_t>(joint)];
   for (int j = skeleton.joints[static_cast<std::size_t>(joint)].parent; j != ancestor;
        j = skeleton.joints[static_cast<std::size_t>(j)].parent) {
-    v = translations_ls[static_cast<std::size_t>(j)] + rotations_ls[static_cast<std::size_t>(j)] * v;
+    v = translations_ls[static_cast<std::size_t>(j)] +
+        rotations_ls[static_cast<std::size_t>(j)] * v;
   }
   return v;
 }
@@ -77,8 +78,8 @@ FrameVectors frame_vectors(Role role, const JointRoles& roles) {
             roles[Role::kRightHip], roles[Role::kLeftHip]};
   }
   // Chest. Up: chest -> neck. Lateral: right -> left upper arm.
-  return {roles[Role::kChest], roles[Role::kChest], roles[Role::kNeck],
-          roles[Role::kRightShoulder], roles[Role::kLeftShoulder]};
+  return {roles[Role::kChest], roles[Role::kChest], roles[Role::kNeck], roles[Role::kRightShoulder],
+          roles[Role::kLeftShoulder]};
 }
 
 // Evaluates a frame joint's two vectors relative to `origin`, with `point(j)` giving a joint's
@@ -100,17 +101,25 @@ struct BonePair {
   Role joint, end;
 };
 constexpr BonePair kBones[] = {
-    {Role::kSpine, Role::kChest},          {Role::kNeck, Role::kHead},
-    {Role::kLeftShoulder, Role::kLeftElbow}, {Role::kLeftElbow, Role::kLeftWrist},
-    {Role::kRightShoulder, Role::kRightElbow}, {Role::kRightElbow, Role::kRightWrist},
-    {Role::kLeftHip, Role::kLeftKnee},     {Role::kLeftKnee, Role::kLeftAnkle},
-    {Role::kLeftAnkle, Role::kLeftToe},    {Role::kRightHip, Role::kRightKnee},
-    {Role::kRightKnee, Role::kRightAnkle}, {Role::kRightAnkle, Role::kRightToe},
+    {Role::kSpine, Role::kChest},
+    {Role::kNeck, Role::kHead},
+    {Role::kLeftShoulder, Role::kLeftElbow},
+    {Role::kLeftElbow, Role::kLeftWrist},
+    {Role::kRightShoulder, Role::kRightElbow},
+    {Role::kRightElbow, Role::kRightWrist},
+    {Role::kLeftHip, Role::kLeftKnee},
+    {Role::kLeftKnee, Role::kLeftAnkle},
+    {Role::kLeftAnkle, Role::kLeftToe},
+    {Role::kRightHip, Role::kRightKnee},
+    {Role::kRightKnee, Role::kRightAnkle},
+    {Role::kRightAnkle, Role::kRightToe},
 };
 // End joints and the role whose bone they follow.
 constexpr BonePair kFollowers[] = {
-    {Role::kHead, Role::kNeck},          {Role::kLeftWrist, Role::kLeftElbow},
-    {Role::kRightWrist, Role::kRightElbow}, {Role::kLeftToe, Role::kLeftAnkle},
+    {Role::kHead, Role::kNeck},
+    {Role::kLeftWrist, Role::kLeftElbow},
+    {Role::kRightWrist, Role::kRightElbow},
+    {Role::kLeftToe, Role::kLeftAnkle},
     {Role::kRightToe, Role::kRightAnkle},
 };
 // Shorter than this (metres) at rest, a bone gives no direction.
@@ -129,7 +138,8 @@ std::vector<Vec3> rest_positions(const Skeleton& skeleton, std::vector<Vec3>& of
   return positions;
 }
 
-std::string check_roles(const Skeleton& skeleton, const JointRoles& roles, const std::string& name) {
+std::string check_roles(const Skeleton& skeleton, const JointRoles& roles,
+                        const std::string& name) {
   if (skeleton.joint_count() == 0) return name + ": the skeleton has no joints";
   for (int r = 0; r < kRoleCount; ++r) {
     const int j = roles.joints[static_cast<std::size_t>(r)];
@@ -155,10 +165,12 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
   if (std::string e = check_roles(*target, target_roles, target_name); !e.empty()) return Error{e};
   const BodyDimensions source_body = measure_body(*source, source_roles);
   const BodyDimensions target_body = measure_body(*target, target_roles);
-  for (const auto& [body, name] : {std::pair{&source_body, &source_name}, {&target_body, &target_name}}) {
+  for (const auto& [body, name] :
+       {std::pair{&source_body, &source_name}, {&target_body, &target_name}}) {
     if (!(body->leg_length_m > 1e-6) || !std::isfinite(body->leg_length_m)) {
-      return Error{*name + ": the legs have no length (the hip, knee and ankle roles sit at one "
-                           "place), so strides cannot be scaled"};
+      return Error{*name +
+                   ": the legs have no length (the hip, knee and ankle roles sit at one "
+                   "place), so strides cannot be scaled"};
     }
   }
 
@@ -168,7 +180,8 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
   r.source_roles_ = source_roles;
   r.target_roles_ = target_roles;
   r.options_ = options;
-  r.stride_scale_ = options.stride_scale.value_or(target_body.leg_length_m / source_body.leg_length_m);
+  r.stride_scale_ =
+      options.stride_scale.value_or(target_body.leg_length_m / source_body.leg_length_m);
   if (!(r.stride_scale_ > 0.0) || !std::isfinite(r.stride_scale_)) {
     return Error{"retarget: the stride scale must be a positive number"};
   }
@@ -182,7 +195,8 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
   r.rules_.assign(static_cast<std::size_t>(t.joint_count()), JointRule{});
   auto rule_of = [&](int joint) -> JointRule& { return r.rules_[static_cast<std::size_t>(joint)]; };
   auto free = [&](int joint) {
-    return rule_of(joint).rule == Rule::kRest && !t.joints[static_cast<std::size_t>(joint)].end_site;
+    return rule_of(joint).rule == Rule::kRest &&
+           !t.joints[static_cast<std::size_t>(joint)].end_site;
   };
 
   auto rest_length = [](const std::vector<Vec3>& rest, int a, int b) {
@@ -192,30 +206,41 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
   for (const Role role : {Role::kHips, Role::kChest}) {
     const int tj = target_roles[role], sj = source_roles[role];
     if (!free(tj)) continue;
-    if (role == Role::kChest &&
-        (rest_length(t_rest, tj, target_roles[Role::kNeck]) < kShortBone ||
-         rest_length(s_rest, sj, source_roles[Role::kNeck]) < kShortBone)) {
+    if (role == Role::kChest && (rest_length(t_rest, tj, target_roles[Role::kNeck]) < kShortBone ||
+                                 rest_length(s_rest, sj, source_roles[Role::kNeck]) < kShortBone)) {
       // The neck joint sits on the chest joint (the CMU MotionBuilder rig): no up vector. The
       // chest then turns like the source's, through the rest alignment of the shoulder line, and
       // the smallest swing makes the shoulder line exact.
       const int tl = target_roles[Role::kLeftShoulder], tr = target_roles[Role::kRightShoulder];
       const int sl = source_roles[Role::kLeftShoulder], sr = source_roles[Role::kRightShoulder];
       if (!below(t, tj, {tl, tr}) || !below(s, sj, {sl, sr})) continue;
-      const Vec3 t_line = t_rest[static_cast<std::size_t>(tl)] - t_rest[static_cast<std::size_t>(tr)];
-      const Vec3 s_line = s_rest[static_cast<std::size_t>(sl)] - s_rest[static_cast<std::size_t>(sr)];
+      const Vec3 t_line =
+          t_rest[static_cast<std::size_t>(tl)] - t_rest[static_cast<std::size_t>(tr)];
+      const Vec3 s_line =
+          s_rest[static_cast<std::size_t>(sl)] - s_rest[static_cast<std::size_t>(sr)];
       if (!(t_line.norm() > 1e-9) || !(s_line.norm() > 1e-9)) continue;
-      rule_of(tj) = {Rule::kDirection, sj, tl, sl, -1, -1,
-                     Quat::FromTwoVectors(t_line, s_line).normalized(), tr, sr};
+      rule_of(tj) = {Rule::kDirection,
+                     sj,
+                     tl,
+                     sl,
+                     -1,
+                     -1,
+                     Quat::FromTwoVectors(t_line, s_line).normalized(),
+                     tr,
+                     sr};
       continue;
     }
-    const FrameVectors tv = frame_vectors(role, target_roles), sv = frame_vectors(role, source_roles);
+    const FrameVectors tv = frame_vectors(role, target_roles),
+                       sv = frame_vectors(role, source_roles);
     if (!below(t, tj, {tv.up_from_a, tv.up_from_b, tv.up_to, tv.lateral_from, tv.lateral_to}) ||
         !below(s, sj, {sv.up_from_a, sv.up_from_b, sv.up_to, sv.lateral_from, sv.lateral_to})) {
       continue;
     }
     Quat t_frame, s_frame;
-    if (!frame_at(tv, [&](int j) { return t_rest[static_cast<std::size_t>(j)]; }, t_frame) ||
-        !frame_at(sv, [&](int j) { return s_rest[static_cast<std::size_t>(j)]; }, s_frame)) {
+    if (!frame_at(
+            tv, [&](int j) { return t_rest[static_cast<std::size_t>(j)]; }, t_frame) ||
+        !frame_at(
+            sv, [&](int j) { return s_rest[static_cast<std::size_t>(j)]; }, s_frame)) {
       continue;
     }
     rule_of(tj) = {Rule::kFrame, sj, -1, -1, -1, -1, (s_frame * t_frame.conjugate()).normalized()};
@@ -228,8 +253,15 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
     const Vec3 t_dir = t_rest[static_cast<std::size_t>(te)] - t_rest[static_cast<std::size_t>(tj)];
     const Vec3 s_dir = s_rest[static_cast<std::size_t>(se)] - s_rest[static_cast<std::size_t>(sj)];
     if (!(t_dir.norm() > 1e-9) || !(s_dir.norm() > 1e-9)) continue;
-    rule_of(tj) = {Rule::kDirection, sj, te, se, -1, -1,
-                   Quat::FromTwoVectors(t_dir, s_dir).normalized(), tj, sj};
+    rule_of(tj) = {Rule::kDirection,
+                   sj,
+                   te,
+                   se,
+                   -1,
+                   -1,
+                   Quat::FromTwoVectors(t_dir, s_dir).normalized(),
+                   tj,
+                   sj};
   }
   // End joints follow their parent role's bone.
   for (const BonePair& follower : kFollowers) {
@@ -242,7 +274,8 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
   // paths have the same length.
   std::vector<int> role_of_target(static_cast<std::size_t>(t.joint_count()), -1);
   for (int role = kRoleCount - 1; role >= 0; --role) {
-    role_of_target[static_cast<std::size_t>(target_roles.joints[static_cast<std::size_t>(role)])] = role;
+    role_of_target[static_cast<std::size_t>(target_roles.joints[static_cast<std::size_t>(role)])] =
+        role;
   }
   for (int role = 0; role < kRoleCount; ++role) {
     const int tj = target_roles.joints[static_cast<std::size_t>(role)];
@@ -280,7 +313,8 @@ void Retargeter::retarget_frame(std::span<const Vec3> source_translations_ls,
                                 std::span<Quat> target_rotations_ls) {
   const Skeleton& s = *source_;
   const Skeleton& t = *target_;
-  forward_kinematics(s, source_translations_ls, source_rotations_ls, source_positions_, source_world_);
+  forward_kinematics(s, source_translations_ls, source_rotations_ls, source_positions_,
+                     source_world_);
   auto ps = [&](int j) { return source_positions_[static_cast<std::size_t>(j)]; };
   auto ws = [&](int j) { return source_world_[static_cast<std::size_t>(j)]; };
 
@@ -293,7 +327,8 @@ void Retargeter::retarget_frame(std::span<const Vec3> source_translations_ls,
     if (rule.rule == Rule::kCopy) {
       const Quat& q = rules_[static_cast<std::size_t>(rule.parent_role)].alignment;
       target_rotations_ls[j] =
-          (q.conjugate() * source_rotations_ls[static_cast<std::size_t>(rule.source)] * q).normalized();
+          (q.conjugate() * source_rotations_ls[static_cast<std::size_t>(rule.source)] * q)
+              .normalized();
     } else {
       target_rotations_ls[j] = Quat::Identity();
     }
@@ -329,11 +364,12 @@ void Retargeter::retarget_frame(std::span<const Vec3> source_translations_ls,
         const Role role = joint == target_roles_[Role::kHips] ? Role::kHips : Role::kChest;
         Quat local_frame, source_frame;
         const bool ok =
-            frame_at(frame_vectors(role, target_roles_),
-                     [&](int e) {
-                       return chain_vector(t, joint, e, target_translations_ls, target_rotations_ls);
-                     },
-                     local_frame) &&
+            frame_at(
+                frame_vectors(role, target_roles_),
+                [&](int e) {
+                  return chain_vector(t, joint, e, target_translations_ls, target_rotations_ls);
+                },
+                local_frame) &&
             frame_at(frame_vectors(role, source_roles_), ps, source_frame);
         world = ok ? source_frame * local_frame.conjugate() : ws(rule.source) * rule.alignment;
         break;
@@ -352,7 +388,8 @@ void Retargeter::retarget_frame(std::span<const Vec3> source_translations_ls,
 
   // Root: the target posed at the origin, then moved so that its pelvis centre follows the
   // source's scaled path and its lowest foot point sits at the source's scaled height.
-  forward_kinematics(t, target_translations_ls, target_rotations_ls, target_positions_, target_world_);
+  forward_kinematics(t, target_translations_ls, target_rotations_ls, target_positions_,
+                     target_world_);
   const double k = stride_scale_;
   const Vec3 source_pelvis = pelvis_centre(source_positions_, source_roles_);
   const Vec3 target_pelvis = pelvis_centre(target_positions_, target_roles_);
@@ -362,7 +399,8 @@ void Retargeter::retarget_frame(std::span<const Vec3> source_translations_ls,
     double target_low = std::numeric_limits<double>::infinity();
     for (const Role foot : kFeet) {
       source_low = std::min(source_low, ps(source_roles_[foot]).y());
-      target_low = std::min(target_low, target_positions_[static_cast<std::size_t>(target_roles_[foot])].y());
+      target_low = std::min(target_low,
+                            target_positions_[static_cast<std::size_t>(target_roles_[foot])].y());
     }
     shift.y() = k * source_low - target_low;
   }

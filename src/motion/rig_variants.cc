@@ -34,7 +34,8 @@ std::vector<bool> subtree(const Skeleton& skeleton, int root) {
 void turn_subtree(Skeleton& skeleton, int root, const Quat& rotation) {
   const std::vector<bool> in = subtree(skeleton, root);
   for (std::size_t j = 0; j < in.size(); ++j) {
-    if (in[j] && static_cast<int>(j) != root) skeleton.joints[j].offset = rotation * skeleton.joints[j].offset;
+    if (in[j] && static_cast<int>(j) != root)
+      skeleton.joints[j].offset = rotation * skeleton.joints[j].offset;
   }
 }
 
@@ -89,9 +90,11 @@ Skeleton make_proportioned_rig(const Skeleton& skeleton, const JointRoles& roles
   if (proportions.toes_out_deg != 0.0) {
     // About the vertical: the left foot turns to the left, the right to the right.
     turn_subtree(rig, roles[Role::kLeftAnkle],
-                 quat_from_axis_angle(forward.cross(left).normalized(), deg_to_rad(proportions.toes_out_deg)));
+                 quat_from_axis_angle(forward.cross(left).normalized(),
+                                      deg_to_rad(proportions.toes_out_deg)));
     turn_subtree(rig, roles[Role::kRightAnkle],
-                 quat_from_axis_angle(forward.cross(-left).normalized(), deg_to_rad(proportions.toes_out_deg)));
+                 quat_from_axis_angle(forward.cross(-left).normalized(),
+                                      deg_to_rad(proportions.toes_out_deg)));
   }
   turn_bone_toward(rig, roles[Role::kSpine], roles[Role::kChest], forward,
                    proportions.trunk_lean_deg);
@@ -111,8 +114,10 @@ bool parse_rig_proportions(std::string_view text, RigProportions& proportions, s
     }
     const std::string_view key = item.substr(0, eq), value_text = item.substr(eq + 1);
     double value = 0.0;
-    const auto [end, ec] = std::from_chars(value_text.data(), value_text.data() + value_text.size(), value);
-    if (ec != std::errc{} || end != value_text.data() + value_text.size() || !std::isfinite(value)) {
+    const auto [end, ec] =
+        std::from_chars(value_text.data(), value_text.data() + value_text.size(), value);
+    if (ec != std::errc{} || end != value_text.data() + value_text.size() ||
+        !std::isfinite(value)) {
       error = "'" + std::string(item) + "': the value is not a number";
       return false;
     }
@@ -125,13 +130,20 @@ bool parse_rig_proportions(std::string_view text, RigProportions& proportions, s
       error = "'" + std::string(item) + "': an angle must be within [-90, 90] degrees";
       return false;
     }
-    if (key == "arms") parsed.arms = value;
-    else if (key == "legs") parsed.legs = value;
-    else if (key == "trunk") parsed.trunk = value;
-    else if (key == "arms_down") parsed.arms_down_deg = value;
-    else if (key == "legs_apart") parsed.legs_apart_deg = value;
-    else if (key == "lean") parsed.trunk_lean_deg = value;
-    else if (key == "toes_out") parsed.toes_out_deg = value;
+    if (key == "arms")
+      parsed.arms = value;
+    else if (key == "legs")
+      parsed.legs = value;
+    else if (key == "trunk")
+      parsed.trunk = value;
+    else if (key == "arms_down")
+      parsed.arms_down_deg = value;
+    else if (key == "legs_apart")
+      parsed.legs_apart_deg = value;
+    else if (key == "lean")
+      parsed.trunk_lean_deg = value;
+    else if (key == "toes_out")
+      parsed.toes_out_deg = value;
     else {
       error = "'" + std::string(key) +
               "': unknown key (arms, legs, trunk, arms_down, legs_apart, lean, toes_out)";

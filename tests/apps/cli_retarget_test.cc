@@ -36,7 +36,8 @@ std::vector<double> lowest_feet(const LoadedMotion& m) {
   for (int f = 0; f < m.clip.frame_count(); ++f) {
     double low = 1e9;
     for (Role r : {Role::kLeftAnkle, Role::kLeftToe, Role::kRightAnkle, Role::kRightToe}) {
-      low = std::min(low, p[static_cast<std::size_t>(f) * n + static_cast<std::size_t>(m.roles[r])].y());
+      low = std::min(low,
+                     p[static_cast<std::size_t>(f) * n + static_cast<std::size_t>(m.roles[r])].y());
     }
     lows.push_back(low);
   }
@@ -62,16 +63,17 @@ TEST(CliRetarget, OntoTheHandshakeRigReadsBackAtTheRigsSizeWithFeetOnTheFloor) {
   for (std::size_t f = 0; f < feet_in.size(); ++f) {
     worst = std::max(worst, std::abs(feet_out[f] - k * feet_in[f]));
   }
-  std::printf("CLI salsa -> handshake rig: lowest foot off by at most %.2g m (k = %.4f)\n", worst, k);
+  std::printf("CLI salsa -> handshake rig: lowest foot off by at most %.2g m (k = %.4f)\n", worst,
+              k);
   EXPECT_LT(worst, 0.02);
   std::filesystem::remove(out);
 }
 
 TEST(CliRetarget, ProportionsWithoutARigUseTheInputsOwnSkeleton) {
   const auto out = temp("proportioned.bvh");
-  const CommandResult r = run_duet("retarget --fps 60 " + kSalsa +
-                                   " --proportions arms=1.1,legs=0.92,trunk=1.05,arms_down=40 -o " +
-                                   out.string());
+  const CommandResult r =
+      run_duet("retarget --fps 60 " + kSalsa +
+               " --proportions arms=1.1,legs=0.92,trunk=1.05,arms_down=40 -o " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const LoadedMotion source = load({kSalsa});
   const LoadedMotion written = load({out.string()});
@@ -84,7 +86,8 @@ TEST(CliRetarget, ProportionsWithoutARigUseTheInputsOwnSkeleton) {
 TEST(CliRetarget, BadInputFailsWithReasonAndWritesNothing) {
   const auto out = temp("bad.bvh");
   std::filesystem::remove(out);
-  CommandResult r = run_duet("retarget " + kSalsa + " --rig /nonexistent/rig.bvh -o " + out.string());
+  CommandResult r =
+      run_duet("retarget " + kSalsa + " --rig /nonexistent/rig.bvh -o " + out.string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("/nonexistent/rig.bvh"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(out));
@@ -93,11 +96,12 @@ TEST(CliRetarget, BadInputFailsWithReasonAndWritesNothing) {
   const auto no_roles = temp("no_roles.bvh");
   {
     std::FILE* f = std::fopen(no_roles.c_str(), "w");
-    std::fputs("HIERARCHY\nROOT a\n{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition Zposition "
-               "Zrotation Xrotation Yrotation\n JOINT b\n {\n  OFFSET 0 1 0\n  CHANNELS 3 "
-               "Zrotation Xrotation Yrotation\n  End Site\n  {\n   OFFSET 0 1 0\n  }\n }\n}\n"
-               "MOTION\nFrames: 1\nFrame Time: 0.0333\n0 0 0 0 0 0 0 0 0\n",
-               f);
+    std::fputs(
+        "HIERARCHY\nROOT a\n{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition Zposition "
+        "Zrotation Xrotation Yrotation\n JOINT b\n {\n  OFFSET 0 1 0\n  CHANNELS 3 "
+        "Zrotation Xrotation Yrotation\n  End Site\n  {\n   OFFSET 0 1 0\n  }\n }\n}\n"
+        "MOTION\nFrames: 1\nFrame Time: 0.0333\n0 0 0 0 0 0 0 0 0\n",
+        f);
     std::fclose(f);
   }
   r = run_duet("retarget " + kSalsa + " --rig " + no_roles.string() + " -o " + out.string());

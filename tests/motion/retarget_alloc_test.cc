@@ -60,8 +60,8 @@ TEST(Retargeter, PerFrameCallAllocatesNothing) {
   ASSERT_TRUE(salsa.ok() && rig.ok());
   const Clip& source = salsa.value().clip;
   Result<Retargeter> retargeter =
-      Retargeter::create(source.skeleton_ptr(), salsa.value().roles, rig.value().clip.skeleton_ptr(),
-                         rig.value().roles);
+      Retargeter::create(source.skeleton_ptr(), salsa.value().roles,
+                         rig.value().clip.skeleton_ptr(), rig.value().roles);
   ASSERT_TRUE(retargeter.ok()) << retargeter.error().message;
   const auto n = static_cast<std::size_t>(rig.value().clip.joint_count());
   std::vector<Vec3> translations(n);
@@ -77,8 +77,9 @@ TEST(Retargeter, PerFrameCallAllocatesNothing) {
   const auto stop = std::chrono::steady_clock::now();
   g_counting = false;
   EXPECT_EQ(g_allocations.load(), 0);
-  std::printf("retarget_frame, salsa (43 joints) -> handshake rig (38 joints): %.2f us per frame\n",
-              std::chrono::duration<double, std::micro>(stop - start).count() / source.frame_count());
+  std::printf(
+      "retarget_frame, salsa (43 joints) -> handshake rig (38 joints): %.2f us per frame\n",
+      std::chrono::duration<double, std::micro>(stop - start).count() / source.frame_count());
 }
 
 }  // namespace

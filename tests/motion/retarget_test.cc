@@ -19,7 +19,9 @@
 namespace duet {
 namespace {
 
-std::string data(const std::string& relative) { return std::string(DUET_DATA_DIR) + "/" + relative; }
+std::string data(const std::string& relative) {
+  return std::string(DUET_DATA_DIR) + "/" + relative;
+}
 
 LoadedMotion load(const std::vector<std::string>& paths) {
   MotionLoadOptions options;
@@ -48,12 +50,18 @@ struct Bone {
   Role from, to;
 };
 constexpr Bone kLimbs[] = {
-    {Role::kLeftShoulder, Role::kLeftElbow}, {Role::kLeftElbow, Role::kLeftWrist},
-    {Role::kRightShoulder, Role::kRightElbow}, {Role::kRightElbow, Role::kRightWrist},
-    {Role::kLeftHip, Role::kLeftKnee},       {Role::kLeftKnee, Role::kLeftAnkle},
-    {Role::kRightHip, Role::kRightKnee},     {Role::kRightKnee, Role::kRightAnkle},
-    {Role::kSpine, Role::kChest},            {Role::kNeck, Role::kHead},
-    {Role::kLeftAnkle, Role::kLeftToe},      {Role::kRightAnkle, Role::kRightToe},
+    {Role::kLeftShoulder, Role::kLeftElbow},
+    {Role::kLeftElbow, Role::kLeftWrist},
+    {Role::kRightShoulder, Role::kRightElbow},
+    {Role::kRightElbow, Role::kRightWrist},
+    {Role::kLeftHip, Role::kLeftKnee},
+    {Role::kLeftKnee, Role::kLeftAnkle},
+    {Role::kRightHip, Role::kRightKnee},
+    {Role::kRightKnee, Role::kRightAnkle},
+    {Role::kSpine, Role::kChest},
+    {Role::kNeck, Role::kHead},
+    {Role::kLeftAnkle, Role::kLeftToe},
+    {Role::kRightAnkle, Role::kRightToe},
 };
 
 double angle_deg(const Vec3& a, const Vec3& b) {
@@ -73,7 +81,8 @@ Stats stats(std::vector<double> v) {
 std::vector<double> direction_errors(const Clip& a, const JointRoles& ra, const Clip& b,
                                      const JointRoles& rb, bool pelvis_to_head) {
   const std::vector<Vec3> pa = world_positions(a), pb = world_positions(b);
-  const auto na = static_cast<std::size_t>(a.joint_count()), nb = static_cast<std::size_t>(b.joint_count());
+  const auto na = static_cast<std::size_t>(a.joint_count()),
+             nb = static_cast<std::size_t>(b.joint_count());
   std::vector<double> errors;
   for (int f = 0; f < a.frame_count(); ++f) {
     const std::span<const Vec3> fa(pa.data() + static_cast<std::size_t>(f) * na, na);
@@ -123,7 +132,8 @@ TEST(Retarget, RoundTripThroughTheHandshakeRigKeepsTheRoleDirections) {
       retarget_or_fail(src.clip, src.roles, handshake().clip.skeleton_ptr(), handshake().roles);
   const Clip back = retarget_or_fail(there, handshake().roles, src.clip.skeleton_ptr(), src.roles);
   ASSERT_EQ(back.frame_count(), src.clip.frame_count());
-  expect_directions("salsa -> handshake rig", direction_errors(src.clip, src.roles, there, handshake().roles, false), 2.0);
+  expect_directions("salsa -> handshake rig",
+                    direction_errors(src.clip, src.roles, there, handshake().roles, false), 2.0);
   expect_directions("salsa -> handshake rig -> salsa",
                     direction_errors(src.clip, src.roles, back, src.roles, true), 2.0);
 }
@@ -131,7 +141,8 @@ TEST(Retarget, RoundTripThroughTheHandshakeRigKeepsTheRoleDirections) {
 TEST(Retarget, OntoTheAsfRigKeepsTheRoleDirections) {
   const LoadedMotion& src = salsa();
   const Clip out = retarget_or_fail(src.clip, src.roles, asf().clip.skeleton_ptr(), asf().roles);
-  expect_directions("salsa -> ASF rig", direction_errors(src.clip, src.roles, out, asf().roles, false), 2.0);
+  expect_directions("salsa -> ASF rig",
+                    direction_errors(src.clip, src.roles, out, asf().roles, false), 2.0);
   // Pelvis -> head is a sum of trunk bones whose lengths differ between the rigs: reported only.
   const Stats trunk = stats(direction_errors(src.clip, src.roles, out, asf().roles, true));
   std::printf("salsa -> ASF rig, with pelvis -> head: max %.3f deg, median %.3f deg\n", trunk.max,
@@ -142,12 +153,17 @@ TEST(Retarget, ToAndFromTheBandaiRig) {
   // A third-party rig in centimetres whose roles are found from its joint names.
   const LoadedMotion bandai = load({data("bandai/dataset-1_dance-short_normal_001.bvh")});
   const LoadedMotion& src = salsa();
-  const Clip there = retarget_or_fail(src.clip, src.roles, bandai.clip.skeleton_ptr(), bandai.roles);
-  expect_directions("salsa -> Bandai rig", direction_errors(src.clip, src.roles, there, bandai.roles, false), 2.0);
+  const Clip there =
+      retarget_or_fail(src.clip, src.roles, bandai.clip.skeleton_ptr(), bandai.roles);
+  expect_directions("salsa -> Bandai rig",
+                    direction_errors(src.clip, src.roles, there, bandai.roles, false), 2.0);
   const Clip back = retarget_or_fail(there, bandai.roles, src.clip.skeleton_ptr(), src.roles);
-  expect_directions("salsa -> Bandai rig -> salsa", direction_errors(src.clip, src.roles, back, src.roles, true), 2.0);
-  const Clip dance = retarget_or_fail(bandai.clip, bandai.roles, src.clip.skeleton_ptr(), src.roles);
-  expect_directions("Bandai dance -> salsa rig", direction_errors(bandai.clip, bandai.roles, dance, src.roles, false), 2.0);
+  expect_directions("salsa -> Bandai rig -> salsa",
+                    direction_errors(src.clip, src.roles, back, src.roles, true), 2.0);
+  const Clip dance =
+      retarget_or_fail(bandai.clip, bandai.roles, src.clip.skeleton_ptr(), src.roles);
+  expect_directions("Bandai dance -> salsa rig",
+                    direction_errors(bandai.clip, bandai.roles, dance, src.roles, false), 2.0);
 }
 
 TEST(Retarget, OntoAProportionedRigKeepsDirectionsFeetAndScaledStrides) {
@@ -169,12 +185,15 @@ TEST(Retarget, OntoAProportionedRigKeepsDirectionsFeetAndScaledStrides) {
   // Copying the local rotations instead would not follow the rig: the check can fail.
   Clip copied(rig, src.clip.frame_rate(), src.clip.frame_count());
   for (int f = 0; f < src.clip.frame_count(); ++f) {
-    std::copy_n(src.clip.rotations_ls(f).begin(), src.clip.joint_count(), copied.rotations_ls(f).begin());
+    std::copy_n(src.clip.rotations_ls(f).begin(), src.clip.joint_count(),
+                copied.rotations_ls(f).begin());
     copied.translations_ls(f)[0] = src.clip.translations_ls(f)[0];
   }
   const Stats copy = stats(direction_errors(src.clip, src.roles, copied, src.roles, false));
-  std::printf("copying local rotations onto the proportioned rig instead: max %.1f deg, median "
-              "%.1f deg\n", copy.max, copy.median);
+  std::printf(
+      "copying local rotations onto the proportioned rig instead: max %.1f deg, median "
+      "%.1f deg\n",
+      copy.max, copy.median);
   EXPECT_GT(copy.max, 20.0);
 
   const double k = body.leg_length_m / original.leg_length_m;
@@ -184,7 +203,8 @@ TEST(Retarget, OntoAProportionedRigKeepsDirectionsFeetAndScaledStrides) {
     return std::span<const Vec3>(p.data() + static_cast<std::size_t>(f) * n, n);
   };
   double worst_foot = 0.0, worst_path = 0.0, worst_step = 0.0, previous_lift = 0.0;
-  const Vec3 start_s = pelvis_centre(frame(ps, 0), src.roles), start_t = pelvis_centre(frame(pt, 0), src.roles);
+  const Vec3 start_s = pelvis_centre(frame(ps, 0), src.roles),
+             start_t = pelvis_centre(frame(pt, 0), src.roles);
   for (int f = 0; f < src.clip.frame_count(); ++f) {
     worst_foot = std::max(worst_foot, std::abs(lowest_foot(frame(pt, f), src.roles) -
                                                k * lowest_foot(frame(ps, f), src.roles)));
@@ -193,7 +213,8 @@ TEST(Retarget, OntoAProportionedRigKeepsDirectionsFeetAndScaledStrides) {
     moved_s.y() = moved_t.y() = 0.0;
     worst_path = std::max(worst_path, (moved_t - k * moved_s).norm());
     // Smoothness: the pelvis height minus the scaled source's changes little from frame to frame.
-    const double lift = pelvis_centre(frame(pt, f), src.roles).y() - k * pelvis_centre(frame(ps, f), src.roles).y();
+    const double lift =
+        pelvis_centre(frame(pt, f), src.roles).y() - k * pelvis_centre(frame(ps, f), src.roles).y();
     if (f > 0) worst_step = std::max(worst_step, std::abs(lift - previous_lift));
     previous_lift = lift;
   }
@@ -213,13 +234,16 @@ TEST(Retarget, OntoAProportionedRigKeepsDirectionsFeetAndScaledStrides) {
       ++planted;
     }
   }
-  std::printf("proportioned rig: planted toes (%d toe-frames) slide %.2f mm per frame on average, "
-              "at most %.2f mm\n", planted, 1000.0 * slide_sum / std::max(planted, 1), 1000.0 * slide_max);
+  std::printf(
+      "proportioned rig: planted toes (%d toe-frames) slide %.2f mm per frame on average, "
+      "at most %.2f mm\n",
+      planted, 1000.0 * slide_sum / std::max(planted, 1), 1000.0 * slide_max);
   EXPECT_GT(planted, 100);
   EXPECT_LT(slide_sum / planted, 0.002);
-  std::printf("proportioned rig: lowest foot off by at most %.2g m; pelvis floor path off by at "
-              "most %.2g m; height correction changes by at most %.2f mm per frame\n",
-              worst_foot, worst_path, 1000.0 * worst_step);
+  std::printf(
+      "proportioned rig: lowest foot off by at most %.2g m; pelvis floor path off by at "
+      "most %.2g m; height correction changes by at most %.2f mm per frame\n",
+      worst_foot, worst_path, 1000.0 * worst_step);
   EXPECT_LT(worst_foot, 0.02);
   EXPECT_LT(worst_path, 1e-6);
   EXPECT_LT(worst_step, 0.01);
@@ -243,24 +267,27 @@ TEST(Retarget, SameRigIsTheIdentityOnTheRoleJoints) {
 
 TEST(Retarget, FramesAreFiniteAndBadRolesAreNamed) {
   const LoadedMotion& src = salsa();
-  const Clip out = retarget_or_fail(src.clip, src.roles, handshake().clip.skeleton_ptr(), handshake().roles);
+  const Clip out =
+      retarget_or_fail(src.clip, src.roles, handshake().clip.skeleton_ptr(), handshake().roles);
   for (int f = 0; f < out.frame_count(); ++f) {
     for (const Quat& q : out.rotations_ls(f)) ASSERT_TRUE(q.coeffs().allFinite()) << f;
     for (const Vec3& t : out.translations_ls(f)) ASSERT_TRUE(t.allFinite()) << f;
   }
   JointRoles broken = handshake().roles;
   broken.joints[static_cast<std::size_t>(Role::kLeftKnee)] = 999;
-  Result<Clip> bad = retarget_clip(src.clip, src.roles, handshake().clip.skeleton_ptr(), broken,
-                                   {}, "salsa.bvh", "rig.bvh");
+  Result<Clip> bad = retarget_clip(src.clip, src.roles, handshake().clip.skeleton_ptr(), broken, {},
+                                   "salsa.bvh", "rig.bvh");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().message.find("rig.bvh"), std::string::npos) << bad.error().message;
   EXPECT_NE(bad.error().message.find("left_knee"), std::string::npos) << bad.error().message;
   // Legs of no length: strides cannot be scaled.
   JointRoles flat = handshake().roles;
-  for (Role r : {Role::kLeftKnee, Role::kLeftAnkle, Role::kRightHip, Role::kRightKnee, Role::kRightAnkle}) {
+  for (Role r :
+       {Role::kLeftKnee, Role::kLeftAnkle, Role::kRightHip, Role::kRightKnee, Role::kRightAnkle}) {
     flat.joints[static_cast<std::size_t>(r)] = flat[Role::kLeftHip];
   }
-  bad = retarget_clip(src.clip, src.roles, handshake().clip.skeleton_ptr(), flat, {}, "salsa.bvh", "rig.bvh");
+  bad = retarget_clip(src.clip, src.roles, handshake().clip.skeleton_ptr(), flat, {}, "salsa.bvh",
+                      "rig.bvh");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().message.find("rig.bvh: the legs have no length"), std::string::npos)
       << bad.error().message;
@@ -269,7 +296,8 @@ TEST(Retarget, FramesAreFiniteAndBadRolesAreNamed) {
 TEST(RigProportions, ParsesKeysAndRejectsNonsense) {
   RigProportions p;
   std::string error;
-  ASSERT_TRUE(parse_rig_proportions("arms=1.1,legs=0.92,trunk=1.05,arms_down=40", p, error)) << error;
+  ASSERT_TRUE(parse_rig_proportions("arms=1.1,legs=0.92,trunk=1.05,arms_down=40", p, error))
+      << error;
   EXPECT_DOUBLE_EQ(p.arms, 1.1);
   EXPECT_DOUBLE_EQ(p.legs, 0.92);
   EXPECT_DOUBLE_EQ(p.trunk, 1.05);

@@ -79,10 +79,10 @@ class Retargeter {
   enum class Rule : int { kRest, kCopy, kDirection, kFrame, kFollow };
   struct JointRule {
     Rule rule = Rule::kRest;
-    int source = -1;       // kCopy/kDirection/kFrame/kFollow: the source joint it follows
-    int target_end = -1;   // kDirection: the target child role joint (bone end)
-    int source_end = -1;   // kDirection: the source child role joint
-    int parent_role = -1;  // kCopy/kFollow: the target role joint whose alignment applies
+    int source = -1;              // kCopy/kDirection/kFrame/kFollow: the source joint it follows
+    int target_end = -1;          // kDirection: the target child role joint (bone end)
+    int source_end = -1;          // kDirection: the source child role joint
+    int parent_role = -1;         // kCopy/kFollow: the target role joint whose alignment applies
     int source_parent_role = -1;  // kFollow: that role's source joint
     Quat alignment = Quat::Identity();  // rest alignment: target rest frame -> source rest frame
     int target_start = -1;  // kDirection: where the bone starts (the joint itself, or the right

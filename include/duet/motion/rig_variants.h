@@ -21,16 +21,14 @@ struct RigProportions {
   double trunk = 1.0;
   // Rest pose changes, degrees. Each turns a whole subtree about its joint in the rest pose, so
   // the joint-local frames below it turn too (the skeleton keeps identity rest rotations).
-  double arms_down_deg = 0.0;    // upper arms lowered from the source's rest (T-pose -> A-pose)
-  double legs_apart_deg = 0.0;   // thighs turned outwards
-  double trunk_lean_deg = 0.0;   // spine and everything above it leaning forwards
-  double toes_out_deg = 0.0;     // feet turned outwards about the vertical
+  double arms_down_deg = 0.0;   // upper arms lowered from the source's rest (T-pose -> A-pose)
+  double legs_apart_deg = 0.0;  // thighs turned outwards
+  double trunk_lean_deg = 0.0;  // spine and everything above it leaning forwards
+  double toes_out_deg = 0.0;    // feet turned outwards about the vertical
 
   // The variant the evaluation and the tests use: longer arms in an A-pose, shorter legs apart,
   // a longer leaning trunk, feet turned out.
-  static RigProportions evaluation_variant() {
-    return {1.1, 0.92, 1.05, 40.0, 6.0, 8.0, 15.0};
-  }
+  static RigProportions evaluation_variant() { return {1.1, 0.92, 1.05, 40.0, 6.0, 8.0, 15.0}; }
 };
 
 // The proportioned rig of `skeleton` (in metres; Y up). Joint names, order, parents and channels
