@@ -1,6 +1,7 @@
 #include "duet/motion/retarget.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -313,6 +314,10 @@ void Retargeter::retarget_frame(std::span<const Vec3> source_translations_ls,
                                 std::span<Quat> target_rotations_ls) {
   const Skeleton& s = *source_;
   const Skeleton& t = *target_;
+  assert(source_translations_ls.size() == s.joints.size() &&
+         source_rotations_ls.size() == s.joints.size());
+  assert(target_translations_ls.size() == t.joints.size() &&
+         target_rotations_ls.size() == t.joints.size());
   forward_kinematics(s, source_translations_ls, source_rotations_ls, source_positions_,
                      source_world_);
   auto ps = [&](int j) { return source_positions_[static_cast<std::size_t>(j)]; };
