@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <string_view>
 
 namespace duet {
 
@@ -46,6 +47,50 @@ std::string partner_cell(bool meaningful, double value, int decimals) {
   return meaningful ? fmt::format("{:.{}f}", value, decimals) : std::string("-");
 }
 
+// What each column of the partner table means, in the table's own words (docs/evaluation.md
+// has the definitions in full).
+void append_partner_legend(std::string& out, const PartnerMetricsOptions& options) {
+  const double pct = 100.0 * options.reference_percentile;
+  const double window = options.post_jump_window_s;
+  out +=
+      "\ncolumns (against the true response: the partner had the follower known the true frame):\n";
+  const auto line = [&out](std::string_view name, const std::string& text) {
+    fmt::format_to(std::back_inserter(out), "  {:<18} {}\n", name, text);
+  };
+  line("frames", "performance frames, pauses included");
+  line("joint cm", "mean distance of every joint (End Sites included) from the true response's");
+  line("hand med/avg cm",
+       "while the take's dancers hold hands: |partner-to-user wrist distance - the captured "
+       "one|, median / mean");
+  line("hand n samples", "(frame, holding hand pair) samples behind hand med/avg");
+  line("slip %", fmt::format("frames in which a toe within {:g} cm of the floor moves faster "
+                             "than {:g} m/s horizontally",
+                             100.0 * options.slip.height_margin_m, options.slip.speed_mps));
+  line("skate cm/s", "mean horizontal speed of the toes near the floor");
+  line("jump max/med deg/s",
+       fmt::format("largest joint angular speed in the {:g} s after each true jump: largest / "
+                   "median over jumps",
+                   window));
+  line("true med deg/s", "the same for the true response, median over jumps");
+  line(">p99 jumps", fmt::format("jumps whose largest exceeds the captured response's p{:g} "
+                                 "angular speed",
+                                 pct));
+  line(">true jumps", "of those, jumps whose largest also exceeds the true response's there");
+  line(">win99 jumps", fmt::format("jumps whose largest exceeds the p{:g} of the captured "
+                                   "response's largest per {:g} s window",
+                                   pct, window));
+  line(">w99&t jumps", "of those, jumps whose largest also exceeds the true response's there");
+  line("jerk m/s^3",
+       "mean |third derivative| of the joint positions; true jerk: the true "
+       "response's");
+  line("us/frame",
+       "mean live-loop step with the tracker's estimates replayed (features, "
+       "synthesis, forward kinematics)");
+  line("-",
+       "not meaningful: no jumps or hand contacts, or `none` (partner not placed at the "
+       "user)");
+}
+
 // The partner section of the table: one line per case x configuration, then per case the captured
 // partner's own numbers and the loop's cost with the tracker.
 void append_partner_table(std::string& out, const EvalReport& report) {
@@ -54,11 +99,15 @@ void append_partner_table(std::string& out, const EvalReport& report) {
       "\npartner metrics (hmm tracker, the live loop as `duet follow` runs it; against the true "
       "response, docs/evaluation.md):\n";
   constexpr const char* kHeader =
-      "{:<18} {:<12} {:>7} {:>8} {:>8} {:>8} {:>7} {:>7} {:>7} {:>9} {:>9} {:>9} {:>7} "
+      "{:<18} {:<12} {:>7} {:>8} {:>9} {:>9} {:>7} {:>7} {:>7} {:>9} {:>9} {:>9} {:>7} "
       "{:>7} {:>7} {:>7} {:>9} {:>9} {:>8}\n";
-  fmt::format_to(std::back_inserter(out), kHeader, "case", "corrections", "frames", "joint cm",
+  // Two header lines: the column's name, then its unit (the legend below says what each means).
+  fmt::format_to(std::back_inserter(out), kHeader, "case", "corrections", "frames", "joint",
                  "hand med", "hand avg", "hand n", "slip", "skate", "jump max", "jump med",
                  "true med", ">p99", ">true", ">win99", ">w99&t", "jerk", "true jerk", "us/frame");
+  fmt::format_to(std::back_inserter(out), kHeader, "", "", "", "cm", "cm", "cm", "samples", "%",
+                 "cm/s", "deg/s", "deg/s", "deg/s", "jumps", "jumps", "jumps", "jumps", "m/s^3",
+                 "m/s^3", "us");
   std::string previous_case;
   const auto case_footer = [&](const PartnerRow& row) {
     const PartnerMetrics& m = row.metrics;
@@ -102,6 +151,7 @@ void append_partner_table(std::string& out, const EvalReport& report) {
                    fmt::format("{:.1f}", m.mean_step_us));
   }
   case_footer(report.partner_rows.back());
+  append_partner_legend(out, report.partner_options);
 }
 
 void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::string& take,
@@ -282,17 +332,18 @@ std::vector<PlotFile> make_eval_plots(const EvalReport& report, const std::strin
         "set grid\n"
         "plot ",
         terminal, first.case_name, take_name(report, first.take), other_take_y);
-    // Estimates first, the truth on top of them.
-    for (std::size_t k = 0; k < report.traces.size(); ++k) {
-      const int column = 4 + 2 * static_cast<int>(k);
-      script += fmt::format(
-          "'trace.dat' using 1:(${}) with points pt 7 ps 0.5 lc {} title '{}', \\\n"
-          "     'trace.dat' using 1:(${}) with points pt 2 ps 0.6 lc {} notitle, \\\n     ",
-          column, k + 1, report.traces[k].tracker, column + 1, k + 1);
-    }
+    // The truth first, so it lies underneath: the trackers' points drawn after it stay visible
+    // where they agree with it (drawn the other way round, the truth line hid a right estimate).
     script +=
         "'trace.dat' using 1:($2) with lines lw 1.5 lc rgb 'black' title 'truth', \\\n"
         "     'trace.dat' using 1:($3) with lines lw 4 lc rgb 'red' title 'truth (pause)'";
+    for (std::size_t k = 0; k < report.traces.size(); ++k) {
+      const int column = 4 + 2 * static_cast<int>(k);
+      script += fmt::format(
+          ", \\\n     'trace.dat' using 1:(${}) with points pt 7 ps 0.5 lc {} title '{}', \\\n"
+          "     'trace.dat' using 1:(${}) with points pt 2 ps 0.6 lc {} notitle",
+          column, k + 1, report.traces[k].tracker, column + 1, k + 1);
+    }
     script += "\n";
   }
   files.push_back({"plots.gp", script});
