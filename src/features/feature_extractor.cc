@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "duet/math/rotation.h"
+#include "duet/motion/body_space.h"
 #include "duet/motion/forward_kinematics.h"
 
 namespace duet {
@@ -39,29 +40,38 @@ Result<FeatureExtractor> FeatureExtractor::create(std::shared_ptr<const Skeleton
   if (!(spec.velocity_window_s > 0.0)) {
     return Error{"feature extractor: velocity window must be positive"};
   }
+  // Every role the canonical points are built from, and every role the spec names.
+  std::vector<Role> needed = {Role::kHips,      Role::kLeftHip,      Role::kRightHip,
+                              Role::kLeftWrist, Role::kRightWrist,   Role::kLeftAnkle,
+                              Role::kRightAnkle, Role::kLeftShoulder, Role::kRightShoulder};
+  for (const BodySegment& segment : spec.posture_segments) {
+    needed.push_back(segment.from);
+    needed.push_back(segment.to);
+  }
+  for (Role role : spec.posture_points) needed.push_back(role);
+  std::string missing;
+  for (Role role : needed) {
+    const int joint = roles[role];
+    if ((joint < 0 || joint >= skeleton->joint_count()) &&
+        missing.find(role_name(role)) == std::string::npos) {
+      if (!missing.empty()) missing += ", ";
+      missing += role_name(role);
+    }
+  }
+  if (!missing.empty()) {
+    return Error{"feature extractor: the skeleton has no joint for role(s) " + missing};
+  }
+  const BodyDimensions body = measure_body(*skeleton, roles);
+  if (!(body.leg_length_m > 1e-3) || !std::isfinite(body.leg_length_m)) {
+    return Error{"feature extractor: the skeleton's legs have no length (hip, knee and ankle "
+                 "joints at one place?)"};
+  }
   FeatureExtractor extractor;
   extractor.spec_ = spec;
-  auto joint_of = [&](Role role) { return roles[role]; };
-  for (Role role : spec.posture_roles) {
-    const int joint = joint_of(role);
-    if (joint < 0 || joint >= skeleton->joint_count()) {
-      return Error{"feature extractor: the skeleton has no joint for role " +
-                   std::string(role_name(role))};
-    }
-    extractor.posture_joints_.push_back(joint);
-  }
-  const std::array<Role, 5> needed = {Role::kHips, Role::kLeftWrist, Role::kRightWrist,
-                                      Role::kLeftAnkle, Role::kRightAnkle};
-  for (Role role : needed) {
-    const int joint = joint_of(role);
-    if (joint < 0 || joint >= skeleton->joint_count()) {
-      return Error{"feature extractor: the skeleton has no joint for role " +
-                   std::string(role_name(role))};
-    }
-  }
-  extractor.root_joint_ = joint_of(Role::kHips);
-  extractor.effector_joints_ = {joint_of(Role::kLeftWrist), joint_of(Role::kRightWrist),
-                                joint_of(Role::kLeftAnkle), joint_of(Role::kRightAnkle)};
+  extractor.roles_ = roles;
+  extractor.leg_length_m_ = body.leg_length_m;
+  extractor.effector_joints_ = {roles[Role::kLeftWrist], roles[Role::kRightWrist],
+                                roles[Role::kLeftAnkle], roles[Role::kRightAnkle]};
   extractor.skeleton_ = std::move(skeleton);
   return extractor;
 }
@@ -71,6 +81,13 @@ FeatureExtractor::Context FeatureExtractor::make_context() const {
   context.positions_ws_.resize(static_cast<std::size_t>(skeleton_->joint_count()));
   context.rotations_ws_.resize(static_cast<std::size_t>(skeleton_->joint_count()));
   return context;
+}
+
+Vec3 FeatureExtractor::body_point(std::span<const Vec3> positions_ws, Role role) const noexcept {
+  auto at = [&](Role r) { return positions_ws[static_cast<std::size_t>(roles_[r])]; };
+  if (role == Role::kHips) return pelvis_centre(positions_ws, roles_);
+  if (role == Role::kChest) return 0.5 * (at(Role::kLeftShoulder) + at(Role::kRightShoulder));
+  return at(role);
 }
 
 void FeatureExtractor::extract(Context& context, std::span<const Vec3> translations_ls,
@@ -84,20 +101,31 @@ void FeatureExtractor::extract(Context& context, std::span<const Vec3> translati
   }
   forward_kinematics(*skeleton_, translations_ls, rotations_ls, context.positions_ws_,
                      context.rotations_ws_);
-
-  // Posture: rotation vectors of the local rotations (the BVH rest pose has zero rotations).
-  std::size_t d = 0;
-  for (int joint : posture_joints_) {
-    const Vec3 v = log_map(rotations_ls[static_cast<std::size_t>(joint)]);
-    for (int k = 0; k < 3; ++k) out[d++] = static_cast<float>(v[k]);
-  }
+  const std::span<const Vec3> positions(context.positions_ws_);
 
   Context::Sample now;
   now.time_s = time_s;
-  now.root = context.positions_ws_[static_cast<std::size_t>(root_joint_)];
-  now.yaw = heading_yaw(context.rotations_ws_[static_cast<std::size_t>(root_joint_)]);
+  now.pelvis = pelvis_centre(positions, roles_);
+  now.yaw = body_heading_yaw(positions, roles_);
   for (std::size_t e = 0; e < 4; ++e) {
-    now.effectors[e] = context.positions_ws_[static_cast<std::size_t>(effector_joints_[e])];
+    now.effectors[e] = positions[static_cast<std::size_t>(effector_joints_[e])];
+  }
+  const Quat to_heading = yaw_rotation(-now.yaw);
+  const double per_leg = 1.0 / leg_length_m_;
+
+  // Posture: segment directions and effector positions, in the heading frame (x left, y up,
+  // z forward).
+  std::size_t d = 0;
+  auto put = [&](const Vec3& v) {
+    for (int k = 0; k < 3; ++k) out[d++] = static_cast<float>(v[k]);
+  };
+  for (const BodySegment& segment : spec_.posture_segments) {
+    const Vec3 delta = body_point(positions, segment.to) - body_point(positions, segment.from);
+    const double length = delta.norm();
+    put(length > 1e-9 ? Vec3(to_heading * (delta / length)) : Vec3::Zero());
+  }
+  for (Role role : spec_.posture_points) {
+    put(to_heading * (body_point(positions, role) - now.pelvis) * per_leg);
   }
 
   // The reference sample: the newest one at least velocity_window_s older than now, else the
@@ -116,11 +144,10 @@ void FeatureExtractor::extract(Context& context, std::span<const Vec3> translati
   std::array<double, 4> effector_speed{};
   if (reference != nullptr) {
     const double dt = now.time_s - reference->time_s;
-    const Vec3 velocity_ws = (now.root - reference->root) / dt;
-    root_velocity_heading = yaw_rotation(-now.yaw) * velocity_ws;
+    root_velocity_heading = to_heading * ((now.pelvis - reference->pelvis) * (per_leg / dt));
     yaw_rate = wrap_angle(now.yaw - reference->yaw) / dt;
     for (std::size_t e = 0; e < 4; ++e) {
-      effector_speed[e] = (now.effectors[e] - reference->effectors[e]).norm() / dt;
+      effector_speed[e] = (now.effectors[e] - reference->effectors[e]).norm() * per_leg / dt;
     }
   }
   out[d++] = static_cast<float>(root_velocity_heading.z());  // forward
@@ -165,8 +192,8 @@ FeatureNormalizer FeatureNormalizer::fit(const FeatureMatrix& raw, const Feature
     const int begin = spec.block_begin(block);
     const int size = spec.block_size(block);
     for (int d = begin; d < begin + size; ++d) {
-      double floor = spec.speed_std_floor_mps;
-      if (block == FeatureBlock::kPosture) floor = spec.rotation_std_floor_rad;
+      double floor = spec.speed_std_floor;
+      if (block == FeatureBlock::kPosture) floor = spec.posture_std_floor;
       if (block == FeatureBlock::kRootVelocity && d == begin + 3) {
         floor = spec.yaw_rate_std_floor_radps;
       }

@@ -7,20 +7,23 @@ namespace duet {
 Result<FollowSession> FollowSession::create(const DuetLibrary& library,
                                             std::shared_ptr<const Skeleton> user_skeleton,
                                             const JointRoles& user_roles,
-                                            std::unique_ptr<Tracker> tracker) {
+                                            std::unique_ptr<Tracker> tracker,
+                                            const PostureBiasParams& bias) {
   if (!tracker) return Error{"follow session: no tracker"};
   Result<FeatureExtractor> extractor = library.make_extractor(std::move(user_skeleton), user_roles);
   if (!extractor) return Error{"the user's motion: " + extractor.error().message};
-  return FollowSession(library, std::move(extractor).value(), std::move(tracker));
+  return FollowSession(library, std::move(extractor).value(), std::move(tracker), bias);
 }
 
 FollowSession::FollowSession(const DuetLibrary& library, FeatureExtractor extractor,
-                             std::unique_ptr<Tracker> tracker)
+                             std::unique_ptr<Tracker> tracker, const PostureBiasParams& bias)
     : library_(&library),
       extractor_(std::move(extractor)),
       context_(extractor_.make_context()),
       tracker_(std::move(tracker)),
-      features_(static_cast<std::size_t>(extractor_.dimension())) {}
+      features_(static_cast<std::size_t>(extractor_.dimension())),
+      bias_(extractor_.spec().block_begin(FeatureBlock::kPosture),
+            extractor_.spec().block_size(FeatureBlock::kPosture), bias) {}
 
 FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
                                  std::span<const Quat> rotations_ls, double time_s) noexcept {
@@ -31,12 +34,23 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
     previous_time_s_ = time_s;
     has_previous_ = true;
   }
-  return tracker_->step(features_, dt_s);
+  bias_.correct(features_);
+  const FollowResult result = tracker_->step(features_, dt_s);
+  if (!result.jumped && !result.missing && result.state >= 0 &&
+      result.state < library_->model().num_states()) {
+    const auto& rows = library_->model().features();
+    bias_.learn(features_,
+                std::span<const float>(rows.row(result.state).data(),
+                                       static_cast<std::size_t>(rows.cols())),
+                dt_s, result.confidence);
+  }
+  return result;
 }
 
 void FollowSession::reset() noexcept {
   context_.reset();
   tracker_->reset();
+  bias_.reset();
   has_previous_ = false;
 }
 

@@ -52,7 +52,8 @@ TEST_F(FeatureExtractorTest, DoesNotDependOnPlaceOrFacingInTheRoom) {
 }
 
 TEST_F(FeatureExtractorTest, VelocitiesAreRealSpeedsAtAnyInputRate) {
-  // A body gliding forward at 1.5 m/s while it turns: forward speed 1.5 m/s whatever the rate.
+  // A body gliding forward at 1.5 m/s while it turns: forward speed 1.5 m/s whatever the rate, in
+  // leg lengths per second.
   for (double fps : {30.0, 60.0, 120.0}) {
     Clip clip(skeleton_, fps, static_cast<int>(fps));
     for (int f = 0; f < clip.frame_count(); ++f) {
@@ -65,7 +66,9 @@ TEST_F(FeatureExtractorTest, VelocitiesAreRealSpeedsAtAnyInputRate) {
     const int root = spec_.block_begin(FeatureBlock::kRootVelocity);
     const int last = clip.frame_count() - 1;
     const double yaw = 0.5 * last / fps;
-    EXPECT_NEAR(rows(last, root), 1.5 * std::cos(yaw), 0.05) << fps;  // forward
+    const double legs = extractor_->leg_length_m();
+    EXPECT_NEAR(legs, 0.84, 1e-9);
+    EXPECT_NEAR(rows(last, root), 1.5 * std::cos(yaw) / legs, 0.05) << fps;  // forward
     EXPECT_NEAR(rows(last, root + 3), 0.5, 1e-3) << fps;                // yaw rate
   }
 }
@@ -100,9 +103,98 @@ TEST_F(FeatureExtractorTest, MissingRoleIsAClearError) {
   EXPECT_NE(e.error().message.find("left_wrist"), std::string::npos);
 }
 
+// The same body and motion on another rig: every joint's local axes turned by its own constant
+// rotation, an extra (twist) joint in each forearm, another unit of length and a 1.2x bigger body.
+// The world pose is the same up to scale, so the features must be the same.
+TEST_F(FeatureExtractorTest, SameMotionOnAnotherRigGivesTheSameFeatures) {
+  const Clip clip = make_dance(skeleton_, 60.0, 240);
+  const double scale = 1.2 * 100.0;  // a 1.2x body, in centimetres
+  const int n = skeleton_->joint_count();
+  std::vector<Quat> axes(static_cast<std::size_t>(n));
+  for (int j = 0; j < n; ++j) {
+    axes[static_cast<std::size_t>(j)] = exp_map(Vec3(0.7 * std::sin(j), 1.3 * std::cos(2.0 * j), 0.4 * j));
+  }
+  // Old joint j -> new index; each elbow gets a twist joint halfway along the forearm.
+  auto rig = std::make_shared<Skeleton>();
+  std::vector<int> new_index(static_cast<std::size_t>(n), -1);
+  const std::array<int, 2> elbows = {static_cast<int>(Role::kLeftElbow),
+                                     static_cast<int>(Role::kRightElbow)};
+  std::vector<int> twist_of(static_cast<std::size_t>(n), -1);
+  for (int j = 0; j < n; ++j) {
+    const Joint& old = skeleton_->joints[static_cast<std::size_t>(j)];
+    Joint joint = old;
+    joint.name = "bone" + std::to_string(j);
+    const int parent = old.parent < 0 ? -1 : old.parent;
+    const int attach = parent >= 0 && twist_of[static_cast<std::size_t>(parent)] >= 0
+                           ? twist_of[static_cast<std::size_t>(parent)]
+                           : (parent >= 0 ? new_index[static_cast<std::size_t>(parent)] : -1);
+    const Quat parent_axes = parent >= 0 ? axes[static_cast<std::size_t>(parent)] : Quat::Identity();
+    Vec3 offset = parent_axes.conjugate() * (old.offset * scale);
+    if (attach != (parent >= 0 ? new_index[static_cast<std::size_t>(parent)] : -1)) {
+      offset *= 0.5;  // the twist joint took the first half of the bone
+    }
+    joint.parent = attach;
+    joint.offset = offset;
+    new_index[static_cast<std::size_t>(j)] = rig->joint_count();
+    rig->joints.push_back(joint);
+    if (std::ranges::find(elbows, j) != elbows.end()) {
+      // The twist joint: halfway to the wrist (the elbow's only child), no rotation of its own.
+      Joint twist;
+      twist.name = "twist" + std::to_string(j);
+      twist.parent = new_index[static_cast<std::size_t>(j)];
+      const Vec3 to_wrist = skeleton_->joints[static_cast<std::size_t>(j + 1)].offset * scale;
+      twist.offset = axes[static_cast<std::size_t>(j)].conjugate() * (0.5 * to_wrist);
+      twist.channels = old.channels;
+      twist_of[static_cast<std::size_t>(j)] = rig->joint_count();
+      rig->joints.push_back(twist);
+    }
+  }
+  ASSERT_EQ(rig->validate(), "");
+  JointRoles roles;
+  roles.convention = "test-rig";
+  for (int r = 0; r < kRoleCount; ++r) roles.joints[static_cast<std::size_t>(r)] = new_index[static_cast<std::size_t>(r)];
+
+  Clip moved(rig, clip.frame_rate(), clip.frame_count());
+  for (int f = 0; f < clip.frame_count(); ++f) {
+    auto rotations = moved.rotations_ls(f);
+    for (int j = 0; j < n; ++j) {
+      const Joint& old = skeleton_->joints[static_cast<std::size_t>(j)];
+      const Quat parent_axes =
+          old.parent >= 0 ? axes[static_cast<std::size_t>(old.parent)] : Quat::Identity();
+      // World rotation W'_j = W_j C_j, so the local one is C_parent^-1 q_j C_j.
+      rotations[static_cast<std::size_t>(new_index[static_cast<std::size_t>(j)])] =
+          parent_axes.conjugate() * clip.rotations_ls(f)[static_cast<std::size_t>(j)] *
+          axes[static_cast<std::size_t>(j)];
+    }
+    for (int elbow : elbows) {
+      // The twist joint keeps the elbow's axes: identity local rotation.
+      rotations[static_cast<std::size_t>(twist_of[static_cast<std::size_t>(elbow)])] = Quat::Identity();
+    }
+    moved.translations_ls(f)[0] = clip.translations_ls(f)[0] * scale;
+    for (int j = 1; j < rig->joint_count(); ++j) {
+      moved.translations_ls(f)[static_cast<std::size_t>(j)] = rig->joints[static_cast<std::size_t>(j)].offset;
+    }
+  }
+  // The wrists hang below the twist joints now: their offsets are the other half of the forearm.
+  for (int elbow : elbows) {
+    const int wrist = new_index[static_cast<std::size_t>(elbow + 1)];
+    for (int f = 0; f < moved.frame_count(); ++f) {
+      moved.translations_ls(f)[static_cast<std::size_t>(wrist)] = rig->joints[static_cast<std::size_t>(wrist)].offset;
+    }
+  }
+  Result<FeatureExtractor> other = FeatureExtractor::create(rig, roles, spec_);
+  ASSERT_TRUE(other) << other.error().message;
+  EXPECT_NEAR(other.value().leg_length_m() / extractor_->leg_length_m(), scale, 1e-9);
+  const FeatureMatrix a = extractor_->extract_clip(clip);
+  const FeatureMatrix b = other.value().extract_clip(moved);
+  ASSERT_EQ(a.cols(), b.cols());
+  EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-4f);
+}
+
 TEST(FeatureNormalizer, FloorsTinyDeviationsAndWeighsBlocks) {
   FeatureSpec spec;
-  spec.posture_roles = {Role::kSpine};  // 3 + 4 + 4 = 11 dims
+  spec.posture_segments = {{Role::kHips, Role::kChest}};  // 3 + 4 + 4 = 11 dims
+  spec.posture_points.clear();
   FeatureMatrix raw = FeatureMatrix::Zero(100, spec.dimension());
   for (int f = 0; f < 100; ++f) {
     raw(f, 0) = static_cast<float>(f % 2);  // std 0.5
@@ -110,7 +202,7 @@ TEST(FeatureNormalizer, FloorsTinyDeviationsAndWeighsBlocks) {
   }
   const FeatureNormalizer n = FeatureNormalizer::fit(raw, spec);
   EXPECT_NEAR(n.scale()[0], spec.posture_weight / (std::sqrt(3.0) * 0.5), 1e-5);
-  EXPECT_NEAR(n.scale()[1], spec.posture_weight / (std::sqrt(3.0) * spec.rotation_std_floor_rad),
+  EXPECT_NEAR(n.scale()[1], spec.posture_weight / (std::sqrt(3.0) * spec.posture_std_floor),
               1e-4);
   EXPECT_NEAR(n.scale()[spec.block_begin(FeatureBlock::kRootVelocity) + 3],
               spec.root_velocity_weight / (2.0 * spec.yaw_rate_std_floor_radps), 1e-4);

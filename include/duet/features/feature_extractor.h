@@ -19,7 +19,9 @@ using FeatureMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen
 
 class FeatureExtractor {
  public:
-  // Checks that every role the spec needs exists in the skeleton.
+  // Checks that every role the spec needs exists in the skeleton and that its legs have a length
+  // (the body's scale). The skeleton's lengths must be in metres (load_motion does that), though
+  // the features themselves do not depend on units or body size.
   static Result<FeatureExtractor> create(std::shared_ptr<const Skeleton> skeleton,
                                          const JointRoles& roles, const FeatureSpec& spec);
 
@@ -33,7 +35,7 @@ class FeatureExtractor {
     friend class FeatureExtractor;
     struct Sample {
       double time_s = 0.0;
-      Vec3 root = Vec3::Zero();
+      Vec3 pelvis = Vec3::Zero();
       double yaw = 0.0;
       std::array<Vec3, 4> effectors;  // left hand, right hand, left foot, right foot
     };
@@ -46,6 +48,8 @@ class FeatureExtractor {
   };
 
   Context make_context() const;
+  // The body's leg length (metres): the unit of the position and velocity features.
+  double leg_length_m() const { return leg_length_m_; }
   int dimension() const { return spec_.dimension(); }
   const FeatureSpec& spec() const { return spec_; }
 
@@ -61,9 +65,13 @@ class FeatureExtractor {
 
  private:
   FeatureExtractor() = default;
+  // A role's point in the canonical body (see BodySegment): the pelvis centre for kHips, the
+  // shoulder centre for kChest, else the role's joint.
+  Vec3 body_point(std::span<const Vec3> positions_ws, Role role) const noexcept;
+
   FeatureSpec spec_;
-  std::vector<int> posture_joints_;
-  int root_joint_ = 0;
+  JointRoles roles_;
+  double leg_length_m_ = 1.0;
   std::array<int, 4> effector_joints_{};
   std::shared_ptr<const Skeleton> skeleton_;
 };

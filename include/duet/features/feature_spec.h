@@ -1,8 +1,16 @@
 // What the feature vector phi_t holds (method.md 3, paper eq. 1-3), as weighted blocks:
 //   [ posture | root velocity | effector speed ]
-// posture: the log map (rotation vector) of each listed joint's local rotation; root velocity:
-// forward, lateral and vertical velocity in the body's heading frame (m/s) plus the yaw rate
-// (rad/s); effector speed: speeds of both hands and both feet (m/s).
+// computed in a canonical body space (issue 10), so the same dance gives the same features on any
+// rig: nothing depends on joint names, rest poses, joint-local axes, the number of bones between
+// two roles, units or body size.
+//   posture: the world direction of body segments between roles (unit vectors) and the positions
+//            of the hands and feet relative to the pelvis centre (in leg lengths), both in the
+//            body's heading frame (x left, y up, z forward);
+//   root velocity: forward, lateral and vertical velocity of the pelvis centre in the heading
+//            frame (leg lengths per second) plus the heading's yaw rate (rad/s);
+//   effector speed: speeds of both hands and both feet (leg lengths per second).
+// The heading comes from the hip joints' positions (duet::body_heading_yaw), the leg length from
+// the skeleton's bones (duet::measure_body).
 #pragma once
 
 #include <vector>
@@ -14,14 +22,27 @@ namespace duet {
 enum class FeatureBlock : int { kPosture, kRootVelocity, kEffectorSpeed, kCount };
 constexpr int kFeatureBlockCount = static_cast<int>(FeatureBlock::kCount);
 
+// A body segment from one role's point to another's. Two roles stand for canonical points rather
+// than their joints, whose place differs between rigs: kHips is the pelvis centre (midpoint of the
+// two thigh joints) and kChest the shoulder centre (midpoint of the two upper-arm joints).
+struct BodySegment {
+  Role from;
+  Role to;
+};
+
 struct FeatureSpec {
-  // Joints whose local rotation is a posture feature. The root is left out (its rotation is the
-  // body's place in the room); fingers, eyes and toes carry no CMU data.
-  std::vector<Role> posture_roles = {
-      Role::kSpine,         Role::kChest,      Role::kNeck,       Role::kHead,
-      Role::kLeftShoulder,  Role::kLeftElbow,  Role::kLeftWrist,  Role::kRightShoulder,
-      Role::kRightElbow,    Role::kRightWrist, Role::kLeftHip,    Role::kLeftKnee,
-      Role::kLeftAnkle,     Role::kRightHip,   Role::kRightKnee,  Role::kRightAnkle};
+  // Segments whose direction is a posture feature: the trunk, neck and head, the shoulder line
+  // (the chest's twist against the hips), and the four limbs' two long bones each.
+  std::vector<BodySegment> posture_segments = {
+      {Role::kHips, Role::kChest},
+      {Role::kRightShoulder, Role::kLeftShoulder},
+      {Role::kLeftShoulder, Role::kLeftElbow},   {Role::kLeftElbow, Role::kLeftWrist},
+      {Role::kRightShoulder, Role::kRightElbow}, {Role::kRightElbow, Role::kRightWrist},
+      {Role::kLeftHip, Role::kLeftKnee},         {Role::kLeftKnee, Role::kLeftAnkle},
+      {Role::kRightHip, Role::kRightKnee},       {Role::kRightKnee, Role::kRightAnkle}};
+  // Effectors whose position relative to the pelvis centre is a posture feature.
+  std::vector<Role> posture_points = {Role::kLeftWrist, Role::kRightWrist, Role::kLeftAnkle,
+                                      Role::kRightAnkle};
 
   // Block weights. After standardisation each block is also divided by sqrt(its dimension), so a
   // weight is the block's share of the squared distance whatever its size.
@@ -36,13 +57,17 @@ struct FeatureSpec {
   // The same window at every input rate keeps the features rate-independent.
   double velocity_window_s = 0.1;
 
-  // Floors on the template's standard deviation per dimension, so a joint that never moves in the
-  // template does not turn sensor noise into huge standardised distances.
-  double rotation_std_floor_rad = 0.05;
-  double speed_std_floor_mps = 0.05;
+  // Floors on the template's standard deviation per dimension, so a dimension that never moves in
+  // the template does not turn sensor noise into huge standardised distances. Posture: unit-vector
+  // components and leg lengths (0.05 is about 3 degrees, or 4-5 cm on an adult); speeds: leg
+  // lengths per second.
+  double posture_std_floor = 0.05;
+  double speed_std_floor = 0.05;
   double yaw_rate_std_floor_radps = 0.2;
 
-  int posture_dims() const { return 3 * static_cast<int>(posture_roles.size()); }
+  int posture_dims() const {
+    return 3 * static_cast<int>(posture_segments.size() + posture_points.size());
+  }
   static constexpr int kRootVelocityDims = 4;
   static constexpr int kEffectorSpeedDims = 4;
   int dimension() const { return posture_dims() + kRootVelocityDims + kEffectorSpeedDims; }

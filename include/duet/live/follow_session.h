@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "duet/base/result.h"
+#include "duet/features/posture_bias.h"
 #include "duet/follow/tracker.h"
 #include "duet/live/duet_library.h"
 
@@ -19,7 +20,8 @@ class FollowSession {
   static Result<FollowSession> create(const DuetLibrary& library,
                                       std::shared_ptr<const Skeleton> user_skeleton,
                                       const JointRoles& user_roles,
-                                      std::unique_ptr<Tracker> tracker);
+                                      std::unique_ptr<Tracker> tracker,
+                                      const PostureBiasParams& bias = {});
 
   // One input frame: local pose of the user's skeleton at time_s (seconds, increasing). The time
   // since the previous frame drives the tracker's rate handling. Allocates nothing.
@@ -27,18 +29,21 @@ class FollowSession {
                     double time_s) noexcept;
   void reset() noexcept;
 
+  // The standardised features of the last frame, after the rig's posture offset was removed.
   std::span<const float> last_features() const { return features_; }
+  const PostureBias& posture_bias() const { return bias_; }
   const Tracker& tracker() const { return *tracker_; }
 
  private:
   FollowSession(const DuetLibrary& library, FeatureExtractor extractor,
-                std::unique_ptr<Tracker> tracker);
+                std::unique_ptr<Tracker> tracker, const PostureBiasParams& bias);
 
   const DuetLibrary* library_;
   FeatureExtractor extractor_;
   FeatureExtractor::Context context_;
   std::unique_ptr<Tracker> tracker_;
   std::vector<float> features_;
+  PostureBias bias_;  // the user's rig's posture offset, learnt online
   double previous_time_s_ = 0.0;
   bool has_previous_ = false;
 };

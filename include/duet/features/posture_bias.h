@@ -1,0 +1,49 @@
+// Online removal of a rig's constant posture offset (issue 10).
+//
+// Two rigs never put their joints at quite the same places: the CMU ASF skeleton's shoulders are
+// 44 cm apart where the salsa BVH's are 23 cm, its head joint sits 4 cm higher, and a rig retargeted
+// by copying local rotations bends its arms differently to reach the same hands. In the canonical
+// body space those differences are a near-constant offset of the posture features, which on take
+// 01 delivered on the ASF rig was larger than the gap between frames 100 ms apart: the follower
+// read the same dance as another one. The offset is estimated online as a slow average of the
+// residual between the (corrected) input and the template frame the follower has confidently
+// matched, and subtracted from later inputs, like cepstral mean normalisation in speech. On the
+// library's own rig the residual averages to about zero, so nothing changes there.
+#pragma once
+
+#include <span>
+#include <vector>
+
+namespace duet {
+
+struct PostureBiasParams {
+  bool enabled = true;
+  double time_constant_s = 4.0;     // the average's time constant (seconds of confident frames)
+  double min_weight = 0.2;  // a frame's weight is the follower's confidence, at least this
+  float max_offset = 2.0f;          // per dimension, in standardised units (a runaway guard)
+};
+
+class PostureBias {
+ public:
+  PostureBias() = default;
+  // Dimensions [begin, begin + size) of the standardised feature vector are adapted.
+  PostureBias(int begin, int size, const PostureBiasParams& params);
+
+  // Subtracts the current offset from the posture dimensions. Allocates nothing.
+  void correct(std::span<float> features) const noexcept;
+  // Learns from one frame: `corrected` is what correct() returned, `matched` the template row the
+  // follower settled on, dt_s the time since the previous frame. Non-finite input is ignored.
+  void learn(std::span<const float> corrected, std::span<const float> matched, double dt_s,
+             float confidence) noexcept;
+  void reset() noexcept;
+
+  std::span<const float> offset() const noexcept { return offset_; }
+
+ private:
+  int begin_ = 0;
+  PostureBiasParams params_;
+  std::vector<float> offset_;
+  double learnt_s_ = 0.0;  // weighted seconds learnt since reset
+};
+
+}  // namespace duet
