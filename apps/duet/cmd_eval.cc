@@ -13,6 +13,7 @@
 #include "duet/eval/report.h"
 #include "duet/eval/runner.h"
 #include "duet/io/atomic_write.h"
+#include "eval_rigs.h"
 #include "library_options.h"
 #include "progress.h"
 
@@ -25,6 +26,7 @@ struct EvalArgs {
   std::vector<int> takes;
   std::vector<std::string> cases;
   std::vector<std::string> trackers;
+  std::vector<std::string> rigs = {"native"};
   std::uint64_t seed = 1;
   std::string csv_path;
   std::string plots_dir;
@@ -123,7 +125,12 @@ int write_plots(const EvalReport& report, const std::string& dir, const std::str
 
 int run_eval(EvalArgs& args) {
   // Everything that can be checked before loading the library.
-  const int pair_count = static_cast<int>(args.library.pair_files.size() / 2);
+  Result<LibrarySetup> setup = resolve_library(args.library);  // the pair count, from a file too
+  if (!setup) {
+    fmt::print(stderr, "duet {}: {}\n", kCommand, setup.error().message);
+    return kExitFailure;
+  }
+  const int pair_count = static_cast<int>(setup.value().pairs.size());
   args.settings.noise_position_m = args.noise_cm / 100.0;
   const std::vector<EvalCase> standard = standard_cases(args.settings);
   EvalOptions options;
@@ -225,6 +232,18 @@ int run_eval(EvalArgs& args) {
     }
   }
 
+  // Every case on every rig asked for (the library's own first).
+  std::string data_dir = args.library.data_dir;
+  if (data_dir.empty() && std::getenv("DUET_DATA_DIR") != nullptr) {
+    data_dir = std::getenv("DUET_DATA_DIR");
+  }
+  Result<std::vector<EvalRig>> rigs = load_eval_rigs(args.rigs, data_dir, *library);
+  if (!rigs) {
+    fmt::print(stderr, "duet eval: {}\n", rigs.error().message);
+    return kExitFailure;
+  }
+  options.cases = cases_on_rigs(options.cases, rigs.value());
+
   ProgressBar bar("evaluating");
   Result<EvalReport> report = run_evaluation(
       *library, partner, options,
@@ -277,6 +296,13 @@ Command register_eval(CLI::App& app) {
   app.add_option("--takes", args->takes,
                  "Takes to perform from, as indices of the --pair list, e.g. 0,2 (default: the "
                  "first, middle and last)")
+      ->delimiter(',');
+  app.add_option("--rigs", args->rigs,
+                 "Rigs to deliver every case on, comma-separated (default native): native (the "
+                 "library's), proportioned (our own: other proportions and rest pose), asf "
+                 "(cmu-salsa 60.asf), handshake (cmu-handshake 18_01.bvh), bandai (a third-party "
+                 "rig), all, or a motion file whose skeleton to use. A case on another rig is "
+                 "reported as CASE@RIG: the same performance, retargeted (docs/retarget.md)")
       ->delimiter(',');
   app.add_option("--cases", args->cases,
                  "Cases to run, comma-separated (default all): clean, tempo-slow, tempo-fast "

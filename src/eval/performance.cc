@@ -6,6 +6,7 @@
 #include <random>
 
 #include "duet/math/rotation.h"
+#include "duet/motion/retarget.h"
 
 namespace duet {
 
@@ -411,6 +412,15 @@ Performance with_room_placement(Performance performance, double yaw_rad, const V
   return performance;
 }
 
+Result<Performance> with_rig(Performance performance, std::shared_ptr<const Skeleton> rig,
+                             const JointRoles& rig_roles) {
+  Result<Clip> moved = retarget_clip(performance.motion, performance.roles, rig, rig_roles);
+  if (!moved) return Error{"onto the rig " + rig_roles.convention + ": " + moved.error().message};
+  performance.motion = std::move(moved).value();
+  performance.roles = rig_roles;
+  return performance;
+}
+
 Result<Performance> make_performance(std::span<const SourceTake> sources,
                                      const PerformanceRecipe& recipe, std::uint64_t seed) {
   if (sources.empty() || sources[0].clip == nullptr) return Error{"no take to perform from"};
@@ -432,6 +442,11 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
   if (recipe.room_yaw_rad != 0.0 || !recipe.room_offset_m.isZero()) {
     performance =
         with_room_placement(std::move(performance), recipe.room_yaw_rad, recipe.room_offset_m);
+  }
+  if (recipe.rig) {
+    Result<Performance> moved = with_rig(std::move(performance), recipe.rig, recipe.rig_roles);
+    if (!moved) return moved.error();
+    performance = std::move(moved).value();
   }
   if (recipe.noise.active()) {
     SensorNoiseOptions options = recipe.noise;

@@ -90,6 +90,26 @@ std::vector<EvalCase> standard_cases(const CaseSettings& settings) {
   return cases;
 }
 
+std::vector<EvalCase> cases_on_rigs(const std::vector<EvalCase>& cases,
+                                    const std::vector<EvalRig>& rigs) {
+  std::vector<EvalCase> out;
+  for (const EvalRig& rig : rigs) {
+    for (const EvalCase& base : cases) {
+      EvalCase c = base;
+      if (rig.skeleton) {
+        c.name = base.name + "@" + rig.name;
+        c.seed_name = base.seed_key();
+        c.description = base.description + ", on the " + rig.name + " rig";
+        c.recipe.rig = rig.skeleton;
+        c.recipe.rig_roles = rig.roles;
+        c.recipe.rig_name = rig.name;
+      }
+      out.push_back(std::move(c));
+    }
+  }
+  return out;
+}
+
 namespace {
 
 struct KindName {
@@ -183,7 +203,7 @@ Result<NaiveCheck> run_naive_check(const DuetLibrary& library, const EvalCase& e
   const std::vector<SourceTake> sources = sources_for(library, take, false);
   Result<Performance> made = make_performance(
       sources, eval_case.recipe,
-      derive_seed(options.seed, name_hash(eval_case.name), static_cast<std::uint64_t>(take)));
+      derive_seed(options.seed, name_hash(eval_case.seed_key()), static_cast<std::uint64_t>(take)));
   if (!made) return made.error();
   const Performance& performance = made.value();
 
@@ -360,7 +380,7 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
       const std::vector<SourceTake> sources = sources_for(lib, take, eval_case.across_takes);
       Result<Performance> made = make_performance(
           sources, eval_case.recipe,
-          derive_seed(options.seed, name_hash(eval_case.name), static_cast<std::uint64_t>(take)));
+          derive_seed(options.seed, name_hash(eval_case.seed_key()), static_cast<std::uint64_t>(take)));
       if (!made) return Error{"case " + eval_case.name + ": " + made.error().message};
       const Performance& performance = made.value();
       for (std::size_t k = 0; k < trackers.size(); ++k) {

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -140,8 +141,15 @@ Performance with_body_scale(Performance performance, double factor);
 // through the world origin, then moved by offset_m.
 Performance with_room_placement(Performance performance, double yaw_rad, const Vec3& offset_m);
 
+// The same performance danced on another rig (a user's suit, avatar or another studio's skeleton):
+// retargeted (duet::retarget_clip: role directions, stride-scaled root, feet on the floor) onto
+// `rig`, a skeleton in metres whose roles are `rig_roles`. Times and truth are kept. Errors: roles
+// the retargeting cannot use.
+Result<Performance> with_rig(Performance performance, std::shared_ptr<const Skeleton> rig,
+                             const JointRoles& rig_roles);
+
 // A composition of the above, applied in this order: play or improvise (at rate_hz), body scale,
-// room placement, sensor noise, frame loss. Each stage's seed is derived from `seed`.
+// room placement, another rig, sensor noise, frame loss. Each stage's seed is derived from `seed`.
 struct PerformanceRecipe {
   bool improvise = false;
   PlayOptions play;                    // when !improvise (seed ignored)
@@ -149,6 +157,9 @@ struct PerformanceRecipe {
   double body_scale = 1.0;
   double room_yaw_rad = 0.0;
   Vec3 room_offset_m = Vec3::Zero();
+  std::shared_ptr<const Skeleton> rig;  // null: the library's own rig
+  JointRoles rig_roles;
+  std::string rig_name;                 // for reports ("asf", "bandai", ...)
   SensorNoiseOptions noise;  // seed ignored
   FrameLossOptions loss;     // seed ignored
 };

@@ -30,7 +30,21 @@ struct EvalCase {
   PerformanceRecipe recipe;
   bool partner_role = false;  // the user dances the partner: the library is built with role=partner
   bool across_takes = false;  // improvisation draws segments from every take of the library
+  // The name its random choices are seeded from (empty: `name`). A case delivered on another rig
+  // ("improv@asf") keeps its base case's, so both rigs dance the very same performance.
+  std::string seed_name;
+  const std::string& seed_key() const { return seed_name.empty() ? name : seed_name; }
 };
+
+// Every case delivered on every rig: the library's own rig keeps the case as it is (rig null);
+// another rig gives "<case>@<rig name>" with the rig in its recipe.
+struct EvalRig {
+  std::string name;                         // "native", "asf", "bandai", ...
+  std::shared_ptr<const Skeleton> skeleton;  // metres; null = the library's own rig
+  JointRoles roles;
+};
+std::vector<EvalCase> cases_on_rigs(const std::vector<EvalCase>& cases,
+                                    const std::vector<EvalRig>& rigs);
 
 // Magnitudes shared by the standard cases, so a run can make them harsher or gentler.
 struct CaseSettings {
