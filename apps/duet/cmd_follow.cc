@@ -6,7 +6,11 @@
 #include "commands.h"
 #include "duet/io/atomic_write.h"
 #include "duet/io/bvh.h"
+#include "duet/io/motion_argument.h"
+#include "duet/live/follow_session.h"
 #include "duet/live/live_loop.h"
+#include "duet/motion/retarget.h"
+#include "lost_diagnosis.h"
 #include "library_options.h"
 #include "motion_options.h"
 #include "partner_options.h"
@@ -28,7 +32,51 @@ struct FollowArgs {
   std::string output_path;
   std::string user_output_path;
   std::string truth_path;
+  std::string partner_rig;  // a motion word whose skeleton the partner is written on
+  MotionFileOptions partner_rig_motion;
+  bool allow_lost = false;
 };
+
+// The partner's motion on another skeleton (--partner-rig): retargeted and written in that rig
+// file's units, so the user's own avatar can play it.
+Status write_partner_on_rig(const FollowArgs& args, const Clip& partner,
+                            const JointRoles& partner_roles) {
+  Result<std::vector<std::string>> paths = split_motion_argument(args.partner_rig);
+  if (!paths) return Error{"--partner-rig: " + paths.error().message};
+  MotionLoadOptions options;
+  if (!make_load_options(args.partner_rig_motion, options)) {
+    return Error{"--partner-rig: bad skeleton map"};
+  }
+  Result<LoadedMotion> rig = load_motion(paths.value(), options);
+  if (!rig) return Error{"--partner-rig: " + rig.error().message};
+  Result<Clip> moved = retarget_clip(partner, partner_roles, rig.value().clip.skeleton_ptr(),
+                                     rig.value().roles, {}, "the partner", args.partner_rig);
+  if (!moved) return Error{"--partner-rig: " + moved.error().message};
+  return write_bvh(moved.value(), args.output_path,
+                   BvhWriteOptions::in_file_units(rig.value().metres_per_unit));
+}
+
+// The share of lost frames when the input is followed as the other dancer (at most the first
+// minute): tells a swapped role or pair order from input that is no part of the dance.
+std::optional<double> lost_as_other_role(const FollowArgs& args, const Clip& user,
+                                         const JointRoles& roles) {
+  LibraryArgs other = args.library;
+  other.role = other.role == "partner" ? "leader" : "partner";
+  std::optional<DuetLibrary> library = load_library(other, "follow");
+  if (!library) return std::nullopt;
+  Result<std::unique_ptr<Tracker>> tracker = make_tracker(args.tracker, library->model());
+  if (!tracker) return std::nullopt;
+  Result<FollowSession> session =
+      FollowSession::create(*library, user.skeleton_ptr(), roles, std::move(tracker).value());
+  if (!session) return std::nullopt;
+  const int frames = std::min(user.frame_count(), static_cast<int>(60.0 * user.frame_rate()));
+  int lost = 0;
+  for (int f = 0; f < frames; ++f) {
+    lost += session.value().step(user.translations_ls(f), user.rotations_ls(f),
+                                 f / user.frame_rate()).lost ? 1 : 0;
+  }
+  return frames > 0 ? static_cast<double>(lost) / frames : 0.0;
+}
 
 // The BVH files are written in the units of the files they come from (the partner in the
 // response takes', the user in the input's), so every duet command reads them back at the same
@@ -39,7 +87,7 @@ Status write_outputs(const FollowArgs& args, const std::string& trace, const Cli
   if (!args.trace_path.empty()) {
     if (Status s = write_file_atomically(args.trace_path, trace); !s) return s;
   }
-  if (!args.output_path.empty()) {
+  if (!args.output_path.empty() && args.partner_rig.empty()) {
     const BvhWriteOptions units = BvhWriteOptions::in_file_units(partner_metres_per_unit);
     if (Status s = write_bvh(partner, args.output_path, units); !s) return s;
   }
@@ -67,7 +115,12 @@ int run_follow(const FollowArgs& args) {
 
   MotionLoadOptions load_options;
   if (!make_load_options(args.input_motion, load_options)) return kExitFailure;
-  Result<LoadedMotion> input = load_motion({args.input}, load_options);
+  Result<std::vector<std::string>> input_paths = split_motion_argument(args.input);
+  if (!input_paths) {
+    fmt::print(stderr, "duet follow: --input: {}\n", input_paths.error().message);
+    return kExitUsage;
+  }
+  Result<LoadedMotion> input = load_motion(input_paths.value(), load_options);
   if (!input) {
     fmt::print(stderr, "duet follow: {}\n", input.error().message);
     return kExitFailure;
@@ -124,18 +177,41 @@ int run_follow(const FollowArgs& args) {
     fmt::print(stderr, "duet follow: {}\n", s.error().message);
     return kExitFailure;
   }
-  int jumps = 0, lost = 0;
-  for (const FollowResult& r : results) {
-    jumps += r.jumped ? 1 : 0;
-    lost += r.lost ? 1 : 0;
+  if (!args.partner_rig.empty() && !args.output_path.empty()) {
+    if (Status s = write_partner_on_rig(args, partner, library->takes()[0].response_motion.roles);
+        !s) {
+      fmt::print(stderr, "duet follow: {}\n", s.error().message);
+      return kExitFailure;
+    }
   }
+  const LostSummary summary = summarise_lost(results);
   fmt::print(
       "followed {} frames ({:.1f} s) against {} take(s), {} states: {} jumps, {} lost "
       "frames; corrections: {}\n",
       user.frame_count(), user.duration(), library->takes().size(), library->model().num_states(),
-      jumps, lost, corrections_string(loop.value().params()));
+      summary.jumps, summary.lost, corrections_string(loop.value().params()));
   if (truth) print_accuracy_summary(*truth, results, library->frame_rate());
-  return kExitOk;
+  if (summary.lost_fraction() <= kMostlyLostFraction) return kExitOk;
+
+  // Most of the input was lost: say why it may be, and fail unless that was the point.
+  LostContext context;
+  context.input = &input.value();
+  context.input_rate_hz = user.frame_rate();
+  context.library_rate_hz = library->frame_rate();
+  parse_dancer_role(args.library.role, context.role);
+  std::vector<float> tempos;
+  for (const FollowResult& r : results) tempos.push_back(r.tempo);
+  std::ranges::nth_element(tempos, tempos.begin() + static_cast<std::ptrdiff_t>(tempos.size() / 2));
+  context.median_tempo = tempos[tempos.size() / 2];
+  context.other_role_lost_fraction = lost_as_other_role(args, user, input.value().roles);
+  fmt::print(stderr, "duet follow: {:.0f}% of the input's frames are lost (no part of the library "
+             "explains them). Likely causes:\n", 100.0 * summary.lost_fraction());
+  for (const std::string& cause : diagnose_lost(summary, context)) {
+    fmt::print(stderr, "  - {}\n", cause);
+  }
+  if (args.allow_lost) return kExitOk;
+  fmt::print(stderr, "duet follow: exit {} (mostly lost; --allow-lost keeps exit 0)\n", kExitLost);
+  return kExitLost;
 }
 
 }  // namespace
@@ -143,9 +219,10 @@ int run_follow(const FollowArgs& args) {
 Command register_follow(CLI::App& app) {
   auto args = std::make_shared<FollowArgs>();
   add_library_options(app, args->library);
-  app.add_option("--input", args->input, "The user's motion (BVH)")
-      ->required()
-      ->check(CLI::ExistingFile);
+  app.add_option("--input", args->input,
+                 "The user's motion: a BVH file, or SKELETON.asf+MOTION.amc; any rig whose body "
+                 "roles are found (duet inspect shows them)")
+      ->required();
   add_motion_file_options(app, args->input_motion, "input-");
   add_tracker_options(app, args->tracker);
   add_partner_options(app, args->partner);
@@ -158,6 +235,15 @@ Command register_follow(CLI::App& app) {
   app.add_option("--user-output", args->user_output_path,
                  "Also write the user's motion (BVH in the input's units), sharing the partner "
                  "file's world frame (open both together to see the duet)");
+  app.add_option("--partner-rig", args->partner_rig,
+                 "Write the partner (-o) on this skeleton instead of the library's, e.g. your own "
+                 "avatar's BVH (or SKELETON.asf+MOTION.amc): retargeted by role directions with the "
+                 "feet on the floor, in that file's units (docs/retarget.md)")
+      ->needs("--output");
+  add_motion_file_options(app, args->partner_rig_motion, "partner-rig-");
+  app.add_flag("--allow-lost", args->allow_lost,
+               "Exit 0 even when over half the input's frames are lost (by default duet follow "
+               "then lists the likely causes and exits 3)");
   app.add_option("--truth", args->truth_path,
                  "Ground truth CSV from `duet improvise`: print the follower's accuracy")
       ->check(CLI::ExistingFile);

@@ -10,6 +10,7 @@ namespace duet::app {
 constexpr int kExitOk = 0;
 constexpr int kExitFailure = 1;  // bad input file, failed write, ...
 constexpr int kExitUsage = 2;    // bad command line
+constexpr int kExitLost = 3;     // duet follow: over half the input's frames were lost
 
 using Command = std::function<int()>;
 

@@ -14,11 +14,10 @@ void add_motion_file_options(CLI::App& app, MotionFileOptions& options, const st
                  "1/0.768, CMU 0.056444; otherwise guessed from the body's height: m, cm, mm, "
                  "inches or CMU units)")
       ->check(CLI::PositiveNumber);
-  if (prefix.empty()) {
-    app.add_option("--map", options.map_path,
-                   "Skeleton map JSON naming the joint of each role (see docs/skeleton-maps.md)")
-        ->check(CLI::ExistingFile);
-  }
+  app.add_option("--" + prefix + "map", options.map_path,
+                 "Skeleton map JSON naming the joint of each role, instead of detecting the roles "
+                 "(see docs/skeleton-maps.md)")
+      ->check(CLI::ExistingFile);
 }
 
 bool make_load_options(const MotionFileOptions& options, MotionLoadOptions& load_options) {

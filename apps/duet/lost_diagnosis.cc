@@ -1,0 +1,74 @@
+#include "lost_diagnosis.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace duet::app {
+
+LostSummary summarise_lost(std::span<const FollowResult> results) {
+  LostSummary summary;
+  for (const FollowResult& r : results) {
+    ++summary.frames;
+    summary.lost += r.lost ? 1 : 0;
+    summary.jumps += r.jumped ? 1 : 0;
+  }
+  return summary;
+}
+
+std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostContext& context) {
+  std::vector<std::string> causes;
+  // The role: the same input followed as the other dancer.
+  if (context.other_role_lost_fraction &&
+      *context.other_role_lost_fraction < 0.5 * summary.lost_fraction()) {
+    const DancerRole other =
+        context.role == DancerRole::kLeader ? DancerRole::kPartner : DancerRole::kLeader;
+    causes.push_back(fmt::format(
+        "role: followed as the {} instead, {:.0f}% of frames are lost (against {:.0f}%): the input "
+        "dances the {}'s part — pass --role {}, or check the order of each --pair (LEADER then "
+        "PARTNER)",
+        dancer_role_name(other), 100.0 * *context.other_role_lost_fraction,
+        100.0 * summary.lost_fraction(), dancer_role_name(other), dancer_role_name(other)));
+  }
+  // The rate: the follower's tempo far from 1 means the input's clock runs at another speed.
+  if (context.median_tempo > 1.5f || context.median_tempo < 0.66f) {
+    const double rate = context.input_rate_hz * context.median_tempo;
+    causes.push_back(fmt::format(
+        "rate: the input was read at {:g} fps but moves {:.2f}x as fast as the library ({:g} fps); "
+        "if its header is wrong, pass --input-fps {:.0f}",
+        context.input_rate_hz, context.median_tempo, context.library_rate_hz, rate));
+  }
+  if (context.input != nullptr) {
+    const LoadedMotion& input = *context.input;
+    // The units: an implausible body height.
+    const double height = input.body.standing_height_m;
+    if (!input.units_warning.empty() || (input.body.valid() && (height < 1.2 || height > 2.2))) {
+      causes.push_back(fmt::format(
+          "units: the dancer is {:.2f} m tall at {} ({}){}; pass --input-scale with the file's "
+          "metres per unit",
+          height, input.units_name.empty() ? fmt::format("{:g} m per unit", input.metres_per_unit)
+                                            : input.units_name,
+          input.units_source, input.units_warning.empty() ? "" : " — " + input.units_warning));
+    }
+    // The rig: roles found without a known convention may be wrong.
+    if (input.roles.convention == "names" || input.roles.convention == "hierarchy") {
+      causes.push_back(fmt::format(
+          "rig: the body roles of {} were found from its joint {} — check them with `duet "
+          "inspect {}` and give a skeleton map with --input-map if one is wrong",
+          input.description, input.roles.convention == "names" ? "names" : "hierarchy",
+          input.description));
+    }
+  }
+  if (std::abs(context.input_rate_hz - context.library_rate_hz) > 1e-6 &&
+      std::abs(context.median_tempo - 1.0f) <= 0.5f) {
+    causes.push_back(fmt::format(
+        "rate: the input runs at {:g} fps and the library at {:g} fps (fine if both are right)",
+        context.input_rate_hz, context.library_rate_hz));
+  }
+  causes.push_back(
+      "dance: the input may not be any part of the library's dance (another dance, a walk, a "
+      "wave: then lost is the right answer; pass --allow-lost to keep exit 0)");
+  return causes;
+}
+
+}  // namespace duet::app
