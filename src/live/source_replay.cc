@@ -104,6 +104,7 @@ bool ReplaySource::seek(double position_s, SteadyClock::time_point now) noexcept
       static_cast<int>(std::lround(std::clamp(position_s * clip().frame_rate(), -1.0,
                                               static_cast<double>(clip().frame_count())))),
       0, clip().frame_count() - 1);
+  last_frame_ = target;  // where the viewer is now, before the frame comes
   if (paused_) {
     // The clock of the next frame stays; the frame comes at once, as a preview.
     segment_first_ = target;

@@ -15,6 +15,7 @@
 #include "duet/io/motion_file.h"
 #include "duet/live/source_neuron.h"
 #include "duet/live/source_pose.h"
+#include "duet/live/source_replay.h"
 #include "duet/net/neuron_receiver.h"
 #include "duet/net/thread_priority.h"
 
@@ -87,6 +88,7 @@ struct LiveServer::Impl {
     }
     neuron = dynamic_cast<NeuronSource*>(source.get());
     pose = dynamic_cast<PoseSource*>(source.get());
+    replay = dynamic_cast<ReplaySource*>(source.get());
     frame.resize(source->source_skeleton().joint_count());
     hello = std::make_shared<const std::string>(make_hello(*loop, source->describe()));
   }
@@ -289,7 +291,30 @@ struct LiveServer::Impl {
         }
         drain();
         return;
+      case ClientMessage::Type::kReplay:
+        control_replay(id);
+        return;
     }
+  }
+
+  // Pause, seek, speed of a file replay; every client sees the new state.
+  void control_replay(ClientId id) {
+    if (replay == nullptr) {
+      reject(id, "replay messages need a file replay (duet serve --source replay:FILE)");
+      return;
+    }
+    const auto now = SteadyClock::now();
+    if (message.replay_speed) replay->set_speed(*message.replay_speed, now);
+    if (message.replay_seek_s) replay->seek(*message.replay_seek_s, now);
+    if (message.replay_paused) replay->set_paused(*message.replay_paused, now);
+    source_end_reported = false;  // a seek may bring a finished replay back
+    drain();  // a seek while paused delivers its frame now
+    broadcast_replay_state();
+  }
+
+  void broadcast_replay_state() {
+    if (replay)
+      server.broadcast(std::make_shared<const std::string>(make_replay_state(replay->state())));
   }
 
   // ---- Role switching ----
@@ -387,6 +412,7 @@ struct LiveServer::Impl {
       s.record_lost = recorder->frames_lost();
     }
     server.broadcast(std::make_shared<const std::string>(make_stats(s)));
+    broadcast_replay_state();  // clients that connected since the last change learn it here
     send.clear();
     loop_window.clear();
     last_stats = now;
@@ -415,6 +441,7 @@ struct LiveServer::Impl {
   std::unique_ptr<FrameSource> source;
   NeuronSource* neuron = nullptr;
   PoseSource* pose = nullptr;
+  ReplaySource* replay = nullptr;
   std::unique_ptr<LiveLoop> loop;
   LoopFactory factory;
 

@@ -265,6 +265,16 @@ std::string make_error(std::string_view reason) {
       -1, ' ', false, json::error_handler_t::replace);
 }
 
+std::string make_replay_state(const ReplayState& state) {
+  const json message = {{"type", "replay_state"},
+                        {"paused", state.paused},
+                        {"speed", state.speed},
+                        {"position_s", std::round(state.position_s * 1000.0) / 1000.0},
+                        {"duration_s", std::round(state.duration_s * 1000.0) / 1000.0},
+                        {"loop", state.loop}};
+  return message.dump();
+}
+
 std::optional<std::string> parse_client_message(std::string_view text, ClientMessage& message) {
   if (text.size() > kMaxClientMessageBytes) return "message larger than 1 MiB";
   // Checked before parsing, so no message costs the loop's thread more than a fraction of a
@@ -341,7 +351,34 @@ std::optional<std::string> parse_client_message(std::string_view text, ClientMes
     }
     return std::nullopt;
   }
-  return "unknown message type '" + type.substr(0, 64) + "' (set, role, reset, pose)";
+  if (type == "replay") {
+    message.type = ClientMessage::Type::kReplay;
+    message.replay_paused.reset();
+    message.replay_seek_s.reset();
+    message.replay_speed.reset();
+    if (const auto paused = doc.find("paused"); paused != doc.end()) {
+      if (!paused->is_boolean()) return "replay: \"paused\" must be true or false";
+      message.replay_paused = paused->get<bool>();
+    }
+    if (const auto seek = doc.find("seek_s"); seek != doc.end()) {
+      double value = 0.0;
+      if (!get_number(*seek, value)) return "replay: \"seek_s\" must be a finite number";
+      message.replay_seek_s = value;
+    }
+    if (const auto speed = doc.find("speed"); speed != doc.end()) {
+      double value = 0.0;
+      if (!get_number(*speed, value) || value < kReplayMinSpeed || value > kReplayMaxSpeed) {
+        return fmt::format("replay: \"speed\" must be a number from {:g} to {:g}", kReplayMinSpeed,
+                           kReplayMaxSpeed);
+      }
+      message.replay_speed = value;
+    }
+    if (!message.replay_paused && !message.replay_seek_s && !message.replay_speed) {
+      return "replay: needs \"paused\", \"seek_s\" or \"speed\"";
+    }
+    return std::nullopt;
+  }
+  return "unknown message type '" + type.substr(0, 64) + "' (set, role, reset, pose, replay)";
 }
 
 }  // namespace duet::net

@@ -28,7 +28,7 @@ constexpr double kReplayMaxSpeed = 4.0;
 struct ReplayState {
   bool paused = false;
   double speed = 1.0;
-  double position_s = 0.0;  // file time of the frame delivered last (of the next before any)
+  double position_s = 0.0;  // file time of the frame delivered last or sought (else the next)
   double duration_s = 0.0;  // of the file: frame count / frame rate
   bool loop = false;
 };
@@ -88,7 +88,7 @@ class ReplaySource final : public FrameSource {
   long long segment_first_ = 0;
   double segment_clock_s_ = 0.0;
   long long next_ = 0;   // frames of the segment delivered or skipped
-  int last_frame_ = -1;  // file frame delivered last
+  int last_frame_ = -1;  // file frame delivered last, or a seek's target
   SourceStats stats_;
 };
 

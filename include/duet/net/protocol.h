@@ -11,6 +11,7 @@
 
 #include "duet/live/live_loop.h"
 #include "duet/live/source_frame.h"
+#include "duet/live/source_replay.h"
 
 namespace duet::net {
 
@@ -55,9 +56,12 @@ std::string make_stats(const StatsSnapshot& stats);
 
 std::string make_error(std::string_view reason);
 
+// `replay_state`: where a file replay is, sent after each `replay` control and once a second.
+std::string make_replay_state(const ReplayState& state);
+
 // What a client asked for.
 struct ClientMessage {
-  enum class Type { kSet, kRole, kReset, kPose };
+  enum class Type { kSet, kRole, kReset, kPose, kReplay };
   Type type = Type::kReset;
   // set
   std::string correction;
@@ -68,6 +72,10 @@ struct ClientMessage {
   double time_s = 0.0;  // NaN when absent
   Vec3 root = Vec3::Zero();
   std::vector<double> rotations;  // w, x, y, z per joint
+  // replay: each absent field leaves that setting alone (at least one is present)
+  std::optional<bool> replay_paused;
+  std::optional<double> replay_seek_s;
+  std::optional<double> replay_speed;
 };
 
 // Parses one client text message. Returns nullopt on success, else the reason for the `error`
