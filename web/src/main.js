@@ -14,8 +14,41 @@ const kCorrections = ['align', 'contact', 'smooth', 'footlock', 'blend'];
 const kPendingToggle_s = 1.5; // how long a clicked switch waits for the server to confirm it
 const kOrbitFollowHalfLife_s = 0.4; // the orbit target trails the couple's midpoint
 const kFirstPersonFov = 70;
+const kSeekInterval_ms = 100; // while dragging the replay slider, at most this often a seek
 
 const params = new URLSearchParams(location.search);
+
+/** A floor grid of `size` metres with `divisions` cells a side, lines along X and along Z.
+ *  Unlike THREE.GridHelper, every line is cut into one segment per cell: a line that runs from
+ *  behind the camera to the horizon was dropped whole by some WebGL implementations (SwiftShader
+ *  showed the lines along one axis only); short segments are clipped one by one. */
+function makeFloorGrid(size, divisions, centreColor, lineColor) {
+  const step = size / divisions;
+  const half = size / 2;
+  const positions = [];
+  const colors = [];
+  const centre = new THREE.Color(centreColor);
+  const line = new THREE.Color(lineColor);
+  const counts = { alongX: 0, alongZ: 0 };
+  for (let i = 0; i <= divisions; ++i) {
+    const k = -half + i * step;
+    const color = i === divisions / 2 ? centre : line;
+    for (let c = 0; c < divisions; ++c) {
+      const a = -half + c * step;
+      positions.push(a, 0, k, a + step, 0, k); // along X at z = k
+      positions.push(k, 0, a, k, 0, a + step); // along Z at x = k
+      for (let v = 0; v < 4; ++v) colors.push(color.r, color.g, color.b);
+      counts.alongX += 1;
+      counts.alongZ += 1;
+    }
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.Float32BufferAttribute(positions, 3));
+  geometry.setAttribute('color', new THREE.Float32BufferAttribute(colors, 3));
+  const grid = new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ vertexColors: true, toneMapped: false }));
+  grid.userData.segments = counts;
+  return grid;
+}
 
 async function main() {
   // The emulated headset must be navigator.xr before three.js looks for one.
@@ -39,6 +72,11 @@ async function main() {
     view: el('view'),
     vr: el('vr'),
     toggles: Object.fromEntries(kCorrections.map((c) => [c, el(`corr-${c}`)])),
+    replay: el('replay'),
+    replayPlay: el('replay-play'),
+    replaySeek: el('replay-seek'),
+    replayTime: el('replay-time'),
+    replaySpeed: el('replay-speed'),
   };
 
   // --- Scene -------------------------------------------------------------------------------
@@ -54,7 +92,7 @@ async function main() {
   const sun = new THREE.DirectionalLight(0xffffff, 1.6);
   sun.position.set(3, 6, 2);
   scene.add(sun);
-  const grid = new THREE.GridHelper(20, 40, 0x5a6070, 0x2c3038);
+  const grid = makeFloorGrid(20, 40, 0x5a6070, 0x2c3038);
   scene.add(grid);
 
   // The camera hangs from a rig: identity on the desktop, at the user's head in VR.
@@ -103,6 +141,9 @@ async function main() {
     pending: {}, // correction -> {enabled, until_ms} after a click
   };
   const rates = { renders: 0, frames: 0, since_ms: performance.now(), fps: 0, frameRate: 0 };
+  // A file replay's state from `replay_state` (null: the source is not a replay), when it came,
+  // and the slider while the user drags it.
+  const replay = { state: null, received_ms: 0, dragging: false, last_seek_ms: 0, states: 0 };
 
   function otherRole(role) {
     return role === 'partner' ? 'leader' : 'partner';
@@ -154,7 +195,7 @@ async function main() {
     }
     state.lastFrame = msg;
     state.pendingFrame = msg;
-    timeline.push(msg.follower);
+    if (!state.frozen) timeline.push(msg.follower); // frozen: the timeline holds still too
     reflectCorrections(msg.corrections);
   }
 
@@ -188,9 +229,65 @@ async function main() {
       case 'error':
         showError(`server: ${msg.reason ?? 'error'}`);
         break;
+      case 'replay_state':
+        onReplayState(msg);
+        break;
       default:
         break; // newer servers may send more; ignore what we do not know
     }
+  }
+
+  // --- Replay (pause, seek, speed of a file the server plays) ---------------------------------
+  function onReplayState(msg) {
+    const duration = Number(msg.duration_s);
+    if (!(duration > 0)) return;
+    replay.state = {
+      paused: !!msg.paused,
+      speed: Number(msg.speed) || 1,
+      position_s: Number(msg.position_s) || 0,
+      duration_s: duration,
+      loop: !!msg.loop,
+    };
+    replay.received_ms = performance.now();
+    replay.states += 1;
+    ui.replay.hidden = false;
+    ui.replaySeek.max = String(duration);
+    const speed = String(replay.state.speed);
+    if (![...ui.replaySpeed.options].some((o) => o.value === speed)) {
+      ui.replaySpeed.add(new Option(`${speed}x`, speed)); // a speed from the command line
+    }
+    ui.replaySpeed.value = speed;
+    ui.replayPlay.textContent = replay.state.paused ? 'Play' : 'Pause';
+    updateReplayPosition();
+  }
+
+  /** Where the file is now: the last state moved on by the time since, at its speed. */
+  function replayPosition() {
+    const s = replay.state;
+    if (!s) return 0;
+    let p = s.position_s;
+    if (!s.paused) p += ((performance.now() - replay.received_ms) / 1000) * s.speed;
+    return s.loop ? p % s.duration_s : Math.min(p, s.duration_s);
+  }
+
+  function updateReplayPosition() {
+    if (!replay.state) return;
+    const p = replay.dragging ? Number(ui.replaySeek.value) : replayPosition();
+    if (!replay.dragging) ui.replaySeek.value = String(p);
+    ui.replayTime.textContent = `${p.toFixed(1)} / ${replay.state.duration_s.toFixed(1)} s`;
+  }
+
+  /** Sends a `replay` control and shows its effect at once; the server's replay_state confirms. */
+  function sendReplay(fields) {
+    if (!replay.state || !connection.send({ type: 'replay', ...fields })) return false;
+    const s = replay.state;
+    s.position_s = replayPosition();
+    replay.received_ms = performance.now();
+    if ('paused' in fields) s.paused = fields.paused;
+    if ('speed' in fields) s.speed = fields.speed;
+    if ('seek_s' in fields) s.position_s = fields.seek_s;
+    ui.replayPlay.textContent = s.paused ? 'Play' : 'Pause';
+    return true;
   }
 
   const connection = new Connection(defaultSocketUrl(location), {
@@ -198,6 +295,9 @@ async function main() {
     onOpen: () => updateStatus(),
     onClose: () => {
       for (const input of [ui.role, ui.reset, ...Object.values(ui.toggles)]) input.disabled = true;
+      // The next server may not play a file; its replay_state shows the controls again.
+      replay.state = null;
+      ui.replay.hidden = true;
       updateStatus();
     },
     onBadMessage: (_text, reason) => showError(`bad message: ${reason}`),
@@ -226,6 +326,30 @@ async function main() {
     state.role = role;
     applyRoleColors();
     timeline.clear();
+  });
+
+  ui.replayPlay.addEventListener('click', () => {
+    if (replay.state) sendReplay({ paused: !replay.state.paused });
+  });
+  ui.replaySeek.addEventListener('input', () => {
+    // Scrubbing: seek while dragging, but not on every pixel.
+    replay.dragging = true;
+    const now = performance.now();
+    if (now - replay.last_seek_ms >= kSeekInterval_ms) {
+      replay.last_seek_ms = now;
+      sendReplay({ seek_s: Number(ui.replaySeek.value) });
+    }
+    updateReplayPosition();
+  });
+  ui.replaySeek.addEventListener('change', () => {
+    replay.dragging = false;
+    replay.last_seek_ms = performance.now();
+    sendReplay({ seek_s: Number(ui.replaySeek.value) });
+    updateReplayPosition();
+  });
+  ui.replaySpeed.addEventListener('change', () => {
+    const speed = Number(ui.replaySpeed.value);
+    if (!sendReplay({ speed })) ui.replaySpeed.value = String(replay.state?.speed ?? 1);
   });
 
   ui.reset.addEventListener('click', () => {
@@ -402,7 +526,10 @@ async function main() {
     renderer.render(scene, camera);
     state.renderCount += 1;
     rates.renders += 1;
-    if (!renderer.xr.isPresenting) timeline.draw();
+    if (!renderer.xr.isPresenting) {
+      timeline.draw();
+      updateReplayPosition();
+    }
     if (now - rates.since_ms >= 1000) {
       const span_s = (now - rates.since_ms) / 1000;
       rates.fps = rates.renders / span_s;
@@ -451,10 +578,35 @@ async function main() {
     freeze(on) { state.frozen = !!on; },
     exitXR() { return renderer.xr.getSession()?.end(); },
     viewSideOn,
-    /** The timeline's view of the follower: current entry, jumps seen, takes known. */
+    /** The timeline's view of the follower: current entry, jumps seen, takes known, and its
+     *  last drawn layout (plot edges, where confidence 1 and 0 sit, the labelled time ticks). */
     get timeline() {
-      return { current: timeline.current, jumps: timeline.jumps.length, takes: timeline.takes.length };
+      const L = timeline.lastLayout;
+      return {
+        current: timeline.current,
+        jumps: timeline.jumps.length,
+        takes: timeline.takes.length,
+        layout: L && {
+          plotTop: L.plotTop, plotBottom: L.plotBottom, yOne: L.yOne, yZero: L.yZero,
+          dotRadius: L.dotRadius, labelTop: L.labelTop, x0: L.x0, x1: L.x1,
+          cursorX: timeline.current ? L.x_of(timeline.current.frame) : null,
+          ticks: L.ticks.map(({ seconds, label, x }) => ({ seconds, label, x })),
+        },
+      };
     },
+    /** The replay as the viewer sees it: the server's last state, the position now, and how
+     *  many states came (null state: the source is not a replay). */
+    get replay() {
+      return {
+        state: replay.state && { ...replay.state },
+        received_ms: replay.received_ms,
+        position_s: replayPosition(),
+        states: replay.states,
+        visible: !ui.replay.hidden,
+      };
+    },
+    /** Segments of the floor grid along each axis. */
+    get floorGrid() { return { ...grid.userData.segments }; },
     renderer,
     send: (msg) => connection.send(msg),
   };

@@ -5,6 +5,17 @@
 const kHistoryFrames = 900; // confidence trail: the last 15 s at 60 Hz
 const kMaxJumps = 64;
 const kContactColors = { left: '#3fd0c9', right: '#ffc94d' };
+const kCursorRadius = 4; // the current confidence's dot
+const kTickSteps_s = [1, 2, 5, 10, 15, 30, 60, 120, 300, 600];
+const kMinTickSpacing_px = 56;
+
+/** "7 s" under a minute, else "1:05". */
+function timeLabel(seconds, long) {
+  if (!long) return `${seconds} s`;
+  const m = Math.floor(seconds / 60);
+  const s = seconds % 60;
+  return `${m}:${String(s).padStart(2, '0')}`;
+}
 
 export class Timeline {
   /** @param canvas a <canvas> sized by CSS; the drawing follows its size and the pixel ratio. */
@@ -51,6 +62,31 @@ export class Timeline {
     if (this.history.length > kHistoryFrames) this.history.splice(0, this.history.length - kHistoryFrames);
     this.current = entry;
     this.dirty_ = true;
+  }
+
+  /** Geometry of the track for a canvas `w` x `h` CSS pixels and a take of `frames` frames:
+   *  the plot's edges, where confidence 1 and 0 sit (inset by the cursor's radius, so a dot at
+   *  either end is whole), and the labelled time ticks. */
+  layout(w, h, frames) {
+    const x0 = 10;
+    const x1 = w - 10;
+    const plot_top = 26;
+    const plot_bottom = h - 40;
+    const inset = kCursorRadius + 1;
+    const y_of = (c) => plot_bottom - inset - c * (plot_bottom - plot_top - 2 * inset);
+    const x_of = (f) => x0 + (Math.min(Math.max(f, 0), frames) / frames) * (x1 - x0);
+    const duration_s = frames / this.fps;
+    const px_per_s = (x1 - x0) / Math.max(duration_s, 1e-6);
+    const step = kTickSteps_s.find((st) => st * px_per_s >= kMinTickSpacing_px) ?? kTickSteps_s.at(-1);
+    const ticks = [];
+    for (let sec = 0; sec <= duration_s + 1e-9; sec += step) {
+      ticks.push({ seconds: sec, label: timeLabel(sec, duration_s >= 60), x: x_of(sec * this.fps) });
+    }
+    return {
+      x0, x1, plotTop: plot_top, plotBottom: plot_bottom, labelTop: plot_bottom + 5,
+      laneTop: h - 22, laneHeight: 8, yOne: y_of(1), yZero: y_of(0), dotRadius: kCursorRadius,
+      ticks, x_of, y_of,
+    };
   }
 
   /** Redraws if anything changed since the last call (or the canvas was resized). */
@@ -108,31 +144,52 @@ export class Timeline {
     }
 
     // Geometry of the track.
-    const x0 = 10;
-    const x1 = w - 10;
-    const plot_top = 26;
-    const plot_bottom = h - 24;
-    const lane_top = h - 20;
-    const lane_h = 8;
-    const x_of = (f) => x0 + (Math.min(Math.max(f, 0), frames) / frames) * (x1 - x0);
-    const y_of = (c) => plot_bottom - c * (plot_bottom - plot_top);
+    const L = this.layout(w, h, frames);
+    this.lastLayout = L;
+    const { x0, x1, x_of, y_of } = L;
+    const plot_top = L.plotTop;
+    const plot_bottom = L.plotBottom;
+    const lane_top = L.laneTop;
+    const lane_h = L.laneHeight;
 
-    // Background, confidence grid lines at 0.5 and 1.
+    // Background, confidence grid lines at 0, 0.5 and 1 with their values at the right end.
     ctx.fillStyle = 'rgba(255,255,255,0.04)';
     ctx.fillRect(x0, plot_top, x1 - x0, plot_bottom - plot_top);
     ctx.strokeStyle = 'rgba(255,255,255,0.10)';
     ctx.lineWidth = 1;
-    for (const c of [0.5, 1]) {
+    for (const c of [0, 0.5, 1]) {
       ctx.beginPath();
       ctx.moveTo(x0, Math.round(y_of(c)) + 0.5);
       ctx.lineTo(x1, Math.round(y_of(c)) + 0.5);
       ctx.stroke();
     }
-    // Seconds ticks every 10 s of template time.
-    ctx.fillStyle = 'rgba(255,255,255,0.25)';
-    for (let s = 10; s * this.fps < frames; s += 10) {
-      ctx.fillRect(Math.round(x_of(s * this.fps)), plot_bottom - 3, 1, 3);
+    ctx.font = '10px system-ui, sans-serif';
+    ctx.textBaseline = 'middle';
+    ctx.textAlign = 'right';
+    ctx.fillStyle = 'rgba(255,255,255,0.35)';
+    for (const c of [0, 1]) ctx.fillText(String(c), x1 - 2, y_of(c));
+    // Time ticks of the template, labelled under the plot, with faint lines across it.
+    ctx.textBaseline = 'top';
+    ctx.textAlign = 'center';
+    for (const t of L.ticks) {
+      const x = Math.round(t.x) + 0.5;
+      ctx.strokeStyle = 'rgba(255,255,255,0.06)';
+      ctx.beginPath();
+      ctx.moveTo(x, plot_top);
+      ctx.lineTo(x, plot_bottom);
+      ctx.stroke();
+      ctx.strokeStyle = 'rgba(255,255,255,0.45)';
+      ctx.beginPath();
+      ctx.moveTo(x, plot_bottom);
+      ctx.lineTo(x, plot_bottom + 4);
+      ctx.stroke();
+      ctx.fillStyle = '#9aa1b1';
+      // The first and last labels stay inside the canvas.
+      const half = ctx.measureText(t.label).width / 2;
+      ctx.fillText(t.label, Math.min(Math.max(t.x, half + 1), w - half - 1), L.labelTop);
     }
+    ctx.textAlign = 'left';
+    ctx.font = '12px system-ui, sans-serif';
 
     // Hand-contact intervals [start, end) of this take.
     const contacts = Array.isArray(take?.contacts) ? take.contacts : [];
@@ -188,7 +245,7 @@ export class Timeline {
       ctx.stroke();
       ctx.fillStyle = '#ffffff';
       ctx.beginPath();
-      ctx.arc(x, y_of(cur.confidence), 4, 0, 2 * Math.PI);
+      ctx.arc(x, y_of(cur.confidence), kCursorRadius, 0, 2 * Math.PI);
       ctx.fill();
     }
   }

@@ -1,6 +1,7 @@
 // A stand-in for `duet serve` that speaks docs/protocol.md: serves web/dist over HTTP and, on
 // /ws, sends `hello`, 60 Hz `frame`s of two 19-joint stick dancers doing a salsa basic step,
-// and `stats` each second. It records every client message for tests (`received`, and
+// and `stats` each second. It plays as a file replay would (60 s, looping): `replay` messages
+// pause, seek and set the speed, and `replay_state` follows each and comes with `stats`. It records every client message for tests (`received`, and
 // GET /mock/received) and rejects bad ones with `error`, as the real server does.
 //
 //   node tests/mock-server.mjs [--port 8080] [--host 127.0.0.1] [--dist ../dist]
@@ -155,6 +156,14 @@ function validate(msg) {
       return null;
     case 'reset':
       return null;
+    case 'replay': {
+      const has = (k) => k in msg;
+      if (!has('paused') && !has('seek_s') && !has('speed')) return "replay: needs 'paused', 'seek_s' or 'speed'";
+      if (has('paused') && typeof msg.paused !== 'boolean') return "replay: 'paused' must be true or false";
+      if (has('seek_s') && !(typeof msg.seek_s === 'number' && Number.isFinite(msg.seek_s))) return "replay: 'seek_s' must be a finite number";
+      if (has('speed') && !(typeof msg.speed === 'number' && msg.speed >= 0.1 && msg.speed <= 4)) return "replay: 'speed' must be a number from 0.1 to 4";
+      return null;
+    }
     case 'pose': {
       const num = (x) => typeof x === 'number' && Number.isFinite(x);
       if (!num(msg.time_s)) return "'time_s' must be a number";
@@ -194,6 +203,13 @@ export async function startMockServer({ port = 0, host = '127.0.0.1', distDir = 
     dropped: 0,
     rejected: 0,
     latencies_us: [],
+    // The "file" the mock replays: its clock drives the dance; paused, no frames come.
+    clock_s: 0,
+    replay: { paused: false, speed: 1, position_s: 0, duration_s: 60, loop: true, preview: false },
+  };
+  const replayState = () => {
+    const r = state.replay;
+    return { type: 'replay_state', paused: r.paused, speed: r.speed, position_s: Math.round(r.position_s * 1000) / 1000, duration_s: r.duration_s, loop: r.loop };
   };
 
   const http = createServer(async (req, res) => {
@@ -270,6 +286,15 @@ export async function startMockServer({ port = 0, host = '127.0.0.1', distDir = 
         state.role = msg.role;
         state.template_frame = 0;
         for (const client of wss.clients) sendJson(client, hello());
+      } else if (msg.type === 'replay') {
+        const r = state.replay;
+        if ('speed' in msg) r.speed = msg.speed;
+        if ('seek_s' in msg) {
+          r.position_s = Math.min(Math.max(msg.seek_s, 0), r.duration_s - 1 / fps);
+          r.preview = r.paused; // like duet serve: a seek while paused shows that frame once
+        }
+        if ('paused' in msg) r.paused = msg.paused;
+        for (const client of wss.clients) sendJson(client, replayState());
       } else if (msg.type === 'reset') {
         state.template_frame = 0;
         state.take = 0;
@@ -283,9 +308,17 @@ export async function startMockServer({ port = 0, host = '127.0.0.1', distDir = 
   const t0 = performance.now();
   let last_s = 0;
   const tick = () => {
-    const t_s = (performance.now() - t0) / 1000;
-    const dt_s = t_s - last_s;
-    last_s = t_s;
+    const wall_s = (performance.now() - t0) / 1000;
+    const wall_dt_s = wall_s - last_s;
+    last_s = wall_s;
+    const r = state.replay;
+    if (r.paused && !r.preview) return;
+    // The dance and the follower run on the replayed file's clock.
+    const dt_s = r.paused ? 0 : wall_dt_s * r.speed;
+    r.preview = false;
+    r.position_s = (r.position_s + dt_s) % r.duration_s;
+    const t_s = r.position_s;
+    state.clock_s += Math.max(dt_s, 1 / fps); // time_s goes on across seeks, still while paused
     state.seq += 1;
 
     // Follower: advance one template frame per input frame, jump every ~4 s.
@@ -301,7 +334,8 @@ export async function startMockServer({ port = 0, host = '127.0.0.1', distDir = 
       const frames = kTakes[state.take].frames;
       state.template_frame = (state.template_frame + 97 * state.jumps) % frames;
     }
-    const confidence = jumped ? 0.45 : 0.8 + 0.15 * Math.sin(t_s * 0.9);
+    // Reaches 1 for about a second in every seven, so the timeline's top edge gets drawn on.
+    const confidence = jumped ? 0.45 : Math.min(1, 0.85 + 0.2 * Math.sin(t_s * 0.9));
     const f = state.template_frame;
     const in_contact = (hand) => kTakes[state.take].contacts.some((c) => c.user_hand === hand && f >= c.start && f < c.end);
 
@@ -316,7 +350,7 @@ export async function startMockServer({ port = 0, host = '127.0.0.1', distDir = 
     const frame = {
       type: 'frame',
       seq: state.seq,
-      time_s: Math.round(t_s * 1000) / 1000,
+      time_s: Math.round(state.clock_s * 1000) / 1000,
       follower: {
         take: state.take,
         template_frame: f,
@@ -355,7 +389,10 @@ export async function startMockServer({ port = 0, host = '127.0.0.1', distDir = 
       rejected: state.rejected,
       latency_us: { p50: percentile(sorted, 0.5), p99: percentile(sorted, 0.99), max: sorted.at(-1) ?? 0 },
     };
-    for (const ws of wss.clients) sendJson(ws, stats);
+    for (const ws of wss.clients) {
+      sendJson(ws, stats);
+      sendJson(ws, replayState());
+    }
   }, 1000);
 
   await new Promise((resolve, reject) => {

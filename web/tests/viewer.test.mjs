@@ -152,6 +152,48 @@ function boxOf(points, pad) {
 }
 
 const centre = (b) => [(b.x0 + b.x1) / 2, (b.y0 + b.y1) / 2];
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+/** Runs of floor-grid pixels (dim grey-blue lines on the dark floor) crossed along one row and
+ *  one column of a PNG screenshot, UI panels masked out. */
+async function gridCrossings(p, png, row_y, column_x, y_range, masks) {
+  return p.evaluate(
+    async ({ b64, row_y, column_x, y_range, masks }) => {
+      const img = new Image();
+      img.src = `data:image/png;base64,${b64}`;
+      await img.decode();
+      const c = document.createElement('canvas');
+      c.width = img.width;
+      c.height = img.height;
+      const ctx = c.getContext('2d', { willReadFrequently: true });
+      ctx.drawImage(img, 0, 0);
+      const { data, width } = ctx.getImageData(0, 0, c.width, c.height);
+      const masked = (x, y) => masks.some((m) => x >= m.x0 && x <= m.x1 && y >= m.y0 && y <= m.y1);
+      // Background 0x15171c (sum 72); grid 0x2c3038 (sum 148), centre line 0x5a6070.
+      const grid = (x, y) => {
+        const i = 4 * (y * width + x);
+        const [r, g, b] = [data[i], data[i + 1], data[i + 2]];
+        return Math.max(r, g, b) - Math.min(r, g, b) <= 24 && r + g + b >= 100 && r + g + b <= 420;
+      };
+      const runs = (points) => {
+        let n = 0;
+        let inside = false;
+        for (const [x, y] of points) {
+          const on = !masked(x, y) && grid(x, y);
+          if (on && !inside) n += 1;
+          inside = on;
+        }
+        return n;
+      };
+      const row = [];
+      for (let x = 0; x < c.width; ++x) row.push([x, row_y]);
+      const column = [];
+      for (let y = y_range[0]; y <= y_range[1]; ++y) column.push([column_x, y]);
+      return { row: runs(row), column: runs(column) };
+    },
+    { b64: png.toString('base64'), row_y, column_x, y_range, masks },
+  );
+}
 const dist = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1]);
 
 /** Screenshot with frames frozen, so the figures' projected joints match the pixels. */
@@ -237,6 +279,23 @@ describe(`duet viewer (${against})`, () => {
     const c_partner_colour = counts.centroid[partner_colour];
     assert.ok(dist(c_user_colour, centre(user_box)) < dist(c_user_colour, centre(partner_box)), `${user_colour} centroid ${c_user_colour} is nearer the partner's figure`);
     assert.ok(dist(c_partner_colour, centre(partner_box)) < dist(c_partner_colour, centre(user_box)), `${partner_colour} centroid ${c_partner_colour} is nearer the user's figure`);
+  });
+
+  test('the floor grid has lines along both axes', async (t) => {
+    requireFrames();
+    const segments = await page.evaluate(() => window.duetViewer.floorGrid);
+    assert.ok(segments.alongX > 0 && segments.alongX === segments.alongZ, `grid segments ${JSON.stringify(segments)}`);
+    await page.evaluate(() => window.duetViewer.viewSideOn());
+    const shot = await frozenShot(page, 'floor-grid');
+    const [panel, timeline] = shot.masks;
+    const feet_y = Math.max(...[...shot.user, ...shot.partner].filter((q) => q.z < 1).map((q) => q.y));
+    // Side-on, the floor between the feet and the timeline is crossed mostly by the lines that
+    // run away from the camera; a column at the left edge mostly by the lines across the view.
+    const row_y = Math.round((Math.min(feet_y, timeline.y0) + timeline.y0) / 2);
+    const crossings = await gridCrossings(page, shot.png, row_y, 20, [panel.y1 + 2, timeline.y0 - 2], shot.masks);
+    t.diagnostic(`grid lines crossed: row y=${row_y} ${crossings.row}, column x=20 ${crossings.column}`);
+    assert.ok(crossings.row >= 6, `only ${crossings.row} grid lines cross the row at y=${row_y} (lines away from the camera missing?)`);
+    assert.ok(crossings.column >= 6, `only ${crossings.column} grid lines cross the column at x=20 (lines across the view missing?)`);
   });
 
   test('a correction switch sends set and follows frame.corrections', async () => {
@@ -328,6 +387,142 @@ describe(`duet viewer (${against})`, () => {
       // The mock jumps every 4 s.
       await waitUntil(page, 'a jump mark', () => window.duetViewer.timeline.jumps >= 1, null, 6);
     }
+  });
+
+  test('the timeline labels its time axis and keeps confidence 1 inside the plot', async (t) => {
+    requireFrames();
+    const { tl, hello } = await page.evaluate(() => ({ tl: window.duetViewer.timeline, hello: window.duetViewer.hello }));
+    const L = tl.layout;
+    assert.ok(L, 'the timeline has been drawn');
+    const take = hello.takes[tl.current.take];
+    const duration_s = take.frames / hello.fps;
+    assert.ok(L.ticks.length >= 3, `time ticks: ${JSON.stringify(L.ticks)}`);
+    assert.equal(L.ticks[0].seconds, 0);
+    for (let k = 1; k < L.ticks.length; ++k) {
+      assert.ok(L.ticks[k].seconds > L.ticks[k - 1].seconds && L.ticks[k].x > L.ticks[k - 1].x, `ticks out of order: ${JSON.stringify(L.ticks)}`);
+    }
+    assert.ok(L.ticks.at(-1).seconds <= duration_s + 1e-6, `last tick past the take's ${duration_s} s`);
+    for (const tick of L.ticks) assert.match(tick.label, /^(\d+ s|\d+:\d\d)$/);
+    assert.equal(new Set(L.ticks.map((k) => k.label)).size, L.ticks.length, 'labels are distinct');
+    // The cursor's dot at confidence 1 (and 0) lies whole inside the plot.
+    assert.ok(L.yOne - L.dotRadius >= L.plotTop, `confidence 1 at y=${L.yOne} is clipped by the plot top ${L.plotTop}`);
+    assert.ok(L.yZero + L.dotRadius <= L.plotBottom, `confidence 0 at y=${L.yZero} is clipped by the plot bottom ${L.plotBottom}`);
+    // Every label is drawn: light text pixels under its tick.
+    const lit = await page.evaluate((ticks) => {
+      const canvas = document.getElementById('timeline');
+      const ratio = canvas.width / canvas.clientWidth;
+      const { labelTop } = window.duetViewer.timeline.layout;
+      const ctx = canvas.getContext('2d');
+      return ticks.map((tick) => {
+        const x0 = Math.max(0, Math.round((tick.x - 14) * ratio));
+        const x1 = Math.min(canvas.width, Math.round((tick.x + 14) * ratio));
+        const img = ctx.getImageData(x0, Math.round(labelTop * ratio), x1 - x0, Math.round(11 * ratio)).data;
+        let n = 0;
+        for (let i = 0; i < img.length; i += 4) if (img[i + 3] > 100 && img[i] + img[i + 1] + img[i + 2] > 300) n += 1;
+        return n;
+      });
+    }, L.ticks);
+    lit.forEach((n, k) => assert.ok(n >= 5, `tick label "${L.ticks[k].label}" has ${n} lit pixels`));
+
+    // When the confidence is 1, its dot is drawn whole at the top of the plot.
+    try {
+      await page.waitForFunction(() => {
+        const v = window.duetViewer;
+        if (!(v.timeline.current?.confidence >= 1)) return false;
+        v.freeze(true); // holds the timeline at this frame
+        return true;
+      }, null, { timeout: mock ? 9000 : 6000, polling: 20 });
+    } catch {
+      assert.ok(!mock, 'the mock reaches confidence 1 every 7 s');
+      t.diagnostic('the confidence did not reach 1 within 6 s; the pixel check of the top edge is skipped');
+      return;
+    }
+    try {
+      const n = await page.evaluate(() => window.duetViewer.renderCount);
+      await waitUntil(page, 'two renders after freezing', (k) => window.duetViewer.renderCount >= k + 2, n, 5);
+      const dot = await page.evaluate(() => {
+        const canvas = document.getElementById('timeline');
+        const ratio = canvas.width / canvas.clientWidth;
+        const L = window.duetViewer.timeline.layout;
+        const ctx = canvas.getContext('2d');
+        const white = (x, y) => {
+          const d = ctx.getImageData(Math.round(x * ratio), Math.round(y * ratio), 1, 1).data;
+          return d[0] > 200 && d[1] > 200 && d[2] > 200 && d[3] > 200;
+        };
+        const x = L.cursorX;
+        const y = L.yOne;
+        return { x, y, left: white(x - 3, y), right: white(x + 3, y), upper: white(x - 2, y - 2), lower: white(x - 2, y + 2) };
+      });
+      t.diagnostic(`confidence-1 dot: ${JSON.stringify(dot)}`);
+      assert.ok(dot.left && dot.right && dot.upper && dot.lower, `the dot at confidence 1 is not whole: ${JSON.stringify(dot)}`);
+    } finally {
+      await page.evaluate(() => window.duetViewer.freeze(false));
+    }
+  });
+
+  test('replay controls pause, seek and set the speed of a file replay', async (t) => {
+    requireFrames();
+    const viewer = () => page.evaluate(() => window.duetViewer.replay);
+    // duet serve --source replay:... and the mock say where the file is once a second.
+    await waitUntil(page, 'a replay_state (the server plays a file)', () => window.duetViewer.replay.visible, null, 5);
+    let r = await viewer();
+    if (r.state.paused) {
+      await page.click('#replay-play');
+      await waitUntil(page, 'playing', () => window.duetViewer.replay.state.paused === false, null, 5);
+      r = await viewer();
+    }
+    const duration_s = r.state.duration_s;
+    assert.ok(duration_s > 1, `duration ${duration_s}`);
+
+    // Pause: the server confirms, the button offers Play, and frames stop.
+    await page.click('#replay-play');
+    if (mock) await waitForReceived('{"type":"replay","paused":true}', (m) => m.type === 'replay' && m.paused === true);
+    await waitUntil(page, 'the server to confirm the pause', (n) => window.duetViewer.replay.states > n && window.duetViewer.replay.state.paused, r.states, 5);
+    assert.equal((await page.textContent('#replay-play')).trim(), 'Play');
+    await sleep(300); // frames already on their way
+    const f0 = await page.evaluate(() => window.duetViewer.framesReceived);
+    await sleep(1000);
+    const f1 = await page.evaluate(() => window.duetViewer.framesReceived);
+    assert.ok(f1 - f0 <= 1, `${f1 - f0} frames in a second while paused`);
+
+    // Seek with the slider to the middle: the server goes there, still paused, and sends that
+    // one frame so the dancers show it.
+    const target = Math.round(duration_s / 2);
+    r = await viewer();
+    await page.$eval('#replay-seek', (el, v) => {
+      el.value = String(v);
+      el.dispatchEvent(new Event('input', { bubbles: true }));
+      el.dispatchEvent(new Event('change', { bubbles: true }));
+    }, target);
+    if (mock) await waitForReceived(`{"type":"replay","seek_s":${target}}`, (m) => m.type === 'replay' && m.seek_s === target);
+    await waitUntil(page, `the server at ${target} s`, ([n, v]) => {
+      const s = window.duetViewer.replay;
+      return s.states > n && Math.abs(s.state.position_s - v) < 0.5 && s.state.paused;
+    }, [r.states, target], 5);
+    await waitUntil(page, 'the frame sought to', (k) => window.duetViewer.framesReceived > k, f1, 5);
+    assert.match(await page.textContent('#replay-time'), new RegExp(`^${target}\\.\\d / ${duration_s.toFixed(1)} s$`));
+
+    // 2x, then play: the file runs at twice the wall clock.
+    r = await viewer();
+    await page.selectOption('#replay-speed', '2');
+    if (mock) await waitForReceived('{"type":"replay","speed":2}', (m) => m.type === 'replay' && m.speed === 2);
+    await waitUntil(page, 'the server at 2x', (n) => window.duetViewer.replay.states > n && window.duetViewer.replay.state.speed === 2, r.states, 5);
+    r = await viewer();
+    await page.click('#replay-play');
+    await waitUntil(page, 'the server playing', (n) => window.duetViewer.replay.states > n && window.duetViewer.replay.state.paused === false, r.states, 5);
+    const a = await viewer();
+    await waitUntil(page, 'a state 1.5 s later', (t0) => window.duetViewer.replay.received_ms - t0 >= 1500, a.received_ms, 5);
+    const b = await viewer();
+    const rate = (b.state.position_s - a.state.position_s) / ((b.received_ms - a.received_ms) / 1000);
+    t.diagnostic(`replay ran ${rate.toFixed(2)} s of file per second at 2x`);
+    assert.ok(rate > 1.4 && rate < 2.6, `at 2x the file ran ${rate.toFixed(2)} s per second`);
+
+    // Back to 1x; frames keep coming.
+    r = await viewer();
+    await page.selectOption('#replay-speed', '1');
+    await waitUntil(page, 'the server at 1x', (n) => window.duetViewer.replay.states > n && window.duetViewer.replay.state.speed === 1, r.states, 5);
+    const frames = await page.evaluate(() => window.duetViewer.framesReceived);
+    await waitUntil(page, 'frames after the replay test', (k) => window.duetViewer.framesReceived > k + 10, frames, 5);
   });
 
   test('Enter VR presents an emulated immersive session at the user head, then exits', async () => {
