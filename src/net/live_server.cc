@@ -82,7 +82,9 @@ struct LiveServer::Impl {
         io(1),
         server(io, options.server, make_callbacks()),
         replay_timer(io),
-        stats_timer(io) {
+        stats_timer(io),
+        role_timer(io),
+        shutdown_timer(io) {
     if (!options.log) {
       options.log = [](const std::string& line) { fmt::print(stderr, "duet serve: {}\n", line); };
     }
@@ -91,6 +93,8 @@ struct LiveServer::Impl {
     replay = dynamic_cast<ReplaySource*>(source.get());
     frame.resize(source->source_skeleton().joint_count());
     hello = std::make_shared<const std::string>(make_hello(*loop, source->describe()));
+    initial_params = loop->params();
+    wanted_role = loop->role();
   }
 
   ServerCallbacks make_callbacks() {
@@ -134,40 +138,48 @@ struct LiveServer::Impl {
     return Ok{};
   }
 
-  Status start_recording(const std::string& stem) {
+  // Opens a set of recording files for `role_loop`'s partner. Thread-safe (it only reads the
+  // source's skeleton, which never changes), so the other role's set opens off the loop thread.
+  static Result<std::unique_ptr<SessionRecorder>> open_recording(const std::string& directory,
+                                                                 const std::string& stem,
+                                                                 const SourceSkeleton& user,
+                                                                 const LiveLoop& role_loop) {
     RecorderOptions r;
-    r.directory = options.record_dir;
+    r.directory = directory;
     r.stem = stem;
     // In the units duet assumes for each skeleton's convention, so that any duet command reads
     // the recordings back at the size they were danced (a WebSocket source sends metres).
-    r.user_metres_per_unit = default_metres_per_unit(source->source_skeleton().roles.convention);
+    r.user_metres_per_unit = default_metres_per_unit(user.roles.convention);
     r.partner_metres_per_unit =
-        default_metres_per_unit(loop->library().takes()[0].response_motion.roles.convention);
+        default_metres_per_unit(role_loop.library().takes()[0].response_motion.roles.convention);
+    return SessionRecorder::start(r, user.skeleton, role_loop.partner_skeleton(),
+                                  user.frame_rate);
+  }
+
+  Status start_recording(const std::string& stem) {
     Result<std::unique_ptr<SessionRecorder>> started =
-        SessionRecorder::start(r, source->source_skeleton().skeleton, loop->partner_skeleton(),
-                               source->source_skeleton().frame_rate);
+        open_recording(options.record_dir, stem, source->source_skeleton(), *loop);
     if (!started) return started.error();
-    if (recorder) retire_recorder();
     recorder = std::move(started).value();
-    log("recording to " + recorder->user_path() + ", " + recorder->partner_path() + ", " +
-        recorder->follow_path());
+    log_recording(*recorder);
     return Ok{};
   }
 
-  // Closes the current recording on a background thread (file work stays off the loop's).
-  void retire_recorder() {
-    if (!recorder) return;
-    add_recording_summary(*recorder);
-    retiring.emplace_back([r = std::move(recorder)]() mutable {
-      use_normal_priority();
-      (void)r->stop();
-    });
+  void log_recording(const SessionRecorder& r) {
+    log("recording to " + r.user_path() + ", " + r.partner_path() + ", " + r.follow_path());
   }
 
-  void add_recording_summary(const SessionRecorder& r) {
-    summary.recordings.push_back(r.user_path());
-    summary.recordings.push_back(r.partner_path());
-    summary.recordings.push_back(r.follow_path());
+  // Completes a recording and adds it to the summary (all of its segments count).
+  Status finish_recording(std::unique_ptr<SessionRecorder>& r) {
+    if (!r) return Ok{};
+    Status status = r->stop();
+    summary.recordings.push_back(r->user_path());
+    summary.recordings.push_back(r->partner_path());
+    summary.recordings.push_back(r->follow_path());
+    summary.recorded += r->frames_recorded();
+    summary.record_lost += r->frames_lost();
+    r.reset();
+    return status;
   }
 
   Status run() {
@@ -184,15 +196,11 @@ struct LiveServer::Impl {
     if (receiver) receiver->stop();
     server.stop();
     if (loader.joinable()) loader.join();
-    Status status = Ok{};
-    if (recorder) {
-      add_recording_summary(*recorder);
-      status = recorder->stop();
-      summary.recorded += recorder->frames_recorded();
-      summary.record_lost += recorder->frames_lost();
-    }
-    for (std::thread& t : retiring) t.join();
-    retiring.clear();
+    // A model (and its recording) that finished loading after the stop is still in the queue.
+    io.restart();
+    io.poll();
+    Status status = finish_recording(recorder);
+    if (Status other = finish_recording(other_recorder); status && !other) status = other;
     finish_summary();
     return status;
   }
@@ -202,10 +210,22 @@ struct LiveServer::Impl {
     stopping = true;
     replay_timer.cancel();
     stats_timer.cancel();
+    role_timer.cancel();
     if (signals) signals->cancel();
     if (receiver) receiver->stop();
-    server.stop();
-    io.stop();
+    server.stop();  // close frames to the WebSocket clients
+    wait_for_close(SteadyClock::now() + kCloseGrace);
+  }
+
+  // Runs the io_context until every connection has closed (the close handshakes are done) or
+  // the deadline has passed; a client that does not answer cannot hold the shutdown up.
+  void wait_for_close(SteadyClock::time_point deadline) {
+    if (server.connection_count() == 0 || SteadyClock::now() >= deadline) {
+      io.stop();
+      return;
+    }
+    shutdown_timer.expires_after(std::chrono::milliseconds(10));
+    shutdown_timer.async_wait([this, deadline](error_code) { wait_for_close(deadline); });
   }
 
   void finish_summary() {
@@ -269,11 +289,21 @@ struct LiveServer::Impl {
       reject(id, *problem);
       return;
     }
+    // With a control token (a server reachable from the network), a client that connected
+    // without it can watch but not steer: every message changes the session for everyone.
+    if (!server.may_control(id)) {
+      reject(id,
+             "this connection may only watch: open the address duet serve printed (with its "
+             "?token=...) to send messages");
+      return;
+    }
     switch (message.type) {
       case ClientMessage::Type::kSet:
         loop->set_correction(message.correction, message.enabled);
         return;
       case ClientMessage::Type::kReset:
+        // The follower starts over and the corrections go back to how the server started.
+        loop->set_params(initial_params);
         loop->reset();
         return;
       case ClientMessage::Type::kRole:
@@ -318,9 +348,32 @@ struct LiveServer::Impl {
   }
 
   // ---- Role switching ----
+  //
+  // The other role's model is built once, on a background thread (with its set of recording
+  // files), and kept: later switches only swap the two (no thread, no file work, no message
+  // built on the loop's thread). Switches are applied at most every kRoleInterval; requests in
+  // between are coalesced into the last one, so a client toggling the role as fast as it can
+  // costs the loop a few swaps per second and never splits the recording further.
 
   void request_role(DancerRole role) {
     wanted_role = role;
+    if (role_timer_armed) return;  // the pending switch will apply the latest wish
+    const auto due = last_switch + kRoleInterval;
+    if (SteadyClock::now() < due) {
+      role_timer_armed = true;
+      role_timer.expires_at(due);
+      role_timer.async_wait([this](error_code ec) {
+        role_timer_armed = false;
+        if (!ec && !stopping) apply_role();
+      });
+      return;
+    }
+    apply_role();
+  }
+
+  void apply_role() {
+    if (stopping) return;
+    const DancerRole role = wanted_role;
     if (role == loop->role()) return;  // a load in progress for the other role is kept for later
     if (other_loop && other_loop->role() == role) {
       activate_other();
@@ -329,33 +382,65 @@ struct LiveServer::Impl {
     if (loading) return;
     loading = true;
     log(fmt::format("building the model for the {} role", dancer_role_name(role)));
-    if (loader.joinable()) loader.join();
-    loader = std::thread([this, role, params = loop->params()] {
+    if (loader.joinable()) loader.join();  // finished: on_loaded has run
+    std::string stem =
+        recorder ? fmt::format("{}-seg2", record_stem) : std::string();  // empty: no recording
+    loader = std::thread([this, role, params = loop->params(), user = source->source_skeleton(),
+                          directory = options.record_dir, stem = std::move(stem)] {
       use_normal_priority();  // building a model takes seconds of CPU: never at the loop's priority
-      auto result = std::make_shared<Result<std::unique_ptr<LiveLoop>>>(Error{"no factory"});
+      auto loaded = std::make_shared<Loaded>();
+      loaded->loop = Error{"no factory"};
       if (factory) {
         try {
-          *result = factory(role, params);
+          loaded->loop = factory(role, params);
         } catch (const std::exception& e) {
-          *result = Error{e.what()};
+          loaded->loop = Error{e.what()};
         }
       }
-      asio::post(io, [this, role, result] { on_loaded(role, std::move(*result)); });
+      if (loaded->loop) {
+        loaded->hello = std::make_shared<const std::string>(
+            make_hello(*loaded->loop.value(), source_description));
+        if (!stem.empty()) {
+          Result<std::unique_ptr<SessionRecorder>> r =
+              open_recording(directory, stem, user, *loaded->loop.value());
+          if (r) {
+            loaded->recorder = std::move(r).value();
+          } else {
+            loaded->record_error = r.error().message;
+          }
+        }
+      }
+      asio::post(io, [this, role, loaded] { on_loaded(role, std::move(*loaded)); });
     });
   }
 
-  void on_loaded(DancerRole role, Result<std::unique_ptr<LiveLoop>> result) {
+  struct Loaded {
+    Result<std::unique_ptr<LiveLoop>> loop = Error{""};
+    std::shared_ptr<const std::string> hello;
+    std::unique_ptr<SessionRecorder> recorder;
+    std::string record_error;
+  };
+
+  void on_loaded(DancerRole role, Loaded loaded) {
     loading = false;
+    if (loaded.recorder) {
+      log_recording(*loaded.recorder);
+      other_recorder = std::move(loaded.recorder);
+    } else if (!loaded.record_error.empty()) {
+      log("the " + std::string(dancer_role_name(role)) +
+          " role will not be recorded: " + loaded.record_error);
+    }
     if (stopping) return;
-    if (!result) {
+    if (!loaded.loop) {
       const std::string why = fmt::format("cannot switch to the {} role: {}",
-                                          dancer_role_name(role), result.error().message);
+                                          dancer_role_name(role), loaded.loop.error().message);
       log(why);
       server.broadcast(std::make_shared<const std::string>(make_error(why)));
       if (wanted_role == role) wanted_role = loop->role();
       return;
     }
-    other_loop = std::move(result).value();
+    other_loop = std::move(loaded.loop).value();
+    other_hello = std::move(loaded.hello);
     if (wanted_role == role) activate_other();
   }
 
@@ -363,16 +448,11 @@ struct LiveServer::Impl {
     other_loop->set_params(loop->params());
     other_loop->reset();
     std::swap(loop, other_loop);
-    hello = std::make_shared<const std::string>(make_hello(*loop, source->describe()));
+    std::swap(hello, other_hello);
+    std::swap(recorder, other_recorder);
+    last_switch = SteadyClock::now();
     server.broadcast(hello);
     log(fmt::format("the user now dances the {}", dancer_role_name(loop->role())));
-    if (recorder) {
-      ++segment;
-      if (Status s = start_recording(fmt::format("{}-seg{}", record_stem, segment)); !s) {
-        log("recording stopped: " + s.error().message);
-        retire_recorder();
-      }
-    }
   }
 
   // ---- Statistics ----
@@ -407,9 +487,11 @@ struct LiveServer::Impl {
     s.latency_total = summarize(send_total);
     s.loop = summarize(loop_window);
     s.source = source->stats();
-    if (recorder) {
-      s.recorded = recorder->frames_recorded();
-      s.record_lost = recorder->frames_lost();
+    for (const auto* r : {&recorder, &other_recorder}) {  // both roles' files
+      if (*r) {
+        s.recorded += (*r)->frames_recorded();
+        s.record_lost += (*r)->frames_lost();
+      }
     }
     server.broadcast(std::make_shared<const std::string>(make_stats(s)));
     broadcast_replay_state();  // clients that connected since the last change learn it here
@@ -449,14 +531,15 @@ struct LiveServer::Impl {
   Server server;
   asio::steady_timer replay_timer;
   asio::steady_timer stats_timer;
+  asio::steady_timer role_timer;
+  asio::steady_timer shutdown_timer;
   std::optional<asio::signal_set> signals;
   std::unique_ptr<NeuronReceiver> receiver;
   bool stopping = false;
 
-  std::unique_ptr<SessionRecorder> recorder;
-  std::vector<std::thread> retiring;
+  // The active role's recording and the other role's (opened with its model).
+  std::unique_ptr<SessionRecorder> recorder, other_recorder;
   std::string record_stem;
-  int segment = 1;
 
   SourceFrame frame;
   MessagePool pool;
@@ -465,9 +548,16 @@ struct LiveServer::Impl {
   std::string pose_reason;
 
   std::unique_ptr<LiveLoop> other_loop;
+  std::shared_ptr<const std::string> other_hello;
+  std::string source_description = source->describe();
   std::thread loader;
   bool loading = false;
   DancerRole wanted_role = DancerRole::kLeader;
+  PartnerParams initial_params;  // what `reset` restores
+  static constexpr auto kRoleInterval = std::chrono::milliseconds(250);
+  static constexpr auto kCloseGrace = std::chrono::milliseconds(1000);
+  SteadyClock::time_point last_switch{};
+  bool role_timer_armed = false;
 
   long long frames = 0;
   long long rejected = 0;
@@ -487,7 +577,6 @@ LiveServer::LiveServer(LiveServerOptions options, SourceSpec spec,
 
 LiveServer::~LiveServer() {
   if (impl_->loader.joinable()) impl_->loader.join();
-  for (std::thread& t : impl_->retiring) t.join();
 }
 
 Status LiveServer::start() { return impl_->start(); }

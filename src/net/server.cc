@@ -25,7 +25,11 @@ using tcp = asio::ip::tcp;
 namespace server_detail {
 
 constexpr std::size_t kReadChunk = 64 * 1024;
-constexpr auto kHttpTimeout = std::chrono::seconds(30);
+constexpr auto kHttpWriteTimeout = std::chrono::seconds(30);  // sending a response
+constexpr auto kWsHandshakeTimeout = std::chrono::seconds(10);
+constexpr std::string_view kBusyResponse =
+    "HTTP/1.1 503 Service Unavailable\r\nContent-Type: text/plain\r\nContent-Length: 26\r\n"
+    "Connection: close\r\n\r\nToo many connections. Retry\n";
 constexpr std::string_view kServerName = "duet-serve";
 
 class HttpSession;
@@ -57,6 +61,9 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   std::unordered_set<server_detail::HttpSession*> http_sessions;
   ClientId next_id = 1;
 
+  int ws_from(const asio::ip::address& address) const;
+  int http_from(const asio::ip::address& address) const;
+
   long long frames_dropped = 0;
   long long messages_dropped = 0;
   LatencyHistogram send_latency;
@@ -69,6 +76,39 @@ using Request = http::request<http::string_body>;
 std::string_view target_path(beast::string_view target) {
   const std::string_view t(target.data(), target.size());
   return t.substr(0, t.find_first_of("?#"));
+}
+
+// The value of `key` in the target's query ("/ws?token=abc" -> "abc"), or nullopt.
+std::optional<std::string_view> query_value(beast::string_view target, std::string_view key) {
+  std::string_view t(target.data(), target.size());
+  const std::size_t question = t.find('?');
+  if (question == std::string_view::npos) return std::nullopt;
+  t = t.substr(question + 1);
+  t = t.substr(0, t.find('#'));
+  while (!t.empty()) {
+    const std::size_t amp = t.find('&');
+    const std::string_view pair = t.substr(0, amp);
+    const std::size_t eq = pair.find('=');
+    if (pair.substr(0, eq) == key)
+      return eq == std::string_view::npos ? std::string_view() : pair.substr(eq + 1);
+    if (amp == std::string_view::npos) break;
+    t = t.substr(amp + 1);
+  }
+  return std::nullopt;
+}
+
+// Compares in time independent of where the first difference is (the token is a secret).
+bool same_secret(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  unsigned char diff = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+  return diff == 0;
+}
+
+std::chrono::steady_clock::duration seconds(double s) {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(s));
 }
 
 constexpr std::string_view kPlaceholderPage = R"(<!doctype html>
@@ -86,9 +126,10 @@ constexpr std::string_view kPlaceholderPage = R"(<!doctype html>
 // One viewer (or pose sender) on /ws.
 class WsSession : public std::enable_shared_from_this<WsSession> {
  public:
-  WsSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
+  WsSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server, asio::ip::address remote)
       : ws_(std::move(socket)),
         server_(std::move(server)),
+        remote_(std::move(remote)),
         buffer_(server_->options.max_message_bytes + 2 * kReadChunk) {}
   ~WsSession() {
     if (id_ != 0) server_->clients.erase(id_);
@@ -96,9 +137,18 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 
   void run(Request request) {
     request_ = std::move(request);
+    const std::string& token = server_->options.control_token;
+    control_ = token.empty() || same_secret(query_value(request_.target(), "token").value_or(""),
+                                            token);
     beast::error_code ec;
     beast::get_lowest_layer(ws_).socket().set_option(tcp::no_delay(true), ec);
-    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    // Idle: a ping after half the timeout without input, closed after all of it. A browser
+    // answers pings, so only a client that stopped reading (or vanished) is closed.
+    websocket::stream_base::timeout timeout{};
+    timeout.handshake_timeout = kWsHandshakeTimeout;
+    timeout.idle_timeout = seconds(server_->options.ws_idle_timeout_s);
+    timeout.keep_alive_pings = true;
+    ws_.set_option(timeout);
     ws_.set_option(websocket::stream_base::decorator([](websocket::response_type& response) {
       response.set(http::field::server, kServerName);
     }));
@@ -135,6 +185,23 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     beast::get_lowest_layer(ws_).close();
   }
 
+  // Shutdown: a close frame 1001 "going away" (after the write in progress, if any), so browsers
+  // see a clean close instead of 1006.
+  void go_away() {
+    if (closed_) return;
+    closed_ = true;
+    frames_.clear();
+    messages_.clear();
+    if (writing_) {
+      close_after_write_ = true;
+      return;
+    }
+    send_close();
+  }
+
+  bool may_control() const { return control_; }
+  const asio::ip::address& remote() const { return remote_; }
+
   bool stalled(SteadyClock::time_point now) const {
     return writing_ && std::chrono::duration<double>(now - write_started_).count() >
                            server_->options.write_timeout_s;
@@ -146,6 +213,13 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     bool frame = false;
     SteadyClock::time_point arrival{};
   };
+
+  void send_close() {
+    ws_.async_close(websocket::close_reason(websocket::close_code::going_away, "server stopping"),
+                    [self = shared_from_this()](beast::error_code) {
+                      beast::get_lowest_layer(self->ws_).close();
+                    });
+  }
 
   void on_accept(beast::error_code ec) {
     if (ec || server_->stopped) return;
@@ -222,6 +296,11 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       close();
       return;
     }
+    if (close_after_write_) {
+      close_after_write_ = false;
+      send_close();
+      return;
+    }
     if (current_.frame) {
       const auto us = std::chrono::duration_cast<std::chrono::microseconds>(SteadyClock::now() -
                                                                             current_.arrival);
@@ -233,6 +312,9 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 
   websocket::stream<beast::tcp_stream> ws_;
   std::shared_ptr<Server::Impl> server_;
+  asio::ip::address remote_;
+  bool control_ = true;
+  bool close_after_write_ = false;
   Request request_;
   beast::flat_buffer buffer_;
   std::size_t message_bytes_ = 0;
@@ -252,21 +334,24 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 // Plain HTTP: static files, the placeholder page, and the upgrade to a WebSocket at /ws.
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
-  HttpSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
-      : stream_(std::move(socket)), server_(std::move(server)) {
+  HttpSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server,
+              asio::ip::address remote)
+      : stream_(std::move(socket)), server_(std::move(server)), remote_(std::move(remote)) {
     server_->http_sessions.insert(this);
   }
   ~HttpSession() { server_->http_sessions.erase(this); }
 
   void run() { do_read(); }
   void close() { stream_.close(); }
+  const asio::ip::address& remote() const { return remote_; }
 
  private:
   void do_read() {
     parser_.emplace();
     parser_->header_limit(16 * 1024);
     parser_->body_limit(64 * 1024);
-    stream_.expires_after(kHttpTimeout);
+    // Covers a keep-alive connection waiting for its next request: idle ones do not pile up.
+    stream_.expires_after(seconds(server_->options.http_idle_timeout_s));
     http::async_read(
         stream_, buffer_, *parser_,
         [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
@@ -288,8 +373,14 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
         send_text(request, http::status::service_unavailable, "Too many clients.\n");
         return;
       }
+      if (server_->ws_from(remote_) >= server_->options.max_clients_per_address) {
+        send_text(request, http::status::service_unavailable,
+                  "Too many clients from this address.\n");
+        return;
+      }
       stream_.expires_never();
-      std::make_shared<WsSession>(stream_.release_socket(), server_)->run(parser_->release());
+      std::make_shared<WsSession>(stream_.release_socket(), server_, remote_)
+          ->run(parser_->release());
       return;
     }
     handle(request);
@@ -381,7 +472,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   template <class Body>
   void send(http::response<Body>&& response) {
     auto message = std::make_shared<http::response<Body>>(std::move(response));
-    stream_.expires_after(kHttpTimeout);
+    stream_.expires_after(kHttpWriteTimeout);
     http::async_write(stream_, *message,
                       [self = shared_from_this(), message](beast::error_code ec, std::size_t) {
                         if (ec || message->need_eof() || self->server_->stopped) {
@@ -396,6 +487,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   beast::flat_buffer buffer_{16 * 1024};
   std::optional<http::request_parser<http::string_body>> parser_;
   std::shared_ptr<Server::Impl> server_;
+  asio::ip::address remote_;
 };
 
 }  // namespace server_detail
@@ -412,10 +504,38 @@ void Server::Impl::do_accept() {
       return;
     }
     beast::error_code option_ec;
+    const asio::ip::address remote = socket.remote_endpoint(option_ec).address();
+    if (option_ec) {
+      self->do_accept();  // already gone
+      return;
+    }
+    if (static_cast<int>(self->http_sessions.size()) >= self->options.max_http_connections ||
+        self->http_from(remote) >= self->options.max_http_per_address) {
+      // Over a cap: a short 503 into the empty send buffer (never blocks), then close.
+      socket.non_blocking(true, option_ec);
+      socket.write_some(asio::buffer(server_detail::kBusyResponse), option_ec);
+      socket.shutdown(tcp::socket::shutdown_both, option_ec);
+      socket.close(option_ec);
+      self->do_accept();
+      return;
+    }
     socket.set_option(tcp::no_delay(true), option_ec);
-    std::make_shared<server_detail::HttpSession>(std::move(socket), self)->run();
+    std::make_shared<server_detail::HttpSession>(std::move(socket), self, remote)->run();
     self->do_accept();
   });
+}
+
+int Server::Impl::ws_from(const asio::ip::address& address) const {
+  int n = 0;
+  for (const auto& [id, session] : clients) n += session->remote() == address ? 1 : 0;
+  return n;
+}
+
+int Server::Impl::http_from(const asio::ip::address& address) const {
+  int n = 0;
+  for (const server_detail::HttpSession* session : http_sessions)
+    n += session->remote() == address ? 1 : 0;
+  return n;
 }
 
 Server::Server(asio::io_context& io, ServerOptions options, ServerCallbacks callbacks)
@@ -432,8 +552,16 @@ Status Server::start() {
   if (ec) return Error{"--http " + where + ": not an IP address"};
   const tcp::endpoint endpoint(address, s.options.port);
   auto fail = [&](const char* what) {
-    s.acceptor.close(ec);
-    return Error{"--http " + where + ": cannot " + what + ": " + ec.message()};
+    // The reason first: closing the acceptor resets `ec` ("cannot bind: Success").
+    std::string reason = ec.message();
+    if (ec == asio::error::address_in_use) {
+      reason += " (another program, or another duet serve, listens on this port)";
+    } else if (ec == boost::system::errc::address_not_available) {
+      reason += " (not an address of this machine)";
+    }
+    beast::error_code close_ec;
+    s.acceptor.close(close_ec);
+    return Error{"--http " + where + ": cannot " + what + ": " + reason};
   };
   s.acceptor.open(endpoint.protocol(), ec);
   if (ec) return fail("open a socket");
@@ -458,7 +586,7 @@ void Server::stop() {
   s.retry_timer.cancel();
   std::vector<server_detail::WsSession*> clients;
   for (auto& [id, session] : s.clients) clients.push_back(session);
-  for (server_detail::WsSession* session : clients) session->close();
+  for (server_detail::WsSession* session : clients) session->go_away();
   const std::vector<server_detail::HttpSession*> https(s.http_sessions.begin(),
                                                        s.http_sessions.end());
   for (server_detail::HttpSession* session : https) session->close();
@@ -494,6 +622,13 @@ void Server::close_stalled_clients() {
 }
 
 int Server::client_count() const { return static_cast<int>(impl_->clients.size()); }
+int Server::connection_count() const {
+  return static_cast<int>(impl_->clients.size() + impl_->http_sessions.size());
+}
+bool Server::may_control(ClientId client) const {
+  const auto it = impl_->clients.find(client);
+  return it != impl_->clients.end() && it->second->may_control();
+}
 long long Server::frames_dropped() const { return impl_->frames_dropped; }
 long long Server::messages_dropped() const { return impl_->messages_dropped; }
 LatencyHistogram& Server::send_latency() { return impl_->send_latency; }

@@ -1,11 +1,14 @@
 // WebSocket link to `duet serve` (docs/protocol.md): parses JSON messages, reconnects on loss.
 
-/** The server's /ws on the host that served the page, unless `?ws=URL` overrides it. */
+/** The server's /ws on the host that served the page (with the page's `?token=`), unless `?ws=URL` overrides it. */
 export function defaultSocketUrl(location) {
   const override = new URLSearchParams(location.search).get('ws');
   if (override) return override;
   const scheme = location.protocol === 'https:' ? 'wss' : 'ws';
-  return `${scheme}://${location.host}/ws`;
+  // A server on the network prints its page address with ?token=...; control needs it.
+  const token = new URLSearchParams(location.search).get('token');
+  const query = token ? `?token=${encodeURIComponent(token)}` : '';
+  return `${scheme}://${location.host}/ws${query}`;
 }
 
 const kRetryFirstS = 0.5; // first reconnect delay

@@ -10,6 +10,12 @@
 // (counted), so a slow client sees gaps in `seq` and the loop never waits for it. Other messages
 // (hello, stats, error) are bounded separately. A write that does not complete within
 // `write_timeout_s` closes the connection.
+//
+// Limits (so that no one viewer, or one address, can lock the others out or exhaust descriptors):
+// WebSocket clients and plain HTTP connections are capped globally and per remote address, idle
+// HTTP connections are closed after `http_idle_timeout_s`, WebSocket clients that answer no ping
+// for `ws_idle_timeout_s`. With a `control_token`, only clients that connected with
+// `/ws?token=...` may send messages (Server::may_control); the others can watch.
 #pragma once
 
 #include <boost/asio/io_context.hpp>
@@ -36,8 +42,16 @@ struct ServerOptions {
   std::size_t max_message_bytes = kMaxClientMessageBytes;
   int max_queued_frames = 2;     // per client, besides the one being written
   int max_queued_messages = 32;  // per client: hello, stats, error replies
-  int max_clients = 64;          // WebSocket connections; more are refused with 503
+  int max_clients = 64;              // WebSocket connections; more are refused with 503
+  int max_clients_per_address = 16;  // WebSocket connections from one remote address (503)
+  int max_http_connections = 256;    // plain HTTP connections; more get 503 and are closed
+  int max_http_per_address = 32;     // plain HTTP connections from one remote address
   double write_timeout_s = 10.0;
+  double http_idle_timeout_s = 15.0;  // waiting for (the rest of) a request
+  // Nothing received for half of it: a ping; for all of it: closed (browsers answer pings).
+  double ws_idle_timeout_s = 30.0;
+  // Non-empty: clients must connect to /ws?token=<control_token> to send messages.
+  std::string control_token;
 };
 
 struct ServerCallbacks {
@@ -58,8 +72,11 @@ class Server {
 
   // Binds and listens. Errors name the address and the reason ("address in use").
   Status start();
-  // Closes the listener and every connection (pending writes are abandoned).
+  // Closes the listener and the HTTP connections, and sends every WebSocket client a close frame
+  // (1001 "going away") once its current write is done. Keep running the io_context until
+  // connection_count() is 0 (or a deadline) for the close frames to go out.
   void stop();
+  int connection_count() const;  // WebSocket + HTTP connections still open
 
   std::uint16_t port() const;
   const std::filesystem::path* web_root() const;  // null when serving the placeholder
@@ -72,6 +89,8 @@ class Server {
   void close_stalled_clients();
 
   int client_count() const;
+  // Whether this client may send messages (no control token, or it connected with the token).
+  bool may_control(ClientId client) const;
   long long frames_dropped() const;    // frame messages dropped for slow clients
   long long messages_dropped() const;  // other messages dropped (a client that never reads)
   // arrival -> write completed, one sample per frame message per client. The owner reads and
