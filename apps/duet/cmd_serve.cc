@@ -5,6 +5,7 @@
 
 #include <charconv>
 #include <filesystem>
+#include <random>
 
 #include "commands.h"
 #include "duet/live/live_loop.h"
@@ -33,6 +34,7 @@ struct ServeArgs {
   std::optional<double> source_scale;
   std::string source_map;
   std::string http = "127.0.0.1:8080";
+  std::optional<std::string> token;
   std::string web;
   std::string record = "recordings";
   bool no_record = false;
@@ -72,6 +74,14 @@ bool parse_http(const std::string& text, std::string& address, std::uint16_t& po
 
 bool is_loopback(const std::string& address) {
   return address == "localhost" || address == "::1" || address.starts_with("127.");
+}
+
+// 128 random bits in hex: the control token of a server reachable from the network.
+std::string random_token() {
+  std::random_device device;  // /dev/urandom on Linux
+  std::string token;
+  for (int k = 0; k < 4; ++k) token += fmt::format("{:08x}", device());
+  return token;
 }
 
 // --web, else web/dist in the working directory, else web/dist in the source tree this binary
@@ -244,6 +254,13 @@ int run_serve(const ServeArgs& args) {
                      user, p);
   };
 
+  // Anyone who can reach a non-loopback address could steer everybody's session: control then
+  // needs a token, which only the printed address carries.
+  if (args.token) {
+    options.server.control_token = *args.token;
+  } else if (!is_loopback(options.server.address)) {
+    options.server.control_token = random_token();
+  }
   options.server.web_dir = find_web_dir(args.web);
   options.server.max_queued_frames = args.queue_frames;
   options.record_dir = args.no_record ? std::string() : args.record;
@@ -260,7 +277,8 @@ int run_serve(const ServeArgs& args) {
   }
   if (!is_loopback(options.server.address)) {
     fail("warning: listening on " + options.server.address +
-         ": anyone who can reach this machine can connect");
+         ": anyone who can reach this machine can watch; only the printed address (with its "
+         "token) can control");
   }
   if (server.web_root() == nullptr) {
     fail(args.web.empty()
@@ -276,8 +294,10 @@ int run_serve(const ServeArgs& args) {
     fmt::print(stderr, "duet serve: viewer files from {}\n", server.web_root()->string());
   }
   // The one line on stdout, for people and for scripts that start the server on port 0.
-  fmt::print("duet serve: viewer at http://{}:{}/ (WebSocket ws://{}:{}/ws)\n", host, server.port(),
-             host, server.port());
+  const std::string query =
+      options.server.control_token.empty() ? "" : "?token=" + options.server.control_token;
+  fmt::print("duet serve: viewer at http://{}:{}/{} (WebSocket ws://{}:{}/ws{})\n", host,
+             server.port(), query, host, server.port(), query);
   std::fflush(stdout);
 
   const Status status = server.run();
@@ -329,6 +349,18 @@ Command register_serve(CLI::App& app) {
                  "Address and port to serve on; 0 as port picks a free one. Loopback unless "
                  "told otherwise")
       ->capture_default_str();
+  app.add_option("--token", args->token,
+                 "Clients must connect with ?token=TOKEN to send control messages (set, reset, "
+                 "role, ...); default: a random token when --http is not loopback, none on "
+                 "loopback")
+      ->check(CLI::Validator(
+          [](std::string& value) -> std::string {
+            const bool ok = !value.empty() && value.size() <= 128 &&
+                            value.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRS"
+                                                    "TUVWXYZ0123456789-_.~") == std::string::npos;
+            return ok ? std::string() : "1 to 128 letters, digits, '-', '_', '.' or '~'";
+          },
+          "TOKEN"));
   app.add_option("--web", args->web,
                  "Directory of the viewer's files (default: web/dist here, else in the source "
                  "tree)");
