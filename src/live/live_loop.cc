@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "duet/motion/body_space.h"
 #include "duet/motion/forward_kinematics.h"
 
 namespace duet {
@@ -96,6 +97,7 @@ LiveLoop::LiveLoop(std::shared_ptr<const DuetLibrary> library, const SourceSkele
   out_.partner_positions_ws.assign(partner_n, Vec3::Zero());
   out_.partner_rotations_ws.assign(partner_n, Quat::Identity());
   shown_pose_.resize(partner_joints);
+  user_height_m_ = measure_body(*user_.skeleton, user_.roles).standing_height_m;
   // Until the first frame, the partner stands in its first captured pose.
   const Clip& response = library_->takes()[0].response_motion.clip;
   std::ranges::copy(response.translations_ls(0), out_.partner_translations_ls.begin());
@@ -131,6 +133,7 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   forward_kinematics(*user_.skeleton, frame.translations_ls, frame.rotations_ls,
                      out_.user_positions_ws, out_.user_rotations_ws);
   user_pose_ = user_pose_from_world(out_.user_positions_ws, out_.user_rotations_ws, user_.roles);
+  user_pose_.height_m = user_height_m_;
 
   // Where the partner is in the library: the estimate, or where it was when there is none.
   int take = result.take;

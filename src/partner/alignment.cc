@@ -4,12 +4,19 @@
 #include <string>
 
 #include "duet/math/rotation.h"
+#include "duet/motion/body_space.h"
+#include "duet/motion/forward_kinematics.h"
 
 namespace duet {
 
 Transform heading_frame(const Vec3& root_position_ws, const Quat& root_rotation_ws) noexcept {
   return {yaw_rotation(heading_yaw(root_rotation_ws)),
           Vec3(root_position_ws.x(), 0.0, root_position_ws.z())};
+}
+
+Transform body_heading_frame(std::span<const Vec3> positions_ws, const JointRoles& roles) noexcept {
+  const Vec3 pelvis = pelvis_centre(positions_ws, roles);
+  return {yaw_rotation(body_heading_yaw(positions_ws, roles)), Vec3(pelvis.x(), 0.0, pelvis.z())};
 }
 
 double RootPlacement::relative_yaw_rad() const noexcept {
@@ -24,8 +31,13 @@ Transform place_root(const RootPlacement& placement, const Vec3& user_root_posit
   return root;
 }
 
-Result<SpatialAlignment> SpatialAlignment::build(const Clip& template_clip,
-                                                 const Clip& response_clip) {
+namespace {
+
+// The placements of the response root in the template's heading frame at every frame, whichever
+// way that frame is taken (`template_frame(f)`).
+template <typename TemplateFrame>
+Result<std::vector<RootPlacement>> placements(const Clip& template_clip, const Clip& response_clip,
+                                              TemplateFrame template_frame) {
   if (template_clip.frame_count() != response_clip.frame_count()) {
     return Error{"spatial alignment: the template has " +
                  std::to_string(template_clip.frame_count()) + " frames, the response " +
@@ -35,20 +47,54 @@ Result<SpatialAlignment> SpatialAlignment::build(const Clip& template_clip,
       response_clip.joint_count() <= 0) {
     return Error{"spatial alignment: the duet has no frames or no joints"};
   }
-  SpatialAlignment alignment;
-  alignment.placements_.resize(static_cast<std::size_t>(template_clip.frame_count()));
+  std::vector<RootPlacement> out(static_cast<std::size_t>(template_clip.frame_count()));
   for (int f = 0; f < template_clip.frame_count(); ++f) {
-    const Transform tmpl =
-        heading_frame(template_clip.translations_ls(f)[0], template_clip.rotations_ls(f)[0]);
+    const Transform tmpl = template_frame(f);
     const Transform resp{response_clip.rotations_ls(f)[0], response_clip.translations_ls(f)[0]};
     const Transform rel = tmpl.inverse() * resp;
     if (!rel.translation.allFinite() || !rel.rotation.coeffs().allFinite()) {
       return Error{"spatial alignment: frame " + std::to_string(f) +
                    " has a non-finite root transform"};
     }
-    alignment.placements_[static_cast<std::size_t>(f)] = {rel.translation,
-                                                          rel.rotation.normalized()};
+    out[static_cast<std::size_t>(f)] = {rel.translation, rel.rotation.normalized()};
   }
+  return out;
+}
+
+}  // namespace
+
+Result<SpatialAlignment> SpatialAlignment::build(const Clip& template_clip,
+                                                 const Clip& response_clip) {
+  Result<std::vector<RootPlacement>> made =
+      placements(template_clip, response_clip, [&](int f) {
+        return heading_frame(template_clip.translations_ls(f)[0], template_clip.rotations_ls(f)[0]);
+      });
+  if (!made) return made.error();
+  SpatialAlignment alignment;
+  alignment.placements_ = std::move(made).value();
+  return alignment;
+}
+
+Result<SpatialAlignment> SpatialAlignment::build(const Clip& template_clip,
+                                                 const JointRoles& template_roles,
+                                                 const Clip& response_clip) {
+  for (Role role : {Role::kLeftHip, Role::kRightHip}) {
+    if (template_roles[role] < 0 || template_roles[role] >= template_clip.joint_count()) {
+      return Error{"spatial alignment: the template has no joint for role " +
+                   std::string(role_name(role))};
+    }
+  }
+  const std::vector<Vec3> positions = world_positions(template_clip);
+  const auto n = static_cast<std::size_t>(template_clip.joint_count());
+  Result<std::vector<RootPlacement>> made =
+      placements(template_clip, response_clip, [&](int f) {
+        return body_heading_frame(
+            std::span<const Vec3>(positions.data() + static_cast<std::size_t>(f) * n, n),
+            template_roles);
+      });
+  if (!made) return made.error();
+  SpatialAlignment alignment;
+  alignment.placements_ = std::move(made).value();
   return alignment;
 }
 

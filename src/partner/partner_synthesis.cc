@@ -1,5 +1,7 @@
 #include "duet/partner/partner_synthesis.h"
 
+#include "duet/motion/body_space.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -106,7 +108,8 @@ Result<PartnerModel> PartnerModel::build(const Clip& template_clip,
   if (!(options.ground_quantile >= 0.0 && options.ground_quantile <= 1.0)) {
     return Error{"partner model: ground_quantile must be in [0, 1]"};
   }
-  Result<SpatialAlignment> alignment = SpatialAlignment::build(template_clip, response_clip);
+  Result<SpatialAlignment> alignment =
+      SpatialAlignment::build(template_clip, template_roles, response_clip);
   if (!alignment) return alignment.error();
   Result<HandContacts> contacts = HandContacts::detect(template_clip, template_roles, response_clip,
                                                        response_roles, options.contacts);
@@ -117,6 +120,8 @@ Result<PartnerModel> PartnerModel::build(const Clip& template_clip,
   model.response_roles_ = response_roles;
   model.alignment_ = std::move(alignment).value();
   model.contacts_ = std::move(contacts).value();
+  model.template_height_m_ = measure_body(template_clip.skeleton(), template_roles).standing_height_m;
+  model.response_height_m_ = measure_body(response_clip.skeleton(), response_roles).standing_height_m;
 
   // Ground height per foot: a low quantile of the toe's height over the clip.
   const std::vector<Vec3> positions = world_positions(response_clip);
@@ -255,6 +260,14 @@ std::string corrections_string(const PartnerParams& params) {
 // ---------------------------------------------------------------------------------------------
 // Run time
 
+double PartnerModel::spacing_scale(double user_height_m) const noexcept {
+  const double captured = template_height_m_ + response_height_m_;
+  if (!(user_height_m > 0.0) || !(template_height_m_ > 0.0) || !(response_height_m_ > 0.0)) {
+    return 1.0;
+  }
+  return (user_height_m + response_height_m_) / captured;
+}
+
 UserPose user_pose_from_world(std::span<const Vec3> positions_ws,
                               std::span<const Quat> rotations_ws,
                               const JointRoles& roles) noexcept {
@@ -262,6 +275,14 @@ UserPose user_pose_from_world(std::span<const Vec3> positions_ws,
   if (positions_ws.empty() || rotations_ws.size() != positions_ws.size()) return user;
   user.root_position_ws = positions_ws[0];
   user.root_rotation_ws = rotations_ws[0];
+  const auto n = static_cast<int>(positions_ws.size());
+  const int left_hip = roles[Role::kLeftHip], right_hip = roles[Role::kRightHip];
+  if (left_hip >= 0 && left_hip < n && right_hip >= 0 && right_hip < n &&
+      left_hip != right_hip) {
+    user.body_heading = body_heading_frame(positions_ws, roles);
+    user.body_heading_valid = user.body_heading.translation.allFinite() &&
+                              user.body_heading.rotation.coeffs().allFinite();
+  }
   for (const Side side : {Side::kLeft, Side::kRight}) {
     const int j = roles[side == Side::kLeft ? Role::kLeftWrist : Role::kRightWrist];
     if (j < 0 || static_cast<std::size_t>(j) >= positions_ws.size()) continue;
@@ -352,7 +373,9 @@ bool PartnerSynthesisJob::run() const noexcept {
                                 user->root_rotation_ws.norm() > 0.0;
   Transform user_heading = ctx.user_heading_;
   if (user_root_finite) {
-    user_heading = heading_frame(user->root_position_ws, user->root_rotation_ws.normalized());
+    user_heading = user->body_heading_valid
+                       ? user->body_heading
+                       : heading_frame(user->root_position_ws, user->root_rotation_ws.normalized());
     if (p.smooth) {
       const Vec3 facing = user_heading.rotation * Vec3::UnitZ();
       const Vec3 smooth_facing = ctx.user_facing_filter_.filter(facing, dt, p.user_filter);
@@ -376,7 +399,14 @@ bool PartnerSynthesisJob::run() const noexcept {
     heading = ctx.user_heading_;
     const RootPlacement placement = has_position ? model->alignment().placement_at(frame_position)
                                                  : model->alignment().placement(frame);
-    const Transform root = heading * Transform{placement.rotation_hs, placement.position_hs};
+    // The captured spacing, fitted to the user's body (a taller user stands further away).
+    Vec3 position_hs = placement.position_hs;
+    if (user != nullptr) {
+      const double spacing = model->spacing_scale(user->height_m);
+      position_hs.x() *= spacing;
+      position_hs.z() *= spacing;
+    }
+    const Transform root = heading * Transform{placement.rotation_hs, position_hs};
     out_t[0] = root.translation;
     out_r[0] = root.rotation.normalized();
   }

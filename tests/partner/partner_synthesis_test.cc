@@ -202,6 +202,7 @@ TEST(PartnerSynthesis, AlignPlacesThePartnerRelativeToTheUser) {
       UserPose user = user_from(duet.leader, f, duet.roles);
       user.root_position_ws = place + yaw_rotation(yaw) * user.root_position_ws;
       user.root_rotation_ws = yaw_rotation(yaw) * user.root_rotation_ws;
+      user.body_heading = Transform{yaw_rotation(yaw), place} * user.body_heading;
       run.step(duet.follower, f, user);
       const Vec3 captured = duet.follower.translations_ls(f)[0];
       if (align) {
@@ -540,7 +541,9 @@ TEST(PartnerSynthesis, FootLockHoldsPlantedFeetUnderAJitteringUserRoot) {
     Vec3 previous = Vec3::Zero();
     for (int f = 0; f < 120; ++f) {
       UserPose user = user_from(duet.leader, f, duet.roles);
-      user.root_position_ws += Vec3(jitter(same_noise), 0.0, jitter(same_noise));
+      const Vec3 shake(jitter(same_noise), 0.0, jitter(same_noise));
+      user.root_position_ws += shake;
+      user.body_heading.translation += shake;
       run.step(duet.follower, f, user);
       const Vec3 foot = run.world().positions[toe];
       if (f > 0) path[lock ? 0 : 1] += (foot - previous).norm();

@@ -95,6 +95,7 @@ class LiveLoop {
   PartnerContext context_;
   LiveOutput out_;
   UserPose user_pose_;
+  double user_height_m_ = 0.0;  // measure_body of the user's skeleton: fits the partner's spacing
   ResponsePlayhead playhead_;
   Pose shown_pose_;  // the response sampled at the playhead
   int previous_take_ = -1;

@@ -14,15 +14,22 @@
 // user's root rotation must follow the template skeleton's axis convention.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "duet/base/result.h"
 #include "duet/motion/clip.h"
+#include "duet/motion/skeleton_map.h"
 
 namespace duet {
 
 // A body's heading frame: its root projected on the floor (y = 0), turned about +Y by its heading.
 Transform heading_frame(const Vec3& root_position_ws, const Quat& root_rotation_ws) noexcept;
+
+// The rig-independent heading frame (issue 10): the pelvis centre (midpoint of the hip joints) on
+// the floor, turned by the heading of the hip line (duet::body_heading_yaw). The same body on any
+// rig, whatever its root joint's place and axes, gets the same frame.
+Transform body_heading_frame(std::span<const Vec3> positions_ws, const JointRoles& roles) noexcept;
 
 // The response root relative to the template's heading frame (_hs: heading space).
 struct RootPlacement {
@@ -47,7 +54,12 @@ class SpatialAlignment {
   SpatialAlignment() = default;
 
   // The two clips must have the same number of frames (error otherwise) and at least one frame.
+  // Placements relative to the template root's heading frame (heading_frame of joint 0).
   static Result<SpatialAlignment> build(const Clip& template_clip, const Clip& response_clip);
+  // Placements relative to the template's body heading frame (body_heading_frame): what a user on
+  // any rig is placed against, with their own body_heading_frame.
+  static Result<SpatialAlignment> build(const Clip& template_clip, const JointRoles& template_roles,
+                                        const Clip& response_clip);
 
   int frame_count() const noexcept { return static_cast<int>(placements_.size()); }
   // frame in [0, frame_count()).

@@ -68,6 +68,13 @@ class PartnerModel {
   const JointRoles& response_roles() const noexcept { return response_roles_; }
   const SpatialAlignment& alignment() const noexcept { return alignment_; }
   const HandContacts& contacts() const noexcept { return contacts_; }
+  // The standing heights (measure_body) of the captured template and response dancers, metres.
+  double template_height_m() const noexcept { return template_height_m_; }
+  double response_height_m() const noexcept { return response_height_m_; }
+  // How much further apart the partner stands for a user `user_height_m` tall: the captured
+  // spacing scales with the sum of the two dancers' heights (reach grows with size), so
+  // (user + response) / (template + response); 1 when a height is unknown.
+  double spacing_scale(double user_height_m) const noexcept;
   // Height (y, metres) of the response's toe joint when that foot stands on the floor.
   double foot_ground_height(Side side) const noexcept {
     return ground_heights_[static_cast<std::size_t>(side)];
@@ -82,6 +89,8 @@ class PartnerModel {
   JointRoles response_roles_;
   SpatialAlignment alignment_;
   HandContacts contacts_;
+  double template_height_m_ = 0.0;
+  double response_height_m_ = 0.0;
   std::array<double, 2> ground_heights_{0.0, 0.0};
   // Per frame and foot (frame * 2 + side): the captured toe's height above its ground height and
   // its horizontal speed, m and m/s.
@@ -191,6 +200,13 @@ std::string corrections_string(const PartnerParams& params);
 struct UserPose {
   Vec3 root_position_ws = Vec3::Zero();
   Quat root_rotation_ws = Quat::Identity();
+  // The rig-independent heading frame the partner is placed in (body_heading_frame: the pelvis
+  // centre on the floor, the hip line's heading); valid = false falls back to the root's.
+  Transform body_heading;
+  bool body_heading_valid = false;
+  // The user's standing height (measure_body), metres; 0 = unknown: the partner keeps the
+  // captured spacing. Otherwise the spacing is scaled to fit the two bodies (see PartnerModel).
+  double height_m = 0.0;
   std::array<Vec3, 2> wrist_positions_ws{Vec3::Zero(), Vec3::Zero()};
   std::array<Quat, 2> wrist_rotations_ws{Quat::Identity(), Quat::Identity()};
 };

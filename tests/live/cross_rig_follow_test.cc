@@ -1,0 +1,85 @@
+// Issue 10 on real files: the same performance on another rig is followed against the salsa
+// library as on the library's own rig, and motion that is no part of the dance is not.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "duet/follow/hmm_follower.h"
+#include "duet/io/motion_file.h"
+#include "duet/live/duet_library.h"
+#include "duet/live/follow_session.h"
+
+namespace duet {
+namespace {
+
+const std::string kData = DUET_DATA_DIR;
+
+std::vector<PairFiles> salsa_library() {
+  std::vector<PairFiles> pairs;
+  for (const char* trial : {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13",
+                            "14", "15"}) {
+    pairs.push_back({{kData + "/cmu-salsa/bvh/60/60_" + trial + "_scaled.bvh"},
+                     {kData + "/cmu-salsa/bvh/61/61_" + trial + "_scaled.bvh"}});
+  }
+  return pairs;
+}
+
+const DuetLibrary& library() {
+  static const DuetLibrary loaded = [] {
+    LibraryOptions options;
+    options.load.frame_rate = 60.0;
+    Result<DuetLibrary> l = DuetLibrary::load(salsa_library(), options);
+    if (!l) throw std::runtime_error(l.error().message);
+    return std::move(l).value();
+  }();
+  return loaded;
+}
+
+std::vector<FollowResult> follow(const LoadedMotion& input) {
+  Result<HmmFollower> follower = HmmFollower::create(library().model(), FollowParams{});
+  EXPECT_TRUE(follower) << follower.error().message;
+  Result<FollowSession> session = FollowSession::create(
+      library(), input.clip.skeleton_ptr(), input.roles,
+      std::make_unique<HmmFollower>(std::move(follower).value()));
+  EXPECT_TRUE(session) << session.error().message;
+  std::vector<FollowResult> results;
+  for (int f = 0; f < input.clip.frame_count(); ++f) {
+    results.push_back(session.value().step(input.clip.translations_ls(f),
+                                           input.clip.rotations_ls(f),
+                                           f / input.clip.frame_rate()));
+  }
+  return results;
+}
+
+TEST(CrossRigFollow, TakeOneFromTheCmuAsfAmcIsFollowedAgainstTheSalsaLibrary) {
+  MotionLoadOptions options;
+  options.frame_rate = 60.0;
+  Result<LoadedMotion> input = load_motion(
+      {kData + "/cmu-salsa/asf-amc/60.asf", kData + "/cmu-salsa/asf-amc/60_01.amc"}, options);
+  ASSERT_TRUE(input) << input.error().message;
+  const std::vector<FollowResult> results = follow(input.value());
+  // Frame i of the AMC is frame i of take 01 (the library's take 0). Within 100 ms = 6 frames.
+  int within = 0;
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    within += results[i].take == 0 && std::abs(results[i].frame_in_take - static_cast<int>(i)) <= 6;
+  }
+  const double share = static_cast<double>(within) / static_cast<double>(results.size());
+  std::printf("ASF take 01: %.1f%% within 100 ms\n", 100.0 * share);
+  EXPECT_GE(share, 0.99);
+}
+
+TEST(CrossRigFollow, AWalkOnAThirdPartyRigIsMostlyLost) {
+  // The Bandai walk: another studio's rig (roles from its joint names, centimetres guessed) and a
+  // motion that is no part of the salsa. The follower must not claim to follow it.
+  Result<LoadedMotion> input = load_motion({kData + "/bandai/dataset-1_walk_normal_001.bvh"});
+  ASSERT_TRUE(input) << input.error().message;
+  const std::vector<FollowResult> results = follow(input.value());
+  int lost = 0;
+  for (const FollowResult& r : results) lost += r.lost ? 1 : 0;
+  const double share = static_cast<double>(lost) / static_cast<double>(results.size());
+  std::printf("Bandai walk: %.1f%% of frames lost\n", 100.0 * share);
+  EXPECT_GE(share, 0.5);
+}
+
+}  // namespace
+}  // namespace duet
