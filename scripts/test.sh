@@ -6,19 +6,28 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 scripts/install-deps.sh
 data_dir=$(scripts/get-data.sh "${1:-}")
 jobs=$(nproc)
+# Each stage says how long the run has taken so far (the CI budget is 40 minutes on 2 cores).
+stage() { echo "== [$((SECONDS / 60)) min $((SECONDS % 60)) s] $*" >&2; }
+# ccache (installed by install-deps.sh) makes a second run on the same machine rebuild only what
+# changed, also from a fresh clone elsewhere (paths relative to the clone, no directory in the hash).
+export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
+launcher=()
+if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
 
-echo "== Release build and tests" >&2
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DDUET_DATA_DIR="$data_dir" >/dev/null
+stage "Release build and tests"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DDUET_DATA_DIR="$data_dir" \
+  "${launcher[@]}" >/dev/null
 cmake --build build -j"$jobs"
 ctest --test-dir build --output-on-failure -j"$jobs"
 
-echo "== Sanitizer build (ASan + UBSan) and tests" >&2
+stage "Sanitizer build (ASan + UBSan) and tests"
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DDUET_SANITIZE=ON \
-  -DDUET_BUILD_BENCHMARKS=OFF -DDUET_BROWSER_TESTS=OFF -DDUET_DATA_DIR="$data_dir" >/dev/null
+  -DDUET_BUILD_BENCHMARKS=OFF -DDUET_BROWSER_TESTS=OFF -DDUET_DATA_DIR="$data_dir" \
+  "${launcher[@]}" >/dev/null
 cmake --build build-asan -j"$jobs"
 ctest --test-dir build-asan --output-on-failure -j"$jobs"
 
-echo "== Fuzzing each reader for ${FUZZ_SECONDS:-30} s" >&2
+stage "Fuzzing each reader for ${FUZZ_SECONDS:-30} s"
 CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DDUET_BUILD_FUZZERS=ON -DDUET_BUILD_TESTS=OFF -DDUET_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build build-fuzz -j"$jobs"
@@ -31,4 +40,4 @@ for fuzzer in build-fuzz/fuzz/*_fuzz; do
   echo "fuzz $name: $(grep -c . "build-fuzz/$name.log") log lines, no crash" >&2
   rm -rf "$corpus"
 done
-echo "== all tests passed" >&2
+stage "all tests passed"

@@ -1,0 +1,82 @@
+// Per-frame cost of following on real data (method.md 6, first half of the loop): features from
+// the user's pose, standardisation (and the rig's posture offset), the HMM forward step, against
+// the whole salsa library (14 duets, 27,495 states). Skipped without the data.
+//
+// BM_FollowSessionStep/0: take 01 on the library's own rig (DAZ BVH, 43 joints).
+// BM_FollowSessionStep/1: take 01 on the CMU ASF rig (31 joints).
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "duet/follow/hmm_follower.h"
+#include "duet/io/motion_file.h"
+#include "duet/live/duet_library.h"
+#include "duet/live/follow_session.h"
+
+namespace duet {
+namespace {
+
+const std::string kSalsa = std::string(DUET_DATA_DIR) + "/cmu-salsa";
+
+const DuetLibrary* salsa_library() {
+  static const std::optional<DuetLibrary> library = []() -> std::optional<DuetLibrary> {
+    std::vector<PairFiles> pairs;
+    for (const char* t : {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13",
+                          "14", "15"}) {
+      pairs.push_back(PairFiles{{kSalsa + "/bvh/60/60_" + t + "_scaled.bvh"},
+                                {kSalsa + "/bvh/61/61_" + t + "_scaled.bvh"}});
+    }
+    LibraryOptions options;
+    options.load.frame_rate = 60.0;
+    Result<DuetLibrary> loaded = DuetLibrary::load(pairs, options);
+    if (!loaded) return std::nullopt;
+    return std::move(loaded).value();
+  }();
+  return library ? &*library : nullptr;
+}
+
+void BM_FollowSessionStep(benchmark::State& state) {
+  const DuetLibrary* library = salsa_library();
+  if (library == nullptr) {
+    state.SkipWithError("salsa data not found");
+    return;
+  }
+  MotionLoadOptions load;
+  load.frame_rate = 60.0;
+  const std::vector<std::string> input_files =
+      state.range(0) == 0 ? std::vector<std::string>{kSalsa + "/bvh/60/60_01_scaled.bvh"}
+                          : std::vector<std::string>{kSalsa + "/asf-amc/60.asf",
+                                                     kSalsa + "/asf-amc/60_01.amc"};
+  Result<LoadedMotion> input = load_motion(input_files, load);
+  if (!input) {
+    state.SkipWithError(input.error().message.c_str());
+    return;
+  }
+  const Clip& clip = input.value().clip;
+  Result<HmmFollower> follower = HmmFollower::create(library->model(), FollowParams{});
+  Result<FollowSession> session = FollowSession::create(
+      *library, clip.skeleton_ptr(), input.value().roles,
+      std::make_unique<HmmFollower>(std::move(follower).value()));
+  if (!session) {
+    state.SkipWithError(session.error().message.c_str());
+    return;
+  }
+  int f = 0;
+  double time_s = 0.0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        session.value().step(clip.translations_ls(f), clip.rotations_ls(f), time_s));
+    f = (f + 1) % clip.frame_count();
+    time_s += 1.0 / 60.0;
+  }
+  state.counters["states"] = library->model().num_states();
+  state.counters["dims"] = library->model().num_dims();
+}
+BENCHMARK(BM_FollowSessionStep)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->MinTime(3.0);
+
+}  // namespace
+}  // namespace duet
