@@ -131,6 +131,10 @@ CapturedDuetSampler::CapturedDuetSampler(const Clip& template_clip,
 
 void CapturedDuetSampler::compute(double template_frame, const Vec3& user_root_position_ws,
                                   const Quat& user_root_rotation_ws) {
+  compute(template_frame, heading_frame(user_root_position_ws, user_root_rotation_ws));
+}
+
+void CapturedDuetSampler::compute(double template_frame, const Transform& user_heading) {
   const int last = response_clip_->frame_count() - 1;
   const double frame = std::clamp(template_frame, 0.0, static_cast<double>(last));
   const double time_s = frame / response_clip_->frame_rate();
@@ -146,7 +150,8 @@ void CapturedDuetSampler::compute(double template_frame, const Vec3& user_root_p
                      std::span(rotations_scratch_).first(rn));
 
   const RootPlacement placement = model_->alignment().placement_at(frame);
-  const Transform root = place_root(placement, user_root_position_ws, user_root_rotation_ws);
+  Transform root = user_heading * Transform{placement.rotation_hs, placement.position_hs};
+  root.rotation.normalize();
   placed_pose_.translations_ls = response_pose_.translations_ls;
   placed_pose_.rotations_ls = response_pose_.rotations_ls;
   placed_pose_.translations_ls[0] = root.translation;

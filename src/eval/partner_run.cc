@@ -1,5 +1,7 @@
 #include "duet/eval/partner_run.h"
 
+#include "duet/partner/alignment.h"
+
 #include <algorithm>
 #include <cassert>
 #include <chrono>
@@ -161,7 +163,8 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
       r.step_us = elapsed_us(start, stop);
       const TruthFrame& truth = performance.truth[fs];
       CapturedDuetSampler& sampler = samplers.at(truth.take);
-      sampler.compute(truth.template_frame, out.user_positions_ws[0], out.user_rotations_ws[0]);
+      sampler.compute(truth.template_frame,
+                      body_heading_frame(out.user_positions_ws, performance.roles));
       r.joint_error_m =
           mean_joint_distance_m(out.partner_positions_ws, sampler.placed_positions_ws());
 

@@ -1,5 +1,6 @@
 #include "duet/motion/body_space.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -85,10 +86,22 @@ BodyDimensions measure_body(const Skeleton& skeleton, const JointRoles& roles,
 }
 
 double body_heading_yaw(std::span<const Vec3> positions_ws, const JointRoles& roles) noexcept {
-  const Vec3 left = positions_ws[static_cast<std::size_t>(roles[Role::kLeftHip])];
-  const Vec3 right = positions_ws[static_cast<std::size_t>(roles[Role::kRightHip])];
+  auto horizontal_unit = [](Vec3 v) {
+    v.y() = 0.0;
+    const double n = v.norm();
+    return n > 1e-9 ? Vec3(v / n) : Vec3::Zero();
+  };
+  auto at = [&](Role r) { return positions_ws[static_cast<std::size_t>(roles[r])]; };
+  // Left-pointing lines of the hips and, where the rig has them, the shoulders. Salsa hips and
+  // shoulders counter-rotate about the spine, so their mean turns far less than either: the
+  // heading the partner is placed in and the features are read in stays steady.
+  Vec3 leftward = horizontal_unit(at(Role::kLeftHip) - at(Role::kRightHip));
+  const int left_shoulder = roles[Role::kLeftShoulder], right_shoulder = roles[Role::kRightShoulder];
+  if (left_shoulder >= 0 && right_shoulder >= 0 &&
+      static_cast<std::size_t>(std::max(left_shoulder, right_shoulder)) < positions_ws.size()) {
+    leftward += horizontal_unit(at(Role::kLeftShoulder) - at(Role::kRightShoulder));
+  }
   // Facing = left-pointing vector x up: a body facing +Z has its left at +X (Y up, right-handed).
-  const Vec3 leftward = left - right;
   const Vec3 facing = leftward.cross(Vec3::UnitY());
   return std::atan2(facing.x(), facing.z());
 }

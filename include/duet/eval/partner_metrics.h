@@ -100,6 +100,10 @@ class CapturedDuetSampler {
   // user's root times the placement (interpolated between the two nearest frames).
   void compute(double template_frame, const Vec3& user_root_position_ws,
                const Quat& user_root_rotation_ws);
+  // Same, placed in a given heading frame of the user: the body heading frame
+  // (body_heading_frame) the synthesis places the partner in, so a user on any rig is scored in
+  // the frame the partner was placed in.
+  void compute(double template_frame, const Transform& user_heading);
 
   // The true response, placed relative to the user (world positions and local rotations).
   std::span<const Vec3> placed_positions_ws() const { return placed_positions_; }

@@ -30,8 +30,9 @@ BodyDimensions measure_body(const Skeleton& skeleton, const JointRoles& roles,
                             double metres_per_unit = 1.0);
 
 // The body's heading (yaw about +Y, the convention of duet::heading_yaw: 0 faces +Z) from world
-// joint positions: the facing is perpendicular to the line from the right hip joint to the left
-// one, on the floor. Independent of the root joint's axes.
+// joint positions: the facing is perpendicular to the mean of the hip line and the shoulder line
+// (right to left, on the floor; the hips alone when the shoulders have no joint). Independent of
+// the root joint's axes.
 double body_heading_yaw(std::span<const Vec3> positions_ws, const JointRoles& roles) noexcept;
 
 // The pelvis centre: the midpoint of the two hip (thigh) joints, which sit at the same place on
