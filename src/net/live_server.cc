@@ -271,7 +271,7 @@ struct LiveServer::Impl {
     const std::int64_t step_us = microseconds(SteadyClock::now() - input.arrival);
     if (recorder) recorder->push(input, out);
     std::shared_ptr<std::string> text = pool.acquire();
-    format_frame(out, loop->params(), step_us, *text);
+    format_frame(out, loop->params(), step_us, *text, frames);  // seq: since the start
     loop_window.record(microseconds(SteadyClock::now() - input.arrival));
     server.broadcast_frame(std::move(text), input.arrival);
     ++frames;

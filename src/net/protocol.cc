@@ -197,11 +197,11 @@ std::string make_hello(const LiveLoop& loop, const std::string& source_descripti
 }
 
 void format_frame(const LiveOutput& output, const PartnerParams& params, std::int64_t latency_us,
-                  std::string& text) {
+                  std::string& text, long long seq) {
   text.clear();
   const FollowResult& f = output.follow;
   text += "{\"type\":\"frame\",\"seq\":";
-  append_int(text, output.seq);
+  append_int(text, seq >= 0 ? seq : output.seq);
   text += ",\"time_s\":";
   append_number(text, output.time_s, 4);
   text += ",\"follower\":{\"take\":";

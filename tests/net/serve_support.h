@@ -74,13 +74,13 @@ class ServeProcess {
     if (stdout_fd_ >= 0) ::close(stdout_fd_);
   }
 
-  // Starts `duet serve ARGS --http 127.0.0.1:0`; stderr goes to `log_path`. Waits for the
-  // address line.
+  // Starts `duet serve ARGS --http 127.0.0.1:0` (or `http`); stderr goes to `log_path`. Waits for
+  // the address line; false if the process exits first (see wait_exit()).
   bool start(std::vector<std::string> args, const fs::path& log_path,
-             std::chrono::milliseconds timeout = 60s) {
+             std::chrono::milliseconds timeout = 60s, const std::string& http = "127.0.0.1:0") {
     log_path_ = log_path;
     args.insert(args.begin(), {DUET_BINARY, "serve"});
-    args.insert(args.end(), {"--http", "127.0.0.1:0"});
+    args.insert(args.end(), {"--http", http});
     int out[2];
     if (::pipe(out) != 0) return false;
     posix_spawn_file_actions_t actions;
@@ -111,8 +111,9 @@ class ServeProcess {
       if (n <= 0) return false;  // exited
       text.append(buffer, static_cast<std::size_t>(n));
       const std::size_t at = text.find("http://127.0.0.1:");
-      if (at != std::string::npos && text.find('/', at + 17) != std::string::npos) {
+      if (at != std::string::npos && text.find('\n', at) != std::string::npos) {
         port_ = static_cast<std::uint16_t>(std::stoi(text.substr(at + 17)));
+        address_line_ = text.substr(at, text.find('\n', at) - at);
         return true;
       }
     }
@@ -120,6 +121,23 @@ class ServeProcess {
   }
 
   std::uint16_t port() const { return port_; }
+  pid_t pid() const { return pid_; }
+  // From "http://..." to the end of the address line.
+  const std::string& address_line() const { return address_line_; }
+
+  // Waits for the process to exit by itself; its exit status (-1 on timeout or a crash).
+  int wait_exit(std::chrono::milliseconds timeout = 60s) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    int status = 0;
+    while (pid_ > 0 && std::chrono::steady_clock::now() < deadline) {
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+      }
+      std::this_thread::sleep_for(10ms);
+    }
+    return -1;
+  }
   std::string log() const { return read_text(log_path_); }
 
   // Sends `signal` and waits for the exit; returns the exit status (-1 on timeout or a crash).
@@ -149,6 +167,7 @@ class ServeProcess {
   pid_t pid_ = -1;
   int stdout_fd_ = -1;
   std::uint16_t port_ = 0;
+  std::string address_line_;
   fs::path log_path_;
 };
 
@@ -156,9 +175,18 @@ class ServeProcess {
 // of hanging it).
 class WsClient {
  public:
-  bool connect(std::uint16_t port, const std::string& target = "/ws") {
+  // `from`: the local address to connect from (another loopback address such as 127.0.0.2
+  // looks like another machine to the server's per-address limits).
+  bool connect(std::uint16_t port, const std::string& target = "/ws",
+               const std::string& from = "") {
     beast::error_code result = asio::error::would_block;
     auto& layer = beast::get_lowest_layer(ws_);
+    if (!from.empty()) {
+      beast::error_code ec;
+      layer.socket().open(tcp::v4(), ec);
+      if (!ec) layer.socket().bind(tcp::endpoint(asio::ip::make_address(from), 0), ec);
+      if (ec) return false;
+    }
     layer.expires_after(5s);
     layer.async_connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port),
                         [&](beast::error_code ec) { result = ec; });

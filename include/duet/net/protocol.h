@@ -31,9 +31,10 @@ constexpr std::size_t kMaxJsonValues = 16384;
 // role, the template frame rate and the corrections.
 std::string make_hello(const LiveLoop& loop, const std::string& source_description);
 
-// `frame`: appends to `text` after clearing it.
+// `frame`: appends to `text` after clearing it. `seq` >= 0 replaces output.seq (the server counts
+// frames across role switches, which change the loop).
 void format_frame(const LiveOutput& output, const PartnerParams& params, std::int64_t latency_us,
-                  std::string& text);
+                  std::string& text, long long seq = -1);
 
 struct LatencySummary {
   std::int64_t p50 = 0, p99 = 0, max = 0, count = 0;
