@@ -1,6 +1,9 @@
 // WebSocket link to `duet serve` (docs/protocol.md): parses JSON messages, reconnects on loss.
 
-/** The server's /ws on the host that served the page (with the page's `?token=`), unless `?ws=URL` overrides it. */
+/**
+ * The server's /ws on the host that served the page (with the page's `?token=`, which control
+ * needs on a networked server), unless `?ws=URL` overrides it.
+ */
 export function defaultSocketUrl(location) {
   const override = new URLSearchParams(location.search).get('ws');
   if (override) return override;
