@@ -28,8 +28,8 @@ constexpr std::size_t kReadChunk = 64 * 1024;
 constexpr auto kHttpWriteTimeout = std::chrono::seconds(30);  // sending a response
 constexpr auto kWsHandshakeTimeout = std::chrono::seconds(10);
 constexpr std::string_view kBusyResponse =
-    "HTTP/1.1 503 Service Unavailable\r\nContent-Type: text/plain\r\nContent-Length: 26\r\n"
-    "Connection: close\r\n\r\nToo many connections. Retry\n";
+    "HTTP/1.1 503 Service Unavailable\r\nContent-Type: text/plain\r\nContent-Length: 22\r\n"
+    "Connection: close\r\n\r\nToo many connections.\n";
 constexpr std::string_view kServerName = "duet-serve";
 
 class HttpSession;

@@ -123,9 +123,11 @@ TEST(ServeRobustness, RoleSwitchStormKeepsFramesThreadsMemoryAndRecordingBounded
   EXPECT_LE(swaps, static_cast<std::ptrdiff_t>((storm_s + 0.5) / 0.25) + 3);
   EXPECT_GT(frames, 20);
   EXPECT_GT(last_seq, first_seq);
-  EXPECT_LE(threads_after, threads_before + 1);      // no thread per switch
-  EXPECT_LT(vm_after - vm_before, 256LL * 1024);     // kB: no stack per switch
+  EXPECT_LE(threads_after, threads_before + 1);  // no thread per switch
 #if defined(NDEBUG) && !defined(DUET_SANITIZED)
+  // kB. A finished thread left unjoined is not in Threads but keeps its 8 MB stack mapped; one
+  // malloc arena (64 MB) for the second recorder's thread is expected.
+  EXPECT_LT(vm_after - vm_before, 128LL * 1024);
   EXPECT_LT(max_gap_s, 0.5);  // frames kept flowing (60 Hz: 17 ms apart)
   EXPECT_GT(last_seq - first_seq, 150);  // of about 360 at 60 Hz over 6 s
 #endif
