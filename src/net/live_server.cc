@@ -152,8 +152,7 @@ struct LiveServer::Impl {
     r.user_metres_per_unit = default_metres_per_unit(user.roles.convention);
     r.partner_metres_per_unit =
         default_metres_per_unit(role_loop.library().takes()[0].response_motion.roles.convention);
-    return SessionRecorder::start(r, user.skeleton, role_loop.partner_skeleton(),
-                                  user.frame_rate);
+    return SessionRecorder::start(r, user.skeleton, role_loop.partner_skeleton(), user.frame_rate);
   }
 
   Status start_recording(const std::string& stem) {
@@ -338,7 +337,7 @@ struct LiveServer::Impl {
     if (message.replay_seek_s) replay->seek(*message.replay_seek_s, now);
     if (message.replay_paused) replay->set_paused(*message.replay_paused, now);
     source_end_reported = false;  // a seek may bring a finished replay back
-    drain();  // a seek while paused delivers its frame now
+    drain();                      // a seek while paused delivers its frame now
     broadcast_replay_state();
   }
 

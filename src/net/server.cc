@@ -101,8 +101,7 @@ std::optional<std::string_view> query_value(beast::string_view target, std::stri
 bool same_secret(std::string_view a, std::string_view b) {
   if (a.size() != b.size()) return false;
   unsigned char diff = 0;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+  for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
   return diff == 0;
 }
 
@@ -138,8 +137,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void run(Request request) {
     request_ = std::move(request);
     const std::string& token = server_->options.control_token;
-    control_ = token.empty() || same_secret(query_value(request_.target(), "token").value_or(""),
-                                            token);
+    control_ =
+        token.empty() || same_secret(query_value(request_.target(), "token").value_or(""), token);
     beast::error_code ec;
     beast::get_lowest_layer(ws_).socket().set_option(tcp::no_delay(true), ec);
     // Idle: a ping after half the timeout without input, closed after all of it. A browser
@@ -334,8 +333,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 // Plain HTTP: static files, the placeholder page, and the upgrade to a WebSocket at /ws.
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
-  HttpSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server,
-              asio::ip::address remote)
+  HttpSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server, asio::ip::address remote)
       : stream_(std::move(socket)), server_(std::move(server)), remote_(std::move(remote)) {
     server_->http_sessions.insert(this);
   }

@@ -1,8 +1,7 @@
 // `duet serve` against viewers that misbehave, end to end over loopback: a role-switch storm,
 // the control token, reset, bind errors, the close frame on shutdown.
-#include <gtest/gtest.h>
-
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 
 #include <cstdio>
 #include <functional>
@@ -14,9 +13,15 @@ namespace duet::test {
 namespace {
 
 std::vector<std::string> replay_args(const fs::path& record) {
-  std::vector<std::string> args = {"--pair", salsa("60", "03"), salsa("61", "03"), "--fps", "60",
-                                   "--source", "replay:" + salsa("60", "03") + "?loop=1",
-                                   "--log-interval", "0"};
+  std::vector<std::string> args = {"--pair",
+                                   salsa("60", "03"),
+                                   salsa("61", "03"),
+                                   "--fps",
+                                   "60",
+                                   "--source",
+                                   "replay:" + salsa("60", "03") + "?loop=1",
+                                   "--log-interval",
+                                   "0"};
   if (record.empty()) {
     args.push_back("--no-record");
   } else {
@@ -114,10 +119,11 @@ TEST(ServeRobustness, RoleSwitchStormKeepsFramesThreadsMemoryAndRecordingBounded
   std::ptrdiff_t swaps = 0;
   for (std::size_t at = 0; (at = log.find("the user now dances", at)) != std::string::npos; ++at)
     ++swaps;
-  std::printf("role storm: %d switches in %.1f s, %td applied, %d frames read, seq %lld -> %lld, "
-              "max gap %.3f s, threads %lld -> %lld, VmSize %lld -> %lld MB\n",
-              kSwitches, storm_s, swaps, frames, first_seq, last_seq, max_gap_s, threads_before,
-              threads_after, vm_before / 1024, vm_after / 1024);
+  std::printf(
+      "role storm: %d switches in %.1f s, %td applied, %d frames read, seq %lld -> %lld, "
+      "max gap %.3f s, threads %lld -> %lld, VmSize %lld -> %lld MB\n",
+      kSwitches, storm_s, swaps, frames, first_seq, last_seq, max_gap_s, threads_before,
+      threads_after, vm_before / 1024, vm_after / 1024);
   // Coalesced: at most one switch per 250 ms (plus the first and a pending one).
   EXPECT_GE(swaps, 2);
   EXPECT_LE(swaps, static_cast<std::ptrdiff_t>((storm_s + 0.5) / 0.25) + 3);
@@ -128,7 +134,7 @@ TEST(ServeRobustness, RoleSwitchStormKeepsFramesThreadsMemoryAndRecordingBounded
   // kB. A finished thread left unjoined is not in Threads but keeps its 8 MB stack mapped; one
   // malloc arena (64 MB) for the second recorder's thread is expected.
   EXPECT_LT(vm_after - vm_before, 128LL * 1024);
-  EXPECT_LT(max_gap_s, 0.5);  // frames kept flowing (60 Hz: 17 ms apart)
+  EXPECT_LT(max_gap_s, 0.5);             // frames kept flowing (60 Hz: 17 ms apart)
   EXPECT_GT(last_seq - first_seq, 150);  // of about 360 at 60 Hz over 6 s
 #endif
 
@@ -179,8 +185,8 @@ TEST(ServeRobustness, ControlNeedsTheTokenAndResetRestoresCorrections) {
   for (int k = 0; k < 200 && !applied; ++k) {
     frame = controller.read_type("frame");
     ASSERT_TRUE(frame);
-    applied = (*frame)["corrections"]["contact"] == false &&
-              (*frame)["corrections"]["blend"] == true;
+    applied =
+        (*frame)["corrections"]["contact"] == false && (*frame)["corrections"]["blend"] == true;
   }
   EXPECT_TRUE(applied);
   // reset: back to the switches the server started with.
@@ -189,8 +195,8 @@ TEST(ServeRobustness, ControlNeedsTheTokenAndResetRestoresCorrections) {
   for (int k = 0; k < 200 && !restored; ++k) {
     frame = controller.read_type("frame");
     ASSERT_TRUE(frame);
-    restored = (*frame)["corrections"]["contact"] == true &&
-               (*frame)["corrections"]["blend"] == false;
+    restored =
+        (*frame)["corrections"]["contact"] == true && (*frame)["corrections"]["blend"] == false;
   }
   EXPECT_TRUE(restored);
 
@@ -223,8 +229,7 @@ TEST(ServeRobustness, BindFailuresSayWhyAndExitNonZero) {
     EXPECT_FALSE(server.start(replay_args({}), dir.path / "foreign.log", 60s, "192.0.2.1:0"));
     EXPECT_EQ(server.wait_exit(), 1);
     const std::string log = server.log();
-    EXPECT_NE(log.find("cannot bind: Cannot assign requested address"), std::string::npos)
-        << log;
+    EXPECT_NE(log.find("cannot bind: Cannot assign requested address"), std::string::npos) << log;
   }
 }
 

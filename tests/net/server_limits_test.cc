@@ -231,7 +231,8 @@ TEST(ServerLimits, WebSocketClientsThatAnswerNoPingAreClosed) {
   live.stream().async_read(buffer, [&](beast::error_code ec, std::size_t) { live_result = ec; });
   live.io().restart();
   const auto deadline = std::chrono::steady_clock::now() + 30s;
-  while (server.clients() > 1 && std::chrono::steady_clock::now() < deadline) live.io().run_for(50ms);
+  while (server.clients() > 1 && std::chrono::steady_clock::now() < deadline)
+    live.io().run_for(50ms);
   EXPECT_EQ(server.clients(), 1) << "the silent client was not closed";
   live.io().run_for(6s);  // beyond another idle timeout: pings answered, still open
   EXPECT_GE(pings, 1);
@@ -275,9 +276,8 @@ TEST(ServerLimits, StopSendsGoingAway) {
   });
   EXPECT_FALSE(viewer.read_text(20s));  // the read ends with the close
   EXPECT_EQ(viewer.stream().reason().code, websocket::close_code::going_away);
-  EXPECT_TRUE(server.eventually([&] {
-    return server.call([&] { return server.server().connection_count(); }) == 0;
-  }));
+  EXPECT_TRUE(server.eventually(
+      [&] { return server.call([&] { return server.server().connection_count(); }) == 0; }));
 }
 
 }  // namespace

@@ -40,8 +40,8 @@ struct ServerOptions {
   std::uint16_t port = 8080;          // 0: any free port (see Server::port())
   std::filesystem::path web_dir;      // the viewer's files; empty or missing: a placeholder page
   std::size_t max_message_bytes = kMaxClientMessageBytes;
-  int max_queued_frames = 2;     // per client, besides the one being written
-  int max_queued_messages = 32;  // per client: hello, stats, error replies
+  int max_queued_frames = 2;         // per client, besides the one being written
+  int max_queued_messages = 32;      // per client: hello, stats, error replies
   int max_clients = 64;              // WebSocket connections; more are refused with 503
   int max_clients_per_address = 16;  // WebSocket connections from one remote address (503)
   int max_http_connections = 256;    // plain HTTP connections; more get 503 and are closed
