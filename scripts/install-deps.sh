@@ -2,8 +2,8 @@
 # Installs the build and test dependencies from Debian 12 packages (needs root or sudo).
 set -euo pipefail
 packages=(
-  build-essential cmake ninja-build clang git curl ca-certificates
-  libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
+  build-essential cmake ninja-build ccache clang git curl ca-certificates
+  libeigen3-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox libboost1.81-dev
   chromium fonts-liberation
 )

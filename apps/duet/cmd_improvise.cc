@@ -10,7 +10,9 @@
 #include "duet/eval/performance.h"
 #include "duet/io/atomic_write.h"
 #include "duet/io/bvh.h"
+#include "duet/io/motion_argument.h"
 #include "duet/live/duet_library.h"
+#include "library_options.h"
 
 namespace duet::app {
 
@@ -19,6 +21,8 @@ namespace {
 struct ImproviseArgs {
   std::string from;
   std::vector<std::string> pair_files;
+  std::string library;
+  std::string data_dir;
   int take = -1;
   std::string role = "leader";
   std::optional<double> fps;
@@ -53,13 +57,38 @@ int run_improvise(const ImproviseArgs& args) {
   // Where the motion comes from: one file (take 0), or the user's role in pair K of a list (take
   // K, the index `duet follow --pair ...` gives that take when the same pairs are passed).
   const bool from_file = !args.from.empty();
-  if (from_file == !args.pair_files.empty()) {
-    return usage_error("give either --from FILE or --pair LEADER PARTNER [...] with --take K");
+  if (from_file == (!args.pair_files.empty() || !args.library.empty())) {
+    return usage_error(
+        "give either --from FILE or --library FILE / --pair LEADER PARTNER [...] with --take K");
   }
   if (from_file && (args.take >= 0 || args.across_takes)) {
-    return usage_error("--take and --across-takes go with --pair, not --from");
+    return usage_error("--take and --across-takes go with --pair or --library, not --from");
   }
-  const int pairs = static_cast<int>(args.pair_files.size() / 2);
+  if (args.pair_files.size() % 2 != 0) {
+    return usage_error("--pair takes two files, LEADER and PARTNER; got only '" +
+                       args.pair_files.back() + "'");
+  }
+  // The pairs (a library file's, then --pair's) and their load options (the file's fps).
+  std::vector<PairFiles> pair_list;
+  MotionLoadOptions load;
+  load.frame_rate = args.fps;
+  load.metres_per_unit = args.scale;
+  if (!from_file) {
+    LibraryArgs library_args;
+    library_args.pair_files = args.pair_files;
+    library_args.library = args.library;
+    library_args.data_dir = args.data_dir;
+    library_args.fps = args.fps;
+    library_args.scale = args.scale;
+    Result<LibrarySetup> setup = resolve_library(library_args);
+    if (!setup) {
+      fmt::print(stderr, "{}: {}\n", kCommand, setup.error().message);
+      return kExitFailure;
+    }
+    pair_list = std::move(setup.value().pairs);
+    load = setup.value().options.load;
+  }
+  const int pairs = static_cast<int>(pair_list.size());
   if (!from_file && (args.take < 0 || args.take >= pairs)) {
     return usage_error(args.take < 0 ? std::string("--pair needs --take K (0-based)")
                                      : fmt::format("--take {}: there are {} pairs (0..{})",
@@ -77,19 +106,16 @@ int run_improvise(const ImproviseArgs& args) {
     return usage_error("--across-takes needs --mode improv");
   }
 
-  MotionLoadOptions load;
-  load.frame_rate = args.fps;
-  load.metres_per_unit = args.scale;
-  std::vector<std::string> files;
+  std::vector<std::vector<std::string>> files;
   std::vector<int> indices;
   if (from_file) {
-    files.push_back(args.from);
+    files.push_back(split_motion_argument(args.from).value());  // checked by motion_word_check
     indices.push_back(0);
   } else {
-    const std::size_t offset = role == DancerRole::kLeader ? 0 : 1;
     for (int k = 0; k < pairs; ++k) {
       if (k != args.take && !args.across_takes) continue;
-      files.push_back(args.pair_files[2 * static_cast<std::size_t>(k) + offset]);
+      const PairFiles& pair = pair_list[static_cast<std::size_t>(k)];
+      files.push_back(role == DancerRole::kLeader ? pair.leader : pair.partner);
       indices.push_back(k);
     }
     // The performed take first.
@@ -98,14 +124,15 @@ int run_improvise(const ImproviseArgs& args) {
     std::iter_swap(indices.begin(), it);
   }
   std::vector<LoadedMotion> motions;
-  for (const std::string& file : files) {
-    Result<LoadedMotion> motion = load_motion({file}, load);
+  for (const std::vector<std::string>& file : files) {
+    Result<LoadedMotion> motion = load_motion(file, load);
     if (!motion) {
       fmt::print(stderr, "{}: {}\n", kCommand, motion.error().message);
       return kExitFailure;
     }
     if (motion.value().clip.frame_count() < 2) {
-      fmt::print(stderr, "{}: {}: needs at least 2 frames\n", kCommand, file);
+      fmt::print(stderr, "{}: {}: needs at least 2 frames\n", kCommand,
+                 join_motion_argument(file));
       return kExitFailure;
     }
     motions.push_back(std::move(motion).value());
@@ -183,19 +210,32 @@ int run_improvise(const ImproviseArgs& args) {
 Command register_improvise(CLI::App& app) {
   auto args = std::make_shared<ImproviseArgs>();
   auto* source = app.add_option_group("source", "Where the performance comes from");
-  source->add_option("--from", args->from, "One take of the user's role (BVH); its take index is 0")
-      ->check(CLI::ExistingFile);
+  source
+      ->add_option("--from", args->from,
+                   "One take of the user's role (BVH or SKELETON.asf+MOTION.amc); its take index "
+                   "is 0")
+      ->check(motion_word_check());
+  source
+      ->add_option("--library", args->library,
+                   "The duets as for `duet follow`: a library file or a directory "
+                   "(libraries/cmu-salsa.toml). The truth's take is the pair's index in it")
+      ->check(CLI::ExistingPath);
   source
       ->add_option("--pair", args->pair_files,
-                   "A captured duet: LEADER then PARTNER file; repeat as for `duet follow`. The "
-                   "truth's take is the index of the pair in this list")
+                   "A captured duet: LEADER then PARTNER (BVH or SKELETON.asf+MOTION.amc); repeat "
+                   "as for `duet follow`. The truth's take is the index of the pair in the list "
+                   "(after --library's)")
+      ->type_name("LEADER PARTNER")
       ->expected(2)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
-      ->check(CLI::ExistingFile);
-  source->add_option("--take", args->take, "With --pair: the pair to perform from (0-based)");
+      ->check(motion_word_check());
+  source->add_option("--data-dir", args->data_dir,
+                     "What ${data} means in a library file (default: $DUET_DATA_DIR)")
+      ->check(CLI::ExistingDirectory);
+  source->add_option("--take", args->take, "With --pair/--library: the pair to perform from (0-based)");
   source->add_option("--role", args->role, "With --pair: the dancer the user dances")
       ->check(CLI::IsMember({"leader", "partner"}));
-  source->add_option("--fps", args->fps, "Frame rate of the source file(s) (salsa: 60)")
+  source->add_option("--fps", args->fps, "Frame rate of the source file(s), overriding the library file's (salsa: 60)")
       ->check(CLI::PositiveNumber);
   source->add_option("--scale", args->scale, "Metres per unit of the source file(s)")
       ->check(CLI::PositiveNumber);

@@ -239,16 +239,10 @@ int run_serve(const ServeArgs& args) {
   // The other role is built on demand (a `role` message), on a background thread.
   net::LoopFactory factory =
       [args, user](DancerRole role, const PartnerParams& p) -> Result<std::unique_ptr<LiveLoop>> {
-    LibraryOptions library_options;
-    library_options.role = role;
-    library_options.load.frame_rate = args.library.fps;
-    library_options.load.metres_per_unit = args.library.scale;
-    library_options.trim_to_shorter = args.library.trim;
-    std::vector<PairFiles> pairs;
-    for (std::size_t k = 0; k + 1 < args.library.pair_files.size(); k += 2) {
-      pairs.push_back({args.library.pair_files[k], args.library.pair_files[k + 1]});
-    }
-    Result<DuetLibrary> other = DuetLibrary::load(pairs, library_options);
+    Result<LibrarySetup> setup = resolve_library(args.library);
+    if (!setup) return setup.error();
+    setup.value().options.role = role;
+    Result<DuetLibrary> other = DuetLibrary::load(setup.value().pairs, setup.value().options);
     if (!other) return other.error();
     return make_loop(std::make_shared<const DuetLibrary>(std::move(other).value()), args.tracker,
                      user, p);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <filesystem>
 
+#include "duet/io/motion_argument.h"
+
 namespace duet {
 
 bool parse_dancer_role(const std::string& text, DancerRole& role) {
@@ -23,6 +25,15 @@ const char* dancer_role_name(DancerRole role) {
 }
 
 namespace {
+
+// The motion file names the take: the .bvh, or the .amc of an ASF+AMC pair (not the skeleton).
+std::string take_name_of(const MotionFiles& files) {
+  for (const std::string& file : files) {
+    const std::filesystem::path p(file);
+    if (p.extension() != ".asf" && p.extension() != ".ASF") return p.stem().string();
+  }
+  return files.empty() ? std::string() : std::filesystem::path(files[0]).stem().string();
+}
 
 Status check_duet(const std::string& what, LoadedMotion& leader, LoadedMotion& partner,
                   bool trim_to_shorter) {
@@ -56,26 +67,28 @@ Status check_duet(const std::string& what, LoadedMotion& leader, LoadedMotion& p
 
 Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
                                       const LibraryOptions& options, const Progress& progress) {
-  if (pairs.empty()) return Error{"no duet given (--pair LEADER PARTNER)"};
+  if (pairs.empty()) return Error{"no duet given (--pair LEADER PARTNER or --library FILE)"};
   DuetLibrary library;
   library.options_ = options;
   std::vector<FeatureMatrix> raw_features;
   int total_frames = 0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const PairFiles& pair = pairs[k];
-    if (progress) progress(static_cast<int>(k), static_cast<int>(pairs.size()), pair.leader);
-    Result<LoadedMotion> leader = load_motion({pair.leader}, options.load);
+    const std::string leader_word = join_motion_argument(pair.leader);
+    const std::string partner_word = join_motion_argument(pair.partner);
+    if (progress) progress(static_cast<int>(k), static_cast<int>(pairs.size()), leader_word);
+    Result<LoadedMotion> leader = load_motion(pair.leader, options.load);
     if (!leader) return leader.error();
-    Result<LoadedMotion> partner = load_motion({pair.partner}, options.load);
+    Result<LoadedMotion> partner = load_motion(pair.partner, options.load);
     if (!partner) return partner.error();
-    const std::string what = "pair " + std::to_string(k + 1) + " (" + pair.leader + ", " +
-                             pair.partner + ")";
+    const std::string what = "pair " + std::to_string(k + 1) + " (" + leader_word + ", " +
+                             partner_word + ")";
     if (Status ok = check_duet(what, leader.value(), partner.value(), options.trim_to_shorter);
         !ok) {
       return ok.error();
     }
     DuetTake take;
-    take.name = std::filesystem::path(pair.leader).stem().string();
+    take.name = pair.name.empty() ? take_name_of(pair.leader) : pair.name;
     const bool user_leads = options.role == DancerRole::kLeader;
     take.template_motion = std::move(user_leads ? leader.value() : partner.value());
     take.response_motion = std::move(user_leads ? partner.value() : leader.value());

@@ -268,7 +268,7 @@ TEST(PartnerRun, RealTakeFollowedExactly) {
   LibraryOptions options;
   options.load.frame_rate = 60.0;
   Result<DuetLibrary> library =
-      DuetLibrary::load({{dir + "60/60_10_scaled.bvh", dir + "61/61_10_scaled.bvh"}}, options);
+      DuetLibrary::load({{{dir + "60/60_10_scaled.bvh"}, {dir + "61/61_10_scaled.bvh"}}}, options);
   ASSERT_TRUE(library) << library.error().message;
   const DuetLibrary& lib = library.value();
   const DuetTake& take = lib.takes()[0];

@@ -21,8 +21,8 @@ LibraryOptions salsa_options(DancerRole role) {
 }
 
 TEST(DuetLibrary, ConcatenatesTakesAndSwapsRoles) {
-  const std::vector<PairFiles> pairs = {{salsa("60", "10"), salsa("61", "10")},
-                                        {salsa("60", "05"), salsa("61", "05")}};
+  const std::vector<PairFiles> pairs = {{{salsa("60", "10")}, {salsa("61", "10")}},
+                                        {{salsa("60", "05")}, {salsa("61", "05")}}};
   Result<DuetLibrary> leader = DuetLibrary::load(pairs, salsa_options(DancerRole::kLeader));
   ASSERT_TRUE(leader) << leader.error().message;
   EXPECT_EQ(leader.value().model().num_states(), 1197 + 1678);
@@ -44,7 +44,7 @@ TEST(DuetLibrary, ConcatenatesTakesAndSwapsRoles) {
 }
 
 TEST(DuetLibrary, RejectsPairsThatAreNotDuets) {
-  const std::vector<PairFiles> pairs = {{salsa("60", "10"), salsa("61", "05")}};
+  const std::vector<PairFiles> pairs = {{{salsa("60", "10")}, {salsa("61", "05")}}};
   Result<DuetLibrary> library = DuetLibrary::load(pairs, salsa_options(DancerRole::kLeader));
   ASSERT_FALSE(library);
   EXPECT_NE(library.error().message.find("different frame counts (1197 and 1678)"),
@@ -57,14 +57,14 @@ TEST(DuetLibrary, RejectsPairsThatAreNotDuets) {
   EXPECT_EQ(trimmed.value().model().num_states(), 1197);
   EXPECT_FALSE(DuetLibrary::load({}, trim));
   Result<DuetLibrary> missing =
-      DuetLibrary::load({{"/nonexistent/a.bvh", salsa("61", "05")}}, trim);
+      DuetLibrary::load({{{"/nonexistent/a.bvh"}, {salsa("61", "05")}}}, trim);
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error().message.find("/nonexistent/a.bvh"), std::string::npos);
 }
 
 TEST(FollowSession, TracksAnUnperturbedTakeExactly) {
-  const std::vector<PairFiles> pairs = {{salsa("60", "10"), salsa("61", "10")},
-                                        {salsa("60", "03"), salsa("61", "03")}};
+  const std::vector<PairFiles> pairs = {{{salsa("60", "10")}, {salsa("61", "10")}},
+                                        {{salsa("60", "03")}, {salsa("61", "03")}}};
   Result<DuetLibrary> library = DuetLibrary::load(pairs, salsa_options(DancerRole::kLeader));
   ASSERT_TRUE(library) << library.error().message;
   const DuetTake& take = library.value().takes()[1];

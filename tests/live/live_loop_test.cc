@@ -25,7 +25,7 @@ const Fixture& fixture() {
     LibraryOptions options;
     options.load.frame_rate = 60.0;
     Result<DuetLibrary> library =
-        DuetLibrary::load({{salsa("60", "03"), salsa("61", "03")}}, options);
+        DuetLibrary::load({{{salsa("60", "03")}, {salsa("61", "03")}}}, options);
     EXPECT_TRUE(library) << library.error().message;
     MotionLoadOptions load;
     load.frame_rate = 60.0;

@@ -21,9 +21,15 @@ enum class DancerRole { kLeader, kPartner };
 bool parse_dancer_role(const std::string& text, DancerRole& role);
 const char* dancer_role_name(DancerRole role);
 
+// One dancer of a captured duet, as load_motion() takes it: {take.bvh} or {skeleton.asf,
+// motion.amc}. On the command line it is one word, "take.bvh" or "skeleton.asf+motion.amc"
+// (duet/io/motion_argument.h); in a library file a string or a two-element array.
+using MotionFiles = std::vector<std::string>;
+
 struct PairFiles {
-  std::string leader;
-  std::string partner;
+  MotionFiles leader;
+  MotionFiles partner;
+  std::string name = {};  // the take's name; empty: the stem of the leader's motion file
 };
 
 struct LibraryOptions {
@@ -35,7 +41,7 @@ struct LibraryOptions {
 };
 
 struct DuetTake {
-  std::string name;  // the leader file's stem, e.g. "60_01_scaled"
+  std::string name;  // PairFiles::name, else the leader's motion file stem, e.g. "60_01_scaled"
   LoadedMotion template_motion;
   LoadedMotion response_motion;
   int first_state = 0;  // index of this take's frame 0 among all template states
