@@ -7,20 +7,17 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 data_dir=${1:-$(scripts/get-data.sh)}
 duet=build/apps/duet/duet
-salsa="$data_dir/cmu-salsa/bvh"
 mkdir -p out
-if [ ! -d "$salsa" ]; then
-  # Downloaded CMU originals only (ASF + AMC): describe one take.
-  "$duet" inspect --fps 60 "$data_dir/cmu-salsa/asf-amc/60.asf" "$data_dir/cmu-salsa/asf-amc/60_01.amc"
-  exit 0
+# The library file: the BVH duets, or the CMU originals (ASF + AMC) that get-data.sh downloads.
+library=libraries/cmu-salsa.toml
+if [ ! -d "$data_dir/cmu-salsa/bvh" ]; then
+  library=libraries/cmu-salsa-asf-amc.toml
 fi
-pairs=()
-for trial in 01 02 03 04 05 06 07 09 10 11 12 13 14 15; do
-  pairs+=(--pair "$salsa/60/60_${trial}_scaled.bvh" "$salsa/61/61_${trial}_scaled.bvh")
-done
-# Take 03 is the third pair in the list: its truth rows say take 2.
-"$duet" improvise "${pairs[@]}" --take 2 --fps 60 --noise-deg 2 --noise-cm 1 --seed 7 \
+lib=(--library "$library" --data-dir "$data_dir")
+# Take 03 is the third pair in the library: its truth rows say take 2. The library file sets
+# the salsa frame rate (60 fps; the BVH headers say 120).
+"$duet" improvise "${lib[@]}" --take 2 --noise-deg 2 --noise-cm 1 --seed 7 \
   -o out/performance.bvh --truth out/truth.csv
-"$duet" follow "${pairs[@]}" --fps 60 --input out/performance.bvh --input-fps 60 \
+"$duet" follow "${lib[@]}" --input out/performance.bvh --input-fps 60 \
   --truth out/truth.csv --trace out/trace.csv -o out/partner.bvh --user-output out/user.bvh
 echo "partner motion: out/partner.bvh (with the user in out/user.bvh); per-frame trace: out/trace.csv" >&2
