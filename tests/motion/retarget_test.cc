@@ -166,6 +166,31 @@ TEST(Retarget, ToAndFromTheBandaiRig) {
                     direction_errors(bandai.clip, bandai.roles, dance, src.roles, false), 2.0);
 }
 
+TEST(Retarget, TheBandaiRigsClaviclesKeepTheShoulderLine) {
+  // The Bandai rig's rest pose has every bone along one axis: a copied clavicle rotation tilted
+  // its shoulder line (right -> left upper arm joint) by 47 degrees on every frame. Turned
+  // like bones, the clavicles put the shoulders where the source's are.
+  const LoadedMotion& src = salsa();
+  const LoadedMotion bandai = load({data("bandai/dataset-1_dance-short_normal_001.bvh")});
+  const Clip there =
+      retarget_or_fail(src.clip, src.roles, bandai.clip.skeleton_ptr(), bandai.roles);
+  const std::vector<Vec3> pa = world_positions(src.clip), pb = world_positions(there);
+  const auto na = static_cast<std::size_t>(src.clip.joint_count()),
+             nb = static_cast<std::size_t>(there.joint_count());
+  std::vector<double> errors;
+  for (int f = 0; f < there.frame_count(); ++f) {
+    auto line = [f](const std::vector<Vec3>& p, std::size_t n, const JointRoles& r) {
+      const std::size_t base = static_cast<std::size_t>(f) * n;
+      return Vec3(p[base + static_cast<std::size_t>(r[Role::kLeftShoulder])] -
+                  p[base + static_cast<std::size_t>(r[Role::kRightShoulder])]);
+    };
+    errors.push_back(angle_deg(line(pa, na, src.roles), line(pb, nb, bandai.roles)));
+  }
+  const Stats s = stats(errors);
+  std::printf("shoulder line on the Bandai rig: median %.2f deg, max %.2f deg\n", s.median, s.max);
+  EXPECT_LT(s.median, 3.0);
+}
+
 TEST(Retarget, OntoAProportionedRigKeepsDirectionsFeetAndScaledStrides) {
   const LoadedMotion& src = salsa();
   const RigProportions proportions = RigProportions::evaluation_variant();
