@@ -335,7 +335,9 @@ Performance with_sensor_noise(Performance performance, const SensorNoiseOptions&
         const Vec3 v(angle(rng), angle(rng), angle(rng));
         rotations[i] = (rotations[i] * exp_map(v)).normalized();
       }
-      if (options.position_m > 0.0 && joint.has_position_channels()) {
+      // The root's position only: a rig that animates every joint's offset (the Bandai rig)
+      // carries its bone lengths there, which no sensor shakes.
+      if (options.position_m > 0.0 && j == 0 && joint.has_position_channels()) {
         translations[i] += Vec3(position(rng), position(rng), position(rng));
       }
     }

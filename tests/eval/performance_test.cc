@@ -282,6 +282,36 @@ TEST(Perturbations, SensorNoiseHasTheRequestedSizeAndKeepsTheTruth) {
   }
 }
 
+TEST(Perturbations, SensorNoiseMovesTheRootOnlyWhenEveryJointHasPositionChannels) {
+  // Rigs like the Bandai one animate every joint's offset; those are bone lengths, not sensor
+  // positions, and must keep their lengths under the sensor's noise.
+  const Fixture f = make_fixture(120);
+  const Performance clean = play(f.source(), {});
+  auto all_positions = std::make_shared<Skeleton>(clean.motion.skeleton());
+  for (Joint& joint : all_positions->joints) {
+    if (!joint.end_site && !joint.has_position_channels()) {
+      joint.channels.insert(joint.channels.begin(),
+                            {Channel::kXposition, Channel::kYposition, Channel::kZposition});
+    }
+  }
+  Performance on_rig = clean;
+  on_rig.motion = Clip(all_positions, clean.motion.frame_rate(), clean.frame_count());
+  for (int k = 0; k < clean.frame_count(); ++k) {
+    std::ranges::copy(clean.motion.translations_ls(k), on_rig.motion.translations_ls(k).begin());
+    std::ranges::copy(clean.motion.rotations_ls(k), on_rig.motion.rotations_ls(k).begin());
+  }
+  const Performance noisy = with_sensor_noise(on_rig, {0.0, 0.01, 5});
+  double root_moved = 0.0;
+  for (int k = 0; k < clean.frame_count(); ++k) {
+    root_moved += (noisy.motion.translations_ls(k)[0] - on_rig.motion.translations_ls(k)[0]).norm();
+    for (int j = 1; j < clean.motion.joint_count(); ++j) {
+      const auto i = static_cast<std::size_t>(j);
+      EXPECT_EQ(noisy.motion.translations_ls(k)[i], on_rig.motion.translations_ls(k)[i]) << j;
+    }
+  }
+  EXPECT_GT(root_moved / clean.frame_count(), 0.005);
+}
+
 TEST(Perturbations, FrameLossDropsInBurstsAndDelaysTimestamps) {
   const Fixture f = make_fixture(1800);
   const SourceTake source = f.source();

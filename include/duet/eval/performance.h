@@ -106,8 +106,9 @@ struct ImproviseOptions {
 Result<Performance> improvise(std::span<const SourceTake> sources, const ImproviseOptions& options);
 
 // Per-frame sensor noise: every joint's local rotation is multiplied by a random rotation whose
-// rotation vector has independent normal components (RMS angle rotation_deg), and the position
-// channels get independent normal noise (per-axis standard deviation position_m).
+// rotation vector has independent normal components (RMS angle rotation_deg), and the root's
+// position channels get independent normal noise (per-axis standard deviation position_m; other
+// joints' position channels hold bone lengths, which a sensor does not shake).
 struct SensorNoiseOptions {
   double rotation_deg = 0.0;
   double position_m = 0.0;
@@ -159,7 +160,7 @@ struct PerformanceRecipe {
   Vec3 room_offset_m = Vec3::Zero();
   std::shared_ptr<const Skeleton> rig;  // null: the library's own rig
   JointRoles rig_roles;
-  std::string rig_name;                 // for reports ("asf", "bandai", ...)
+  std::string rig_name;      // for reports ("asf", "bandai", ...)
   SensorNoiseOptions noise;  // seed ignored
   FrameLossOptions loss;     // seed ignored
 };
