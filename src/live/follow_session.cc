@@ -36,8 +36,11 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
   }
   bias_.correct(features_);
   const FollowResult result = tracker_->step(features_, dt_s);
-  if (!result.jumped && !result.missing && result.state >= 0 &&
-      result.state < library_->model().num_states()) {
+  // Learn only from frames the library explains well: a motion that is no dance (a walk) must
+  // stay lost, not teach the offset that would make it look like one.
+  if (!result.jumped && !result.missing && !result.lost &&
+      result.best_distance_per_dim <= bias_.params().max_learn_distance_per_dim &&
+      result.state >= 0 && result.state < library_->model().num_states()) {
     const auto& rows = library_->model().features();
     bias_.learn(features_,
                 std::span<const float>(rows.row(result.state).data(),

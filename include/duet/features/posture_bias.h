@@ -1,12 +1,12 @@
 // Online removal of a rig's constant posture offset (issue 10).
 //
 // Two rigs never put their joints at quite the same places: the CMU ASF skeleton's shoulders are
-// 44 cm apart where the salsa BVH's are 23 cm, its head joint sits 4 cm higher, and a rig retargeted
-// by copying local rotations bends its arms differently to reach the same hands. In the canonical
-// body space those differences are a near-constant offset of the posture features, which on take
-// 01 delivered on the ASF rig was larger than the gap between frames 100 ms apart: the follower
-// read the same dance as another one. The offset is estimated online as a slow average of the
-// residual between the (corrected) input and the template frame the follower has confidently
+// 44 cm apart where the salsa BVH's are 23 cm, its head joint sits 4 cm higher, and a rig
+// retargeted by copying local rotations bends its arms differently to reach the same hands. In the
+// canonical body space those differences are a near-constant offset of the posture features, which
+// on take 01 delivered on the ASF rig was larger than the gap between frames 100 ms apart: the
+// follower read the same dance as another one. The offset is estimated online as a slow average of
+// the residual between the (corrected) input and the template frame the follower has confidently
 // matched, and subtracted from later inputs, like cepstral mean normalisation in speech. On the
 // library's own rig the residual averages to about zero, so nothing changes there.
 #pragma once
@@ -18,9 +18,14 @@ namespace duet {
 
 struct PostureBiasParams {
   bool enabled = true;
-  double time_constant_s = 4.0;     // the average's time constant (seconds of confident frames)
-  double min_weight = 0.2;  // a frame's weight is the follower's confidence, at least this
-  float max_offset = 2.0f;          // per dimension, in standardised units (a runaway guard)
+  double time_constant_s = 4.0;  // the average's time constant (seconds of confident frames)
+  double min_weight = 0.2;       // a frame's weight is the follower's confidence, at least this
+  float max_offset = 2.0f;       // per dimension, in standardised units (a runaway guard)
+  // Frames whose best template match is further than this (squared standardised distance per
+  // dimension, as FollowResult::best_distance_per_dim) teach nothing: a tenth of the follower's
+  // lost distance. Learning from every frame let a walk's offset make it look like salsa (the
+  // Bandai walk went from 98 % lost to 69 %); measured in docs/features.md.
+  float max_learn_distance_per_dim = 0.005f;
 };
 
 class PostureBias {
@@ -38,6 +43,7 @@ class PostureBias {
   void reset() noexcept;
 
   std::span<const float> offset() const noexcept { return offset_; }
+  const PostureBiasParams& params() const noexcept { return params_; }
 
  private:
   int begin_ = 0;
