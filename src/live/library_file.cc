@@ -1,5 +1,8 @@
 #include "duet/live/library_file.h"
 
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
@@ -10,9 +13,6 @@
 #include <sstream>
 #include <system_error>
 
-#include <fmt/format.h>
-#include <toml++/toml.h>
-
 #include "duet/io/known_datasets.h"
 #include "duet/io/motion_argument.h"
 
@@ -21,9 +21,16 @@ namespace duet {
 namespace fs = std::filesystem;
 
 std::string library_data_dir(const std::string& data_dir) {
-  if (!data_dir.empty()) return data_dir;
-  const char* env = std::getenv("DUET_DATA_DIR");
-  return env != nullptr ? std::string(env) : std::string();
+  std::string dir = data_dir;
+  if (dir.empty()) {
+    const char* env = std::getenv("DUET_DATA_DIR");
+    if (env != nullptr) dir = env;
+  }
+  // Relative to where the user is, not to the library file that says ${data}.
+  if (dir.empty()) return dir;
+  std::error_code ec;
+  const fs::path absolute = fs::absolute(dir, ec);
+  return ec ? dir : absolute.lexically_normal().string();
 }
 
 namespace {
@@ -41,13 +48,20 @@ bool is_file(const fs::path& p) {
 
 const char* type_name(const toml::node& node) {
   switch (node.type()) {
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    default: return "a date or time";
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array";
+    default:
+      return "a date or time";
   }
 }
 
@@ -68,9 +82,9 @@ class FileReader {
     try {
       root = toml::parse(text.str(), path_);
     } catch (const toml::parse_error& e) {
-      return make_error(path_, static_cast<int>(e.source().begin.line),
-                        std::string("not a valid TOML library file: ") +
-                            std::string(e.description()));
+      return make_error(
+          path_, static_cast<int>(e.source().begin.line),
+          std::string("not a valid TOML library file: ") + std::string(e.description()));
     }
     spec_.source = path_;
     if (!read_top(root)) return error_;
@@ -83,8 +97,8 @@ class FileReader {
     return false;
   }
   bool fail_type(const std::string& key, const toml::node& node, const char* expected) {
-    return fail(line_of(node), "key '" + key + "' must be " + expected + ", not " +
-                                   type_name(node));
+    return fail(line_of(node),
+                "key '" + key + "' must be " + expected + ", not " + type_name(node));
   }
 
   bool get_string(const std::string& key, const toml::node& node, std::string& out) {
@@ -120,8 +134,8 @@ class FileReader {
   }
 
   bool read_top(const toml::table& root) {
-    static const std::set<std::string> known = {"name",  "description", "fps",     "scale",
-                                                "trim",  "root",        "dancers", "pair"};
+    static const std::set<std::string> known = {"name", "description", "fps",     "scale",
+                                                "trim", "root",        "dancers", "pair"};
     for (auto&& [k, node] : root) {
       const std::string key(k.str());
       if (!known.contains(key)) {
@@ -199,7 +213,8 @@ class FileReader {
     }
     for (const char* member : {"leader", "partner"}) {
       if (!table->contains(member)) {
-        return fail(line_of(node), where + " has no '" + member + "' (a .bvh path, or [\"x.asf\", \"y.amc\"])");
+        return fail(line_of(node),
+                    where + " has no '" + member + "' (a .bvh path, or [\"x.asf\", \"y.amc\"])");
       }
     }
     spec_.pairs.push_back(std::move(pair));
@@ -222,7 +237,8 @@ class FileReader {
       std::string text = *item->value<std::string>();
       if (!expand(key, *item, text)) return false;
       const fs::path p = (root_ / text).lexically_normal();  // an absolute `text` stays as is
-      if (!is_file(p)) return fail(line_of(*item), "key '" + key + "': no such file: " + p.string());
+      if (!is_file(p))
+        return fail(line_of(*item), "key '" + key + "': no such file: " + p.string());
       files.push_back(p.string());
     }
     std::vector<std::string> ext;
@@ -233,7 +249,8 @@ class FileReader {
     if (!bvh && !asf_amc) {
       return fail(line_of(node), "key '" + key +
                                      "': a dancer is one .bvh file or [\"skeleton.asf\", "
-                                     "\"motion.amc\"], not " + join_motion_argument(files));
+                                     "\"motion.amc\"], not " +
+                                     join_motion_argument(files));
     }
     if (asf_amc && ext[0] == ".amc") std::swap(files[0], files[1]);
     return true;
@@ -338,11 +355,11 @@ Result<LibrarySpec> recognise_pairs(const fs::path& dir) {
     for (const char* ext : {".bvh", ".amc"}) {
       const std::vector<fs::path>& found = by_ext[ext];
       if (found.size() > 1) {
-        return make_error(dir.string(), 0,
-                          fmt::format("subject {} trial {} has {} {} files ({}, {}, ...): keep one "
-                                      "or write a library file",
-                                      subject, trial, found.size(), ext, found[0].string(),
-                                      found[1].string()));
+        return make_error(
+            dir.string(), 0,
+            fmt::format("subject {} trial {} has {} {} files ({}, {}, ...): keep one "
+                        "or write a library file",
+                        subject, trial, found.size(), ext, found[0].string(), found[1].string()));
       }
     }
     if (by_ext[".bvh"].size() == 1) {
@@ -398,8 +415,9 @@ Result<LibrarySpec> read_library_dir(const std::string& dir, const std::string& 
     std::ranges::sort(tomls);
     std::string list;
     for (const fs::path& p : tomls) list += (list.empty() ? "" : ", ") + p.filename().string();
-    return make_error(dir, 0, "has " + std::to_string(tomls.size()) +
-                                  " library files (" + list + "): name one with --library FILE");
+    return make_error(dir, 0,
+                      "has " + std::to_string(tomls.size()) + " library files (" + list +
+                          "): name one with --library FILE");
   }
   return recognise_pairs(fs::path(dir));
 }
@@ -407,7 +425,8 @@ Result<LibrarySpec> read_library_dir(const std::string& dir, const std::string& 
 Result<LibrarySpec> read_library(const std::string& file_or_dir, const std::string& data_dir) {
   std::error_code ec;
   if (fs::is_directory(file_or_dir, ec)) return read_library_dir(file_or_dir, data_dir);
-  if (!fs::exists(file_or_dir, ec)) return make_error(file_or_dir, 0, "no such library file or directory");
+  if (!fs::exists(file_or_dir, ec))
+    return make_error(file_or_dir, 0, "no such library file or directory");
   return read_library_file(file_or_dir, data_dir);
 }
 

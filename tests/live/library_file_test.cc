@@ -62,8 +62,8 @@ TEST(LibraryFile, ShippedSalsaFileLoadsTheSameLibraryAsFourteenPairOptions) {
   ASSERT_TRUE(from_file) << from_file.error().message;
   // What 14 --pair options typed by hand give (with --fps 60).
   std::vector<PairFiles> by_hand;
-  for (const char* t : {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13",
-                        "14", "15"}) {
+  for (const char* t :
+       {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13", "14", "15"}) {
     by_hand.push_back({{bvh("60", t)}, {bvh("61", t)}});
   }
   options.load.frame_rate = 60.0;
@@ -90,17 +90,15 @@ TEST(LibraryFile, AsfAmcFileResolvesTheDownloadLayout) {
 TEST(LibraryFile, ErrorsNameTheFileTheLineAndTheKey) {
   Result<LibrarySpec> missing = read_library("/nonexistent/salsa.toml");
   ASSERT_FALSE(missing);
-  EXPECT_EQ(missing.error().message,
-            "/nonexistent/salsa.toml: no such library file or directory");
+  EXPECT_EQ(missing.error().message, "/nonexistent/salsa.toml: no such library file or directory");
 
-  const std::string pair = "[[pair]]\nleader = \"" + bvh("60", "10") + "\"\npartner = \"" +
-                           bvh("61", "10") + "\"\n";
+  const std::string pair =
+      "[[pair]]\nleader = \"" + bvh("60", "10") + "\"\npartner = \"" + bvh("61", "10") + "\"\n";
   EXPECT_EQ(error_of(pair), "(no error)");
   std::string e = error_of("fsp = 60\n" + pair);
   EXPECT_NE(e.find("lib.toml:1: unknown key 'fsp'"), std::string::npos) << e;
   e = error_of("fps = \"sixty\"\n" + pair);
-  EXPECT_NE(e.find("lib.toml:1: key 'fps' must be a number, not a string"), std::string::npos)
-      << e;
+  EXPECT_NE(e.find("lib.toml:1: key 'fps' must be a number, not a string"), std::string::npos) << e;
   e = error_of("fps = -60\n" + pair);
   EXPECT_NE(e.find("lib.toml:1: key 'fps' must be positive"), std::string::npos) << e;
   e = error_of("name = \"x\"\n" + pair + "\n[[pair]]\nleader = \"" + bvh("60", "10") +
@@ -142,8 +140,9 @@ TEST(LibraryFile, ErrorsNameTheFileTheLineAndTheKey) {
 }
 
 TEST(LibraryFile, RelativePathsStartAtTheRootOrTheFilesDirectory) {
-  TempLibrary lib("root = \"${data}/cmu-salsa/bvh\"\n[[pair]]\nname = \"ten\"\n"
-                  "leader = \"60/60_10_scaled.bvh\"\npartner = \"61/61_10_scaled.bvh\"\n");
+  TempLibrary lib(
+      "root = \"${data}/cmu-salsa/bvh\"\n[[pair]]\nname = \"ten\"\n"
+      "leader = \"60/60_10_scaled.bvh\"\npartner = \"61/61_10_scaled.bvh\"\n");
   Result<LibrarySpec> spec = read_library_file(lib.file.string(), kData);
   ASSERT_TRUE(spec) << spec.error().message;
   EXPECT_EQ(spec.value().pairs[0].leader, MotionFiles{bvh("60", "10")});
@@ -159,6 +158,21 @@ TEST(LibraryFile, RelativePathsStartAtTheRootOrTheFilesDirectory) {
   Result<LibrarySpec> from_dir = read_library(lib.dir.string());
   ASSERT_TRUE(from_dir) << from_dir.error().message;
   EXPECT_EQ(from_dir.value().source, lib.file.string());
+}
+
+TEST(LibraryFile, RelativeDataDirStartsWhereTheUserIs) {
+  // `--data-dir ../shared/data` means from the working directory, not from the library file's.
+  TempLibrary lib(
+      "root = \"${data}/cmu-salsa/bvh\"\n[[pair]]\n"
+      "leader = \"60/60_10_scaled.bvh\"\npartner = \"61/61_10_scaled.bvh\"\n");
+  const fs::path before = fs::current_path();
+  fs::current_path(fs::path(kData).parent_path());
+  Result<LibrarySpec> spec =
+      read_library_file(lib.file.string(), fs::path(kData).filename().string());
+  fs::current_path(before);
+  ASSERT_TRUE(spec) << spec.error().message;
+  EXPECT_EQ(fs::path(spec.value().pairs[0].leader[0]),
+            fs::path(bvh("60", "10")).lexically_normal());
 }
 
 TEST(LibraryDir, RecognisesTheSalsaFolderAsFourteenDuetsAt60Fps) {
@@ -186,13 +200,15 @@ TEST(MotionArgument, SplitsSkeletonPlusMotion) {
   Result<std::vector<std::string>> both = split_motion_argument(amc + "+" + asf);
   ASSERT_TRUE(both) << both.error().message;
   EXPECT_EQ(both.value(), (std::vector<std::string>{asf, amc}));  // skeleton first
-  EXPECT_EQ(split_motion_argument(bvh("60", "01")).value(), std::vector<std::string>{bvh("60", "01")});
+  EXPECT_EQ(split_motion_argument(bvh("60", "01")).value(),
+            std::vector<std::string>{bvh("60", "01")});
   EXPECT_NE(split_motion_argument(asf).error().message.find("skeleton without motion"),
             std::string::npos);
   EXPECT_NE(split_motion_argument(asf + "+x.amc").error().message.find("no such file: x.amc"),
             std::string::npos);
-  EXPECT_NE(split_motion_argument(asf + "+" + bvh("60", "01")).error().message.find(
-                "one .asf and one .amc"),
+  EXPECT_NE(split_motion_argument(asf + "+" + bvh("60", "01"))
+                .error()
+                .message.find("one .asf and one .amc"),
             std::string::npos);
   EXPECT_FALSE(split_motion_argument(asf + "+" + amc + "+" + amc));
   EXPECT_EQ(join_motion_argument({asf, amc}), asf + "+" + amc);
@@ -262,9 +278,10 @@ TEST(LibraryDir, AsfAmcLeaderFollowsLikeTheBvhLeader) {
   EXPECT_GE(near, frames * 95 / 100) << near << " of " << frames;
   EXPECT_GE(a_right, frames * 99 / 100) << a_right << " of " << frames;
   EXPECT_GE(b_right, frames * 95 / 100) << b_right << " of " << frames;
-  std::printf("ASF+AMC leader vs BVH leader: same take and frame on %d of %d frames, within 3 on "
-              "%d, same take on %d; right within 3: %d and %d\n", same, frames, near, same_take,
-              a_right, b_right);
+  std::printf(
+      "ASF+AMC leader vs BVH leader: same take and frame on %d of %d frames, within 3 on "
+      "%d, same take on %d; right within 3: %d and %d\n",
+      same, frames, near, same_take, a_right, b_right);
 }
 
 }  // namespace
