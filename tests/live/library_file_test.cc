@@ -171,8 +171,10 @@ TEST(LibraryFile, RelativeDataDirStartsWhereTheUserIs) {
       read_library_file(lib.file.string(), fs::path(kData).filename().string());
   fs::current_path(before);
   ASSERT_TRUE(spec) << spec.error().message;
-  EXPECT_EQ(fs::path(spec.value().pairs[0].leader[0]),
-            fs::path(bvh("60", "10")).lexically_normal());
+  // The same file (the working directory may be reached through a symbolic link).
+  const fs::path resolved = spec.value().pairs[0].leader[0];
+  EXPECT_TRUE(resolved.is_absolute()) << resolved;
+  EXPECT_TRUE(fs::equivalent(resolved, bvh("60", "10"))) << resolved;
 }
 
 TEST(LibraryDir, RecognisesTheSalsaFolderAsFourteenDuetsAt60Fps) {
