@@ -175,7 +175,8 @@ int run_improvise(const ImproviseArgs& args) {
   const Performance& performance = made.value();
 
   // In the source file's units, so `duet follow` reads it back with the same scale as the pairs.
-  const BvhWriteOptions units = BvhWriteOptions::in_file_units(motions[0].metres_per_unit);
+  const BvhWriteOptions units = BvhWriteOptions::in_file_units(
+      readable_metres_per_unit(performance.motion.skeleton(), motions[0].metres_per_unit));
   if (Status s = write_bvh(performance.motion, args.output_path, units); !s) {
     fmt::print(stderr, "{}: {}\n", kCommand, s.error().message);
     return kExitFailure;
