@@ -115,6 +115,14 @@ int run_follow(const FollowArgs& args) {
       return kExitFailure;
     }
     truth = std::move(read).value();
+    std::vector<int> take_frames;
+    for (const DuetTake& take : library->takes()) {
+      take_frames.push_back(take.template_motion.clip.frame_count());
+    }
+    if (Status s = check_ground_truth(*truth, args.truth_path, take_frames); !s) {
+      fmt::print(stderr, "duet follow: {}\n", s.error().message);
+      return kExitFailure;
+    }
   }
 
   MotionLoadOptions load_options;
@@ -249,7 +257,8 @@ Command register_follow(CLI::App& app) {
                "Exit 0 even when over half the input's frames are lost (by default duet follow "
                "then lists the likely causes and exits 3)");
   app.add_option("--truth", args->truth_path,
-                 "Ground truth CSV from `duet improvise`: print the follower's accuracy")
+                 "Ground truth CSV from `duet improvise` with the same pairs in the same order: "
+                 "print the follower's accuracy (a take or frame the library lacks is an error)")
       ->check(CLI::ExistingFile);
   return [args] { return run_follow(*args); };
 }

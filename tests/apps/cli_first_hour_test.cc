@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "apps/run_command.h"
@@ -90,6 +91,72 @@ TEST(CliFirstHour, FollowOutputsOfAnAsfUserReadBackAtTheirTrueSize) {
   expect_same_size(inspect_json(kPartner01), inspect_json(partner), false);
   std::filesystem::remove(user);
   std::filesystem::remove(partner);
+}
+
+std::string write_file(const std::string& name, const std::string& text) {
+  const std::string path = temp_path(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(CliFirstHour, TruthOfAnotherLibraryIsAnErrorNamingTheFile) {
+  // A performance of take 1 of a two-pair library, scored against a one-pair library.
+  const std::string perf = temp_path("perf.bvh");
+  const std::string truth = temp_path("truth.csv");
+  const std::string pair03 = " --pair " + data_path("cmu-salsa/bvh/60/60_03_scaled.bvh") + " " +
+                             data_path("cmu-salsa/bvh/61/61_03_scaled.bvh");
+  CommandResult r = run_duet("improvise" + kPair01 + pair03 + " --take 1 --duration 4 -o " + perf +
+                             " --truth " + truth);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_duet("follow" + kPair01 + " --input " + perf + " --truth " + truth);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, truth + ":2: take 1 is not in the library, which has 1 take(s)"))
+      << r.output;
+  // The right library scores it.
+  r = run_duet("follow" + kPair01 + pair03 + " --input " + perf + " --truth " + truth);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "accuracy against the ground truth")) << r.output;
+  // A template frame past the take's end: the library read at another rate.
+  std::string text;
+  {
+    std::ifstream in(truth);
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::string bad = write_file(
+      "bad-truth.csv", text.substr(0, text.find('\n') + 1) + "0,0.000000,1,99999.000,0,0\n");
+  r = run_duet("follow" + kPair01 + pair03 + " --input " + perf + " --truth " + bad);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, bad + ":2: template frame 99999 is outside take 1")) << r.output;
+  for (const std::string& path : {perf, truth, bad}) std::filesystem::remove(path);
+}
+
+TEST(CliFirstHour, SwappedPairOrderExitsThreeAndSaysSo) {
+  // --pair PARTNER LEADER while dancing the leader.
+  const CommandResult r = run_duet("follow --pair " + kPartner01 + " " + kLeader01 +
+                                   " --fps 60 --input " + kLeader01 + " --input-fps 60");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_TRUE(contains(r.output, "check the order of each --pair (LEADER then PARTNER)"))
+      << r.output;
+}
+
+TEST(CliFirstHour, EveryFrameLostExitsThreeWithCauses) {
+  // The salsa leader with arms and legs swapped by a skeleton map: no frame is any part of the
+  // dance.
+  const std::string map = write_file("swap.json", R"({"name": "arms-as-legs", "roles": {
+    "hips": "hip", "spine": "abdomen", "chest": "chest", "neck": "neck", "head": "head",
+    "left_shoulder": "rThigh", "left_elbow": "rShin", "left_wrist": "rFoot",
+    "right_shoulder": "lThigh", "right_elbow": "lShin", "right_wrist": "lFoot",
+    "left_hip": "rShldr", "left_knee": "rForeArm", "left_ankle": "rHand", "left_toe": "rMid2",
+    "right_hip": "lShldr", "right_knee": "lForeArm", "right_ankle": "lHand", "right_toe": "lMid2"}})");
+  CommandResult r =
+      run_duet("follow" + kPair01 + " --input " + kLeader01 + " --input-fps 60 --input-map " + map);
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_TRUE(contains(r.output, "100% of the input's frames are lost")) << r.output;
+  EXPECT_TRUE(contains(r.output, "Likely causes")) << r.output;
+  r = run_duet("follow" + kPair01 + " --input " + kLeader01 + " --input-fps 60 --input-map " + map +
+               " --allow-lost");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  std::filesystem::remove(map);
 }
 
 }  // namespace
