@@ -9,6 +9,7 @@
 #include "duet/io/motion_file.h"
 #include "duet/partner/hand_contacts.h"
 #include "motion_options.h"
+#include "number_checks.h"
 
 namespace duet::app {
 
@@ -89,12 +90,12 @@ Command register_contacts(CLI::App& app) {
   add_motion_file_options(app, args->motion);
   app.add_option("--padding", args->contacts.padding_m,
                  "Metres added around each hand's bounding box")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   app.add_option("--min-contact", args->contacts.min_contact_s,
                  "Contacts shorter than this (s) are dropped")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   app.add_option("--min-gap", args->contacts.min_gap_s, "Gaps shorter than this (s) are closed")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   app.add_flag("--json", args->json, "Print one JSON object");
   return [args] { return run_contacts(*args); };
 }

@@ -8,6 +8,7 @@
 #include "duet/io/motion_file.h"
 #include "duet/motion/resample.h"
 #include "motion_options.h"
+#include "number_checks.h"
 
 namespace duet::app {
 
@@ -67,20 +68,20 @@ Command register_convert(CLI::App& app) {
       ->check(CLI::ExistingFile);
   app.add_option("-o,--output", args->output, "Output BVH file (written atomically)")->required();
   app.add_option("--input-fps", args->input.fps, "Frame rate of the input, overriding its header")
-      ->check(CLI::PositiveNumber);
+      ->check(fps_check());
   app.add_option("--scale", args->input.scale,
                  "Metres per input file unit (default: known per skeleton convention)")
-      ->check(CLI::PositiveNumber);
+      ->check(scale_check());
   app.add_option("--map", args->input.map_path, "Skeleton map JSON for the input")
       ->check(CLI::ExistingFile);
   app.add_option("--fps", args->output_fps,
                  "Resample to this frame rate (quaternion interpolation)")
-      ->check(CLI::PositiveNumber);
+      ->check(fps_check());
   app.add_option("--units-per-metre", args->output_units_per_metre,
                  "Length units of the output per metre (default: the units duet reads back for "
                  "the skeleton: the source's, e.g. salsa DAZ 0.768, CMU 17.72; metres for other "
                  "rigs)")
-      ->check(CLI::PositiveNumber);
+      ->check(number_between(1.0 / kMaxScale, 1.0 / kMinScale, "units per metre"));
   return [args] { return run_convert(*args); };
 }
 

@@ -8,6 +8,7 @@
 #include "duet/motion/retarget.h"
 #include "duet/motion/rig_variants.h"
 #include "motion_options.h"
+#include "number_checks.h"
 
 namespace duet::app {
 
@@ -150,7 +151,7 @@ Command register_retarget(CLI::App& app) {
   app.add_option("--rig-scale", args->rig_scale,
                  "Metres per unit of the rig file, and of the output (default: known per skeleton "
                  "convention, else guessed from the body's height)")
-      ->check(CLI::PositiveNumber);
+      ->check(scale_check());
   app.add_option("--rig-map", args->rig_map_path,
                  "Skeleton map JSON naming the joint of each role in the rig")
       ->check(CLI::ExistingFile);
@@ -160,7 +161,7 @@ Command register_retarget(CLI::App& app) {
                  "legs_apart=DEG, lean=DEG, toes_out=DEG; e.g. arms=1.1,legs=0.92,trunk=1.05");
   app.add_option("--stride-scale", args->stride_scale,
                  "Scale of the root's path (default: rig leg length / input leg length)")
-      ->check(CLI::PositiveNumber);
+      ->check(number_between(0.1, 10.0));
   app.add_flag("--no-feet", args->no_feet,
                "Do not put the rig's lowest foot at the input's (scaled) height every frame; "
                "scale the pelvis height instead");

@@ -15,6 +15,7 @@
 #include "duet/live/source_spec.h"
 #include "duet/net/live_server.h"
 #include "library_options.h"
+#include "number_checks.h"
 #include "partner_options.h"
 #include "tracker_options.h"
 
@@ -332,10 +333,10 @@ Command register_serve(CLI::App& app) {
   app.add_option("--source-fps", args->source_fps,
                  "Frame rate of the source (replay: default --fps, else the file's; live: the "
                  "rate recordings are written at)")
-      ->check(CLI::PositiveNumber);
+      ->check(fps_check());
   app.add_option("--source-scale", args->source_scale,
                  "Metres per unit of the source (default: known per skeleton convention)")
-      ->check(CLI::PositiveNumber);
+      ->check(scale_check());
   app.add_option("--source-map", args->source_map,
                  "Skeleton map JSON for the source's joint names (docs/skeleton-maps.md)")
       ->check(CLI::ExistingFile);
@@ -364,7 +365,7 @@ Command register_serve(CLI::App& app) {
   app.add_flag("--exit-at-end", args->exit_at_end, "Stop when a replay without loop ends");
   app.add_option("--log-interval", args->log_interval_s,
                  "Seconds between latency log lines (0: none)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_check())
       ->capture_default_str();
   app.add_option("--queue-frames", args->queue_frames,
                  "Frames queued per viewer before the oldest is dropped")

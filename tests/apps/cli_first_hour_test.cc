@@ -159,5 +159,48 @@ TEST(CliFirstHour, EveryFrameLostExitsThreeWithCauses) {
   std::filesystem::remove(map);
 }
 
+// A bad command line exits 2 with a message that names the mistake.
+void expect_usage_error(const std::string& arguments, const std::string& message) {
+  const CommandResult r = run_duet(arguments);
+  EXPECT_EQ(r.exit_code, 2) << arguments << "\n" << r.output;
+  EXPECT_TRUE(contains(r.output, message)) << arguments << "\n" << r.output;
+  EXPECT_LT(r.output.size(), 400u) << arguments << "\n" << r.output;  // no 309-digit bounds
+}
+
+TEST(CliFirstHour, FrameRatesAndScalesOutsideTheirRangesAreBadCommandLines) {
+  for (const char* fps : {"0", "-3", "nan", "inf", "1e9", "1e400", "0.5", "60fps"}) {
+    expect_usage_error(std::string("inspect --fps ") + fps + " " + kLeader01,
+                       "--fps: must be between 1 and 1000 fps");
+  }
+  for (const char* scale : {"1e-300", "1e300", "0", "nan"}) {
+    expect_usage_error(std::string("inspect --scale ") + scale + " " + kLeader01,
+                       "--scale: must be between 0.0001 and 1000 metres per file unit");
+  }
+  // The same check for every command that reads motion.
+  expect_usage_error("follow" + kPair01 + " --input " + kLeader01 + " --input-fps nan",
+                     "--input-fps: must be between 1 and 1000 fps");
+  expect_usage_error(
+      "follow --pair " + kLeader01 + " " + kPartner01 + " --fps 0 --input " + kLeader01,
+      "--fps: must be between 1 and 1000 fps");
+  expect_usage_error("convert " + kLeader01 + " -o x.bvh --fps 1e9",
+                     "--fps: must be between 1 and 1000 fps");
+  expect_usage_error("convert " + kLeader01 + " -o x.bvh --scale 1e300",
+                     "--scale: must be between 0.0001 and 1000");
+  expect_usage_error("improvise --from " + kLeader01 + " -o x.bvh --rate 1e-300",
+                     "--rate: must be between 1 and 1000 fps");
+  expect_usage_error("improvise --from " + kLeader01 + " -o x.bvh --tempo nan",
+                     "--tempo: must be between 0.1 and 10");
+  expect_usage_error(
+      "retarget " + kLeader01 + " --rig " + kLeader01 + " --rig-scale 1e-300 -o x.bvh",
+      "--rig-scale: must be between 0.0001 and 1000");
+  // In range is fine.
+  EXPECT_EQ(run_duet("inspect --fps 1000 --scale 0.0001 " + kLeader01).exit_code, 0);
+}
+
+TEST(CliFirstHour, PairWithOneFileIsABadCommandLine) {
+  expect_usage_error("follow --pair " + kLeader01 + " --input " + kLeader01,
+                     "--pair: takes two files, LEADER and PARTNER; got only");
+}
+
 }  // namespace
 }  // namespace duet::testing
