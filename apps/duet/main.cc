@@ -1,7 +1,12 @@
 // duet: follow a dancer and answer with a virtual partner. See `duet --help`.
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <map>
+#include <string>
+#include <vector>
 
+#include "command_line_hints.h"
 #include "commands.h"
 
 int main(int argc, char** argv) {
@@ -32,6 +37,12 @@ int main(int argc, char** argv) {
   add("retarget", "Put a motion onto another skeleton, keeping the body's directions and feet",
       duet::app::register_retarget);
 
+  // Mistakes CLI11 would report misleadingly: a misspelt command, an unknown option.
+  if (const std::optional<std::string> mistake = duet::app::find_command_line_mistake(
+          app, std::vector<std::string>(argv + 1, argv + argc))) {
+    fmt::print(stderr, "{}\n", *mistake);
+    return duet::app::kExitUsage;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

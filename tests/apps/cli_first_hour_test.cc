@@ -167,6 +167,24 @@ void expect_usage_error(const std::string& arguments, const std::string& message
   EXPECT_LT(r.output.size(), 400u) << arguments << "\n" << r.output;  // no 309-digit bounds
 }
 
+TEST(CliFirstHour, UnknownOptionsAndCommandsAreNamedWithTheClosestValidOne) {
+  const std::string library = std::string(DUET_TESTDATA_DIR) + "/../../libraries/cmu-salsa.toml";
+  expect_usage_error("follow --fsp 60 --library " + library + " --input " + kLeader01,
+                     "duet follow: unknown option --fsp (did you mean --fps?)");
+  // CLI11 alone took the 60 for the file argument: "File does not exist: 60".
+  expect_usage_error("inspect --fsp 60 " + kLeader01,
+                     "duet inspect: unknown option --fsp (did you mean --fps?)");
+  expect_usage_error("convert " + kLeader01 + " -o x.bvh --fps=30 --unit-per-metre=100",
+                     "unknown option --unit-per-metre (did you mean --units-per-metre?)");
+  expect_usage_error("eval --noise-dg 3", "unknown option --noise-dg (did you mean --noise-deg?)");
+  expect_usage_error("folow", "duet: unknown command 'folow' (did you mean 'follow'?)");
+  expect_usage_error("inpsect " + kLeader01, "unknown command 'inpsect' (did you mean 'inspect'?)");
+  expect_usage_error("frobnicate", "the commands are inspect, convert, follow");
+  // Still understood: the main app's flags, negative numbers as values.
+  EXPECT_EQ(run_duet("--version").exit_code, 0);
+  EXPECT_EQ(run_duet("inspect --help").exit_code, 0);
+}
+
 TEST(CliFirstHour, FrameRatesAndScalesOutsideTheirRangesAreBadCommandLines) {
   for (const char* fps : {"0", "-3", "nan", "inf", "1e9", "1e400", "0.5", "60fps"}) {
     expect_usage_error(std::string("inspect --fps ") + fps + " " + kLeader01,
