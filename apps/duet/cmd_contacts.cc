@@ -60,7 +60,8 @@ int run_contacts(const ContactsArgs& args) {
       }
       doc["pairs"][std::string(hand_pair_name(pair))] = entry;
     }
-    std::cout << doc.dump(2) << "\n";
+    // Names from the files may be any bytes: invalid UTF-8 becomes U+FFFD instead of throwing.
+    std::cout << doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
     return kExitOk;
   }
   fmt::print("{} frames at {:.6g} fps; some hand pair in contact in {:.1f}% of frames\n",

@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "duet/io/bvh.h"
 #include "duet/io/motion_file.h"
+#include "duet/motion/limits.h"
 #include "duet/motion/resample.h"
 #include "motion_options.h"
 #include "number_checks.h"
@@ -32,6 +33,15 @@ int run_convert(const ConvertArgs& args) {
   }
   Clip clip = std::move(loaded.value().clip);
   if (args.output_fps && *args.output_fps != clip.frame_rate()) {
+    // 1000 fps from a long file can still be too many frames: say so rather than exhaust memory.
+    const double frames = resampled_frame_count(clip, *args.output_fps);
+    if (!(frames <= static_cast<double>(kMaxClipFrames))) {
+      fmt::print(stderr,
+                 "duet convert: --fps {:g} would make {:.4g} frames of {}, over the limit of {} "
+                 "frames per clip\n",
+                 *args.output_fps, frames, loaded.value().description, kMaxClipFrames);
+      return kExitFailure;
+    }
     clip = resample(clip, *args.output_fps);
   }
   // A BVH cannot say its units: by default write the ones the reader will infer for this

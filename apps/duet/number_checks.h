@@ -7,14 +7,16 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "duet/motion/limits.h"
+
 namespace duet::app {
 
-// Frame rates (Hz) of files, sensors and outputs.
-inline constexpr double kMinFps = 1.0;
-inline constexpr double kMaxFps = 1000.0;
-// Metres per file unit: from 0.1 mm (a file in tenths of millimetres) to 1 km.
-inline constexpr double kMinScale = 1e-4;
-inline constexpr double kMaxScale = 1e3;
+// Frame rates (Hz) of files, sensors and outputs; metres per file unit (duet/motion/limits.h:
+// library files take the same ranges).
+inline constexpr double kMinFps = kMinFrameRate;
+inline constexpr double kMaxFps = kMaxFrameRate;
+inline constexpr double kMinScale = kMinMetresPerUnit;
+inline constexpr double kMaxScale = kMaxMetresPerUnit;
 // Durations of performances and segments (s): up to a day.
 inline constexpr double kMaxDurationS = 86400.0;
 

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -218,6 +219,72 @@ TEST(CliFirstHour, FrameRatesAndScalesOutsideTheirRangesAreBadCommandLines) {
 TEST(CliFirstHour, PairWithOneFileIsABadCommandLine) {
   expect_usage_error("follow --pair " + kLeader01 + " --input " + kLeader01,
                      "--pair: takes two files, LEADER and PARTNER; got only");
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST(CliFirstHour, SizesFromTheCommandLineAreBoundedWithAClearError) {
+  // Was an uncaught std::length_error (exit 134).
+  expect_usage_error("convert " + kLeader01 + " -o x.bvh --fps 1e9", "--fps: must be between");
+  // Two frames 20000 s apart (a salsa skeleton): 1000 fps would be 2e7 frames.
+  const std::string text = read_text(kLeader01);
+  const std::size_t motion = text.find("Frame Time:");
+  const std::size_t first_line = text.find('\n', motion) + 1;
+  const std::size_t third_line = text.find('\n', text.find('\n', first_line) + 1) + 1;
+  const std::string slow = write_file(
+      "slow.bvh", text.substr(0, text.find("Frames:")) + "Frames: 2\nFrame Time: 20000\n" +
+                      text.substr(first_line, third_line - first_line));
+  const std::string out = temp_path("resampled.bvh");
+  CommandResult r = run_duet("convert " + slow + " --fps 1000 -o " + out);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "--fps 1000 would make 2e+07 frames of " + slow +
+                                     ", over the limit of 10000000 frames per clip"))
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // A day at 1000 Hz.
+  r = run_duet("improvise --from " + kLeader01 + " --fps 60 --duration 86400 --rate 1000 -o " +
+               out);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "8.64e+07 frames, over the limit of 10000000 frames per clip"))
+      << r.output;
+  std::filesystem::remove(slow);
+  std::filesystem::remove(out);
+}
+
+TEST(CliFirstHour, NoExceptionEndsTheToolWithAnAbort) {
+  // Joint names that are not UTF-8: nlohmann::json threw from inspect --json (exit 134).
+  const std::string latin1 =
+      write_file("latin1.bvh",
+                 "HIERARCHY\nROOT h\xfc"
+                 "fte\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition "
+                 "Zposition\n End Site\n {\n  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 1\nFrame Time: "
+                 "0.1\n0 0 0\n");
+  CommandResult r = run_duet("inspect --json " + latin1);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(r.output)["joint_names"][0],
+            "h\xef\xbf\xbd"
+            "fte");
+  std::filesystem::remove(latin1);
+
+  // A library folder with a subject number past 19 digits: std::stoll threw.
+  const std::filesystem::path dir = temp_path("library");
+  std::filesystem::create_directories(dir);
+  std::filesystem::create_symlink(kLeader01, dir / "60_01.bvh");
+  std::filesystem::create_symlink(kPartner01, dir / "61000000000000000000000_01.bvh");
+  r = run_duet("follow --library " + dir.string() + " --fps 60 --input " + kLeader01 +
+               " --input-fps 60");
+  EXPECT_EQ(r.exit_code, 0) << r.output;  // 60 is the smaller number: the leader
+  std::filesystem::remove_all(dir);
+
+  // Whatever else escapes a command is reported as a bug, with exit 1.
+  ::setenv("DUET_TEST_THROW", "1", 1);
+  r = run_duet("inspect " + kLeader01);
+  ::unsetenv("DUET_TEST_THROW");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "duet: internal error: DUET_TEST_THROW")) << r.output;
 }
 
 }  // namespace
