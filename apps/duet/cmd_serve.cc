@@ -85,13 +85,19 @@ std::string random_token() {
   return token;
 }
 
-// --web, else web/dist in the working directory, else web/dist in the source tree this binary
-// was built from.
+// --web, else web/dist in the working directory, else the installed copy beside the binary
+// (<prefix>/share/duet/web for <prefix>/bin/duet: `cmake --install`), else web/dist in the
+// source tree this binary was built from.
 fs::path find_web_dir(const std::string& arg) {
   if (!arg.empty()) return arg;
   std::error_code ec;
   const fs::path here = "web/dist";
   if (fs::is_regular_file(here / "index.html", ec)) return here;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = (exe.parent_path() / DUET_WEB_DIR_FROM_BINDIR).lexically_normal();
+    if (fs::is_regular_file(installed / "index.html", ec)) return installed;
+  }
   const fs::path source_tree = fs::path(__FILE__).parent_path().parent_path().parent_path();
   const fs::path built = source_tree / "web" / "dist";
   if (fs::is_regular_file(built / "index.html", ec)) return built;
@@ -357,8 +363,8 @@ Command register_serve(CLI::App& app) {
           },
           "TOKEN"));
   app.add_option("--web", args->web,
-                 "Directory of the viewer's files (default: web/dist here, else in the source "
-                 "tree)");
+                 "Directory of the viewer's files (default: web/dist here, else the installed "
+                 "share/duet/web beside bin/duet, else web/dist in the source tree)");
   app.add_option("--record", args->record, "Directory for the session's recordings")
       ->capture_default_str();
   app.add_flag("--no-record", args->no_record, "Do not record the session");
