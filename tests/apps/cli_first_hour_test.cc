@@ -2,6 +2,7 @@
 // size, failures that must not exit 0, command-line mistakes answered with a clear message and
 // exit 2, sizes from the command line bounded.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -285,6 +286,24 @@ TEST(CliFirstHour, NoExceptionEndsTheToolWithAnAbort) {
   ::unsetenv("DUET_TEST_THROW");
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_TRUE(contains(r.output, "duet: internal error: DUET_TEST_THROW")) << r.output;
+}
+
+TEST(CliFirstHour, OutputToAPipeOrDeviceIsWrittenNotReplaced) {
+  // `-o /dev/null` as root renamed a regular file over the device. A FIFO stands in for it here
+  // (a regression would leave the reader waiting: hence its timeout).
+  const std::filesystem::path dir = temp_path("fifo");
+  std::filesystem::create_directories(dir);
+  const std::string fifo = (dir / "out.bvh").string();
+  const std::string copy = (dir / "copy.bvh").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string command = "timeout 20 cat " + fifo + " > " + copy + " & " +
+                              std::string(DUET_BINARY) + " convert " + kLeader01 + " -o " + fifo +
+                              " 2>/dev/null; status=$?; wait; exit $status";
+  EXPECT_EQ(std::system(command.c_str()), 0);
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo));
+  EXPECT_TRUE(read_text(copy).starts_with("HIERARCHY")) << read_text(copy).substr(0, 100);
+  EXPECT_FALSE(std::filesystem::exists(fifo + ".tmp"));
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
