@@ -14,4 +14,14 @@ if command -v npm >/dev/null; then
 else
   echo "== npm not found: the browser viewer (web/) is not built" >&2
 fi
+# Install (after the viewer, so its files go along): the prefix is ~/.local unless the build was
+# configured with another CMAKE_INSTALL_PREFIX.
+cmake --install build >/dev/null
+prefix=$(sed -n 's/^CMAKE_INSTALL_PREFIX:PATH=//p' build/CMakeCache.txt)
+echo "== duet is installed: $prefix/bin/duet" >&2
+case ":$PATH:" in
+  *":$prefix/bin:"*) echo "== $prefix/bin is on your PATH: run duet --help" >&2 ;;
+  *) echo "== $prefix/bin is not on your PATH: add it (e.g. to ~/.profile):" \
+       "export PATH=\"$prefix/bin:\$PATH\"" >&2 ;;
+esac
 scripts/demo.sh "$data_dir"

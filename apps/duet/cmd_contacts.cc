@@ -9,6 +9,7 @@
 #include "duet/io/motion_file.h"
 #include "duet/partner/hand_contacts.h"
 #include "motion_options.h"
+#include "number_checks.h"
 
 namespace duet::app {
 
@@ -59,7 +60,8 @@ int run_contacts(const ContactsArgs& args) {
       }
       doc["pairs"][std::string(hand_pair_name(pair))] = entry;
     }
-    std::cout << doc.dump(2) << "\n";
+    // Names from the files may be any bytes: invalid UTF-8 becomes U+FFFD instead of throwing.
+    std::cout << doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
     return kExitOk;
   }
   fmt::print("{} frames at {:.6g} fps; some hand pair in contact in {:.1f}% of frames\n",
@@ -89,12 +91,12 @@ Command register_contacts(CLI::App& app) {
   add_motion_file_options(app, args->motion);
   app.add_option("--padding", args->contacts.padding_m,
                  "Metres added around each hand's bounding box")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   app.add_option("--min-contact", args->contacts.min_contact_s,
                  "Contacts shorter than this (s) are dropped")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   app.add_option("--min-gap", args->contacts.min_gap_s, "Gaps shorter than this (s) are closed")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   app.add_flag("--json", args->json, "Print one JSON object");
   return [args] { return run_contacts(*args); };
 }

@@ -1,11 +1,15 @@
-// duet convert INPUT... -o OUT.bvh [--fps F] [--scale S]
+// duet convert INPUT... -o OUT.bvh [--fps F] [--scale S] [--units-per-metre U]
 #include <fmt/format.h>
+
+#include <cmath>
 
 #include "commands.h"
 #include "duet/io/bvh.h"
 #include "duet/io/motion_file.h"
+#include "duet/motion/limits.h"
 #include "duet/motion/resample.h"
 #include "motion_options.h"
+#include "number_checks.h"
 
 namespace duet::app {
 
@@ -16,7 +20,7 @@ struct ConvertArgs {
   std::string output;
   MotionFileOptions input;
   std::optional<double> output_fps;
-  double output_units_per_metre = 1.0;
+  std::optional<double> output_units_per_metre;  // default: units duet reads back unaided
 };
 
 int run_convert(const ConvertArgs& args) {
@@ -29,17 +33,38 @@ int run_convert(const ConvertArgs& args) {
   }
   Clip clip = std::move(loaded.value().clip);
   if (args.output_fps && *args.output_fps != clip.frame_rate()) {
+    // 1000 fps from a long file can still be too many frames: say so rather than exhaust memory.
+    const double frames = resampled_frame_count(clip, *args.output_fps);
+    if (!(frames <= static_cast<double>(kMaxClipFrames))) {
+      fmt::print(stderr,
+                 "duet convert: --fps {:g} would make {:.4g} frames of {}, over the limit of {} "
+                 "frames per clip\n",
+                 *args.output_fps, frames, loaded.value().description, kMaxClipFrames);
+      return kExitFailure;
+    }
     clip = resample(clip, *args.output_fps);
   }
+  // A BVH cannot say its units: by default write the ones the reader will infer for this
+  // skeleton (the source's, or its convention's), so the file reads back at its true size.
+  const double readable_units_per_metre =
+      1.0 / readable_metres_per_unit(clip.skeleton(), loaded.value().metres_per_unit);
   BvhWriteOptions write_options;
-  write_options.units_per_metre = args.output_units_per_metre;
+  write_options.units_per_metre = args.output_units_per_metre.value_or(readable_units_per_metre);
   Status written = write_bvh(clip, args.output, write_options);
   if (!written) {
     fmt::print(stderr, "duet convert: {}\n", written.error().message);
     return kExitFailure;
   }
-  fmt::print(stderr, "wrote {}: {} frames at {:.6g} fps, {} joints\n", args.output,
-             clip.frame_count(), clip.frame_rate(), clip.skeleton().animated_joint_count());
+  fmt::print(stderr, "wrote {}: {} frames at {:.6g} fps, {} joints, {:.6g} units per metre\n",
+             args.output, clip.frame_count(), clip.frame_rate(),
+             clip.skeleton().animated_joint_count(), write_options.units_per_metre);
+  if (std::abs(write_options.units_per_metre - readable_units_per_metre) >
+      1e-9 * readable_units_per_metre) {
+    fmt::print(stderr,
+               "duet convert: note: duet reads this skeleton at {:.6g} units per metre; read {} "
+               "with --scale {:.6g}\n",
+               readable_units_per_metre, args.output, 1.0 / write_options.units_per_metre);
+  }
   return kExitOk;
 }
 
@@ -53,18 +78,20 @@ Command register_convert(CLI::App& app) {
       ->check(CLI::ExistingFile);
   app.add_option("-o,--output", args->output, "Output BVH file (written atomically)")->required();
   app.add_option("--input-fps", args->input.fps, "Frame rate of the input, overriding its header")
-      ->check(CLI::PositiveNumber);
+      ->check(fps_check());
   app.add_option("--scale", args->input.scale,
                  "Metres per input file unit (default: known per skeleton convention)")
-      ->check(CLI::PositiveNumber);
+      ->check(scale_check());
   app.add_option("--map", args->input.map_path, "Skeleton map JSON for the input")
       ->check(CLI::ExistingFile);
   app.add_option("--fps", args->output_fps,
                  "Resample to this frame rate (quaternion interpolation)")
-      ->check(CLI::PositiveNumber);
+      ->check(fps_check());
   app.add_option("--units-per-metre", args->output_units_per_metre,
-                 "Length units of the output per metre (default 1: metres)")
-      ->check(CLI::PositiveNumber);
+                 "Length units of the output per metre (default: the units duet reads back for "
+                 "the skeleton: the source's, e.g. salsa DAZ 0.768, CMU 17.72; metres for other "
+                 "rigs)")
+      ->check(number_between(1.0 / kMaxScale, 1.0 / kMinScale, "units per metre"));
   return [args] { return run_convert(*args); };
 }
 

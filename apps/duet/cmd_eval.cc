@@ -15,6 +15,7 @@
 #include "duet/io/atomic_write.h"
 #include "eval_rigs.h"
 #include "library_options.h"
+#include "number_checks.h"
 #include "progress.h"
 
 namespace duet::app {
@@ -331,65 +332,65 @@ Command register_eval(CLI::App& app) {
   cases
       ->add_option("--noise-deg", args->settings.noise_rotation_deg,
                    "Rotation noise, RMS angle per joint per frame (default 3)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   cases->add_option("--noise-cm", args->noise_cm, "Root position noise per axis (default 1)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   cases
       ->add_option("--low-rate", args->settings.low_rate_hz,
                    "Sensor rate of the 30hz cases (default 30)")
-      ->check(CLI::PositiveNumber);
+      ->check(fps_check());
   cases
       ->add_option("--body-scale", args->settings.body_scale,
                    "Body size factor of the body-size case (default 1.15)")
-      ->check(CLI::PositiveNumber);
+      ->check(number_between(0.1, 10.0));
   cases
       ->add_option("--improv-duration", args->settings.improvise_duration_s,
                    "Length of the improvised performances in s (default: the take's length)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(number_between(0.0, kMaxDurationS, "s"));
 
   auto* tuning = app.add_option_group(
       "tuning (FollowParams of the hmm trackers; FeatureSpec weights feed every tracker)");
   tuning->add_option("--sigma", args->sigma, "Emission sigma (all HMM variants)")
-      ->check(CLI::PositiveNumber);
-  tuning->add_option("--self", args->self_prob, "self_prob")->check(CLI::Range(0.0, 1.0));
-  tuning->add_option("--next", args->next_prob, "next_prob")->check(CLI::Range(0.0, 1.0));
-  tuning->add_option("--skip", args->skip_prob, "skip_prob")->check(CLI::Range(0.0, 1.0));
-  tuning->add_option("--leave", args->leave_prob, "leave_prob")->check(CLI::Range(0.0, 1.0));
+      ->check(positive_check());
+  tuning->add_option("--self", args->self_prob, "self_prob")->check(number_between(0.0, 1.0));
+  tuning->add_option("--next", args->next_prob, "next_prob")->check(number_between(0.0, 1.0));
+  tuning->add_option("--skip", args->skip_prob, "skip_prob")->check(number_between(0.0, 1.0));
+  tuning->add_option("--leave", args->leave_prob, "leave_prob")->check(number_between(0.0, 1.0));
   tuning->add_option("--pause-stay", args->pause_stay, "pause_stay_prob (A_NN)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(number_between(0.0, 1.0));
   tuning
       ->add_option("--pause-distance", args->pause_distance,
                    "pause_distance_per_dim (all HMM variants)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   tuning->add_option("--lost-distance", args->lost_distance, "lost_distance_per_dim (all trackers)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   tuning
       ->add_option("--velocity-cap", args->velocity_cap,
                    "velocity_distance_cap: most the velocity blocks add to a squared distance "
                    "(all HMM variants; inf for none)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   tuning
       ->add_option("--tempo-time-constant", args->tempo_time_constant,
                    "tempo_time_constant_s of the tempo-centred band (all HMM variants)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_check());
   tuning->add_flag("--fixed-band", args->fixed_band,
                    "Keep the band fixed at the template's tempo (tempo_adaptive = false)");
   tuning->add_option("--dtw-back", args->dtw_back, "online DTW window behind the estimate")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   tuning->add_option("--dtw-ahead", args->dtw_ahead, "online DTW window ahead of the estimate")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   tuning->add_option("--posture-weight", args->posture_weight, "FeatureSpec posture_weight")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   tuning
       ->add_option("--root-velocity-weight", args->root_velocity_weight,
                    "FeatureSpec root_velocity_weight")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   tuning
       ->add_option("--effector-speed-weight", args->effector_speed_weight,
                    "FeatureSpec effector_speed_weight")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   tuning->add_option("--velocity-window", args->velocity_window, "FeatureSpec velocity_window_s")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_check());
   return [args] { return run_eval(*args); };
 }
 

@@ -53,7 +53,8 @@ Status write_partner_on_rig(const FollowArgs& args, const Clip& partner,
                                      rig.value().roles, {}, "the partner", args.partner_rig);
   if (!moved) return Error{"--partner-rig: " + moved.error().message};
   return write_bvh(moved.value(), args.output_path,
-                   BvhWriteOptions::in_file_units(rig.value().metres_per_unit));
+                   BvhWriteOptions::in_file_units(readable_metres_per_unit(
+                       moved.value().skeleton(), rig.value().metres_per_unit)));
 }
 
 // The share of lost frames when the input is followed as the other dancer (at most the first
@@ -80,7 +81,8 @@ std::optional<double> lost_as_other_role(const FollowArgs& args, const Clip& use
 
 // The BVH files are written in the units of the files they come from (the partner in the
 // response takes', the user in the input's), so every duet command reads them back at the same
-// scale and a viewer shows them as it shows the originals.
+// scale and a viewer shows them as it shows the originals. An ASF+AMC source (read in metres) is
+// written in its convention's BVH units, the ones a BVH with its joint names is read in.
 Status write_outputs(const FollowArgs& args, const std::string& trace, const Clip& partner,
                      double partner_metres_per_unit, const Clip& user,
                      double user_metres_per_unit) {
@@ -88,11 +90,13 @@ Status write_outputs(const FollowArgs& args, const std::string& trace, const Cli
     if (Status s = write_file_atomically(args.trace_path, trace); !s) return s;
   }
   if (!args.output_path.empty() && args.partner_rig.empty()) {
-    const BvhWriteOptions units = BvhWriteOptions::in_file_units(partner_metres_per_unit);
+    const BvhWriteOptions units = BvhWriteOptions::in_file_units(
+        readable_metres_per_unit(partner.skeleton(), partner_metres_per_unit));
     if (Status s = write_bvh(partner, args.output_path, units); !s) return s;
   }
   if (!args.user_output_path.empty()) {
-    const BvhWriteOptions units = BvhWriteOptions::in_file_units(user_metres_per_unit);
+    const BvhWriteOptions units = BvhWriteOptions::in_file_units(
+        readable_metres_per_unit(user.skeleton(), user_metres_per_unit));
     if (Status s = write_bvh(user, args.user_output_path, units); !s) return s;
   }
   return Ok{};
@@ -111,6 +115,14 @@ int run_follow(const FollowArgs& args) {
       return kExitFailure;
     }
     truth = std::move(read).value();
+    std::vector<int> take_frames;
+    for (const DuetTake& take : library->takes()) {
+      take_frames.push_back(take.template_motion.clip.frame_count());
+    }
+    if (Status s = check_ground_truth(*truth, args.truth_path, take_frames); !s) {
+      fmt::print(stderr, "duet follow: {}\n", s.error().message);
+      return kExitFailure;
+    }
   }
 
   MotionLoadOptions load_options;
@@ -245,7 +257,8 @@ Command register_follow(CLI::App& app) {
                "Exit 0 even when over half the input's frames are lost (by default duet follow "
                "then lists the likely causes and exits 3)");
   app.add_option("--truth", args->truth_path,
-                 "Ground truth CSV from `duet improvise`: print the follower's accuracy")
+                 "Ground truth CSV from `duet improvise` with the same pairs in the same order: "
+                 "print the follower's accuracy (a take or frame the library lacks is an error)")
       ->check(CLI::ExistingFile);
   return [args] { return run_follow(*args); };
 }

@@ -13,6 +13,7 @@
 #include "duet/io/motion_argument.h"
 #include "duet/live/duet_library.h"
 #include "library_options.h"
+#include "number_checks.h"
 
 namespace duet::app {
 
@@ -175,7 +176,8 @@ int run_improvise(const ImproviseArgs& args) {
   const Performance& performance = made.value();
 
   // In the source file's units, so `duet follow` reads it back with the same scale as the pairs.
-  const BvhWriteOptions units = BvhWriteOptions::in_file_units(motions[0].metres_per_unit);
+  const BvhWriteOptions units = BvhWriteOptions::in_file_units(
+      readable_metres_per_unit(performance.motion.skeleton(), motions[0].metres_per_unit));
   if (Status s = write_bvh(performance.motion, args.output_path, units); !s) {
     fmt::print(stderr, "{}: {}\n", kCommand, s.error().message);
     return kExitFailure;
@@ -235,10 +237,12 @@ Command register_improvise(CLI::App& app) {
   source->add_option("--take", args->take, "With --pair/--library: the pair to perform from (0-based)");
   source->add_option("--role", args->role, "With --pair: the dancer the user dances")
       ->check(CLI::IsMember({"leader", "partner"}));
-  source->add_option("--fps", args->fps, "Frame rate of the source file(s), overriding the library file's (salsa: 60)")
-      ->check(CLI::PositiveNumber);
+  source
+      ->add_option("--fps", args->fps,
+                   "Frame rate of the source file(s), overriding the library file's (salsa: 60)")
+      ->check(fps_check());
   source->add_option("--scale", args->scale, "Metres per unit of the source file(s)")
-      ->check(CLI::PositiveNumber);
+      ->check(scale_check());
   source->add_flag("--across-takes", args->across_takes,
                    "With --pair: improvise with segments of every pair's take");
 
@@ -252,29 +256,30 @@ Command register_improvise(CLI::App& app) {
       ->check(CLI::IsMember({"improv", "play"}));
   app.add_option("--pause-prob", args->pause_prob,
                  "Probability of a 0.3-0.8 s hold before each jump (default 1)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(number_between(0.0, 1.0));
   app.add_option("--continue-prob", args->continue_prob,
                  "Probability that a segment goes on into the next one (default 0.2)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(number_between(0.0, 1.0));
   app.add_option("--segment-min", args->segment_min_s, "Shortest segment in s (default 2)")
-      ->check(CLI::PositiveNumber);
+      ->check(number_between(0.1, kMaxDurationS, "s"));
   app.add_option("--segment-max", args->segment_max_s, "Longest segment in s (default 5)")
-      ->check(CLI::PositiveNumber);
+      ->check(number_between(0.1, kMaxDurationS, "s"));
   app.add_option("--duration", args->duration_s,
                  "Length of an improvised performance in s (default: the take's)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(number_between(0.0, kMaxDurationS, "s"));
   app.add_option("--tempo", args->tempo, "Steady tempo factor (1.4 = 40% faster; default 1)")
-      ->check(CLI::Range(0.1, 10.0));
+      ->check(number_between(0.1, 10.0));
   app.add_option("--drift", args->drift, "Drifting tempo between LOW and HIGH, e.g. 0.8 1.3")
-      ->expected(2);
+      ->expected(2)
+      ->check(number_between(0.1, 10.0));
   app.add_option("--noise-deg", args->noise_deg, "Rotation noise, RMS degrees per joint")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   app.add_option("--noise-cm", args->noise_cm, "Root position noise per axis in cm")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_check());
   app.add_option("--rate", args->rate_hz, "Sensor rate in Hz (default: the take's, e.g. 30)")
-      ->check(CLI::PositiveNumber);
+      ->check(fps_check());
   app.add_option("--body-scale", args->body_scale, "Body size factor (e.g. 1.15)")
-      ->check(CLI::PositiveNumber);
+      ->check(number_between(0.1, 10.0));
   app.add_option("--room-yaw", args->room_yaw_deg, "Turn the dancer about the vertical (deg)");
   app.add_option("--room-offset", args->room_offset, "Move the dancer by X Z metres")->expected(2);
   app.add_option("--seed", args->seed, "Seed of every random choice");

@@ -108,7 +108,8 @@ int run_inspect(const InspectArgs& args) {
       if (!j.end_site) names.push_back(j.name);
     }
     doc["joint_names"] = names;
-    std::cout << doc.dump(2) << "\n";
+    // Names from the file may be any bytes: invalid UTF-8 becomes U+FFFD instead of throwing.
+    std::cout << doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
     return kExitOk;
   }
   fmt::print("file:        {}\n", motion.description);

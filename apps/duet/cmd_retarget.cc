@@ -8,6 +8,7 @@
 #include "duet/motion/retarget.h"
 #include "duet/motion/rig_variants.h"
 #include "motion_options.h"
+#include "number_checks.h"
 
 namespace duet::app {
 
@@ -49,14 +50,6 @@ Skeleton writable(Skeleton skeleton) {
   return skeleton;
 }
 
-// Metres per unit of the BVH written for a rig loaded from `paths`: the file's own units; an ASF
-// skeleton (read in metres) is written in its convention's BVH units, which is how a BVH with its
-// joint names reads back.
-double written_units(const LoadedMotion& loaded, const std::vector<std::string>& paths) {
-  if (paths.size() == 2) return default_metres_per_unit(loaded.roles.convention);
-  return loaded.metres_per_unit;
-}
-
 int run_retarget(const RetargetArgs& args) {
   if (args.rig.empty() && args.proportions.empty()) {
     fmt::print(stderr,
@@ -82,7 +75,7 @@ int run_retarget(const RetargetArgs& args) {
   // The target: the rig file's skeleton (its motion is not used), or the input's own.
   Skeleton rig_skeleton = source.value().clip.skeleton();
   JointRoles rig_roles = source.value().roles;
-  double rig_metres_per_unit = written_units(source.value(), args.inputs);
+  double rig_metres_per_unit = source.value().metres_per_unit;
   std::string rig_name = source.value().description;
   if (!args.rig.empty()) {
     MotionFileOptions rig_input;
@@ -97,7 +90,7 @@ int run_retarget(const RetargetArgs& args) {
     }
     rig_skeleton = rig.value().clip.skeleton();
     rig_roles = rig.value().roles;
-    rig_metres_per_unit = written_units(rig.value(), args.rig);
+    rig_metres_per_unit = rig.value().metres_per_unit;
     rig_name = rig.value().description;
   }
   if (!args.proportions.empty()) {
@@ -122,7 +115,10 @@ int run_retarget(const RetargetArgs& args) {
     retargeter.value().retarget_frame(in.translations_ls(f), in.rotations_ls(f),
                                       out.translations_ls(f), out.rotations_ls(f));
   }
-  Status written = write_bvh(out, args.output, BvhWriteOptions::in_file_units(rig_metres_per_unit));
+  // In the rig file's units; an ASF rig (read in metres) in its convention's BVH units.
+  const double written_metres_per_unit = readable_metres_per_unit(*target, rig_metres_per_unit);
+  Status written =
+      write_bvh(out, args.output, BvhWriteOptions::in_file_units(written_metres_per_unit));
   if (!written) {
     fmt::print(stderr, "duet retarget: {}\n", written.error().message);
     return kExitFailure;
@@ -131,7 +127,7 @@ int run_retarget(const RetargetArgs& args) {
              "wrote {}: {} frames at {:.6g} fps on {} ({} joints, {:.6g} m per unit), stride "
              "scale {:.4f}\n",
              args.output, out.frame_count(), out.frame_rate(), rig_name,
-             target->animated_joint_count(), rig_metres_per_unit,
+             target->animated_joint_count(), written_metres_per_unit,
              retargeter.value().stride_scale());
   return kExitOk;
 }
@@ -155,7 +151,7 @@ Command register_retarget(CLI::App& app) {
   app.add_option("--rig-scale", args->rig_scale,
                  "Metres per unit of the rig file, and of the output (default: known per skeleton "
                  "convention, else guessed from the body's height)")
-      ->check(CLI::PositiveNumber);
+      ->check(scale_check());
   app.add_option("--rig-map", args->rig_map_path,
                  "Skeleton map JSON naming the joint of each role in the rig")
       ->check(CLI::ExistingFile);
@@ -165,7 +161,7 @@ Command register_retarget(CLI::App& app) {
                  "legs_apart=DEG, lean=DEG, toes_out=DEG; e.g. arms=1.1,legs=0.92,trunk=1.05");
   app.add_option("--stride-scale", args->stride_scale,
                  "Scale of the root's path (default: rig leg length / input leg length)")
-      ->check(CLI::PositiveNumber);
+      ->check(number_between(0.1, 10.0));
   app.add_flag("--no-feet", args->no_feet,
                "Do not put the rig's lowest foot at the input's (scaled) height every frame; "
                "scale the pelvis height instead");

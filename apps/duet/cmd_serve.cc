@@ -15,6 +15,7 @@
 #include "duet/live/source_spec.h"
 #include "duet/net/live_server.h"
 #include "library_options.h"
+#include "number_checks.h"
 #include "partner_options.h"
 #include "tracker_options.h"
 
@@ -84,13 +85,19 @@ std::string random_token() {
   return token;
 }
 
-// --web, else web/dist in the working directory, else web/dist in the source tree this binary
-// was built from.
+// --web, else web/dist in the working directory, else the installed copy beside the binary
+// (<prefix>/share/duet/web for <prefix>/bin/duet: `cmake --install`), else web/dist in the
+// source tree this binary was built from.
 fs::path find_web_dir(const std::string& arg) {
   if (!arg.empty()) return arg;
   std::error_code ec;
   const fs::path here = "web/dist";
   if (fs::is_regular_file(here / "index.html", ec)) return here;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = (exe.parent_path() / DUET_WEB_DIR_FROM_BINDIR).lexically_normal();
+    if (fs::is_regular_file(installed / "index.html", ec)) return installed;
+  }
   const fs::path source_tree = fs::path(__FILE__).parent_path().parent_path().parent_path();
   const fs::path built = source_tree / "web" / "dist";
   if (fs::is_regular_file(built / "index.html", ec)) return built;
@@ -332,10 +339,10 @@ Command register_serve(CLI::App& app) {
   app.add_option("--source-fps", args->source_fps,
                  "Frame rate of the source (replay: default --fps, else the file's; live: the "
                  "rate recordings are written at)")
-      ->check(CLI::PositiveNumber);
+      ->check(fps_check());
   app.add_option("--source-scale", args->source_scale,
                  "Metres per unit of the source (default: known per skeleton convention)")
-      ->check(CLI::PositiveNumber);
+      ->check(scale_check());
   app.add_option("--source-map", args->source_map,
                  "Skeleton map JSON for the source's joint names (docs/skeleton-maps.md)")
       ->check(CLI::ExistingFile);
@@ -356,15 +363,15 @@ Command register_serve(CLI::App& app) {
           },
           "TOKEN"));
   app.add_option("--web", args->web,
-                 "Directory of the viewer's files (default: web/dist here, else in the source "
-                 "tree)");
+                 "Directory of the viewer's files (default: web/dist here, else the installed "
+                 "share/duet/web beside bin/duet, else web/dist in the source tree)");
   app.add_option("--record", args->record, "Directory for the session's recordings")
       ->capture_default_str();
   app.add_flag("--no-record", args->no_record, "Do not record the session");
   app.add_flag("--exit-at-end", args->exit_at_end, "Stop when a replay without loop ends");
   app.add_option("--log-interval", args->log_interval_s,
                  "Seconds between latency log lines (0: none)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_check())
       ->capture_default_str();
   app.add_option("--queue-frames", args->queue_frames,
                  "Frames queued per viewer before the oldest is dropped")

@@ -1,6 +1,7 @@
 #include "eval_rigs.h"
 
 #include <filesystem>
+#include <system_error>
 
 #include "duet/io/motion_argument.h"
 #include "duet/io/motion_file.h"
@@ -87,7 +88,8 @@ Result<std::vector<EvalRig>> load_eval_rigs(const std::vector<std::string>& entr
     } else {
       std::string known;
       for (const std::string& n : known_eval_rig_names()) known += n + ", ";
-      if (!std::filesystem::exists(entry) && entry.find('+') == std::string::npos) {
+      std::error_code ec;  // a name too long for a path is no file either, not an exception
+      if (!std::filesystem::exists(entry, ec) && entry.find('+') == std::string::npos) {
         return Error{"--rigs: '" + entry + "' is no rig name (" + known +
                      "all) and no motion file"};
       }

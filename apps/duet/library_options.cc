@@ -4,6 +4,7 @@
 
 #include "duet/io/motion_argument.h"
 #include "duet/live/library_file.h"
+#include "number_checks.h"
 #include "progress.h"
 
 namespace duet::app {
@@ -40,11 +41,11 @@ void add_library_options(CLI::App& app, LibraryArgs& args) {
   app.add_option("--fps", args.fps,
                  "Frame rate of the pair files, overriding their headers and the library file's "
                  "fps (salsa: 60, which libraries/cmu-salsa.toml sets)")
-      ->check(CLI::PositiveNumber);
+      ->check(fps_check());
   app.add_option("--scale", args.scale,
                  "Metres per unit of the pair files (default: the library file's scale, else "
                  "known per skeleton convention)")
-      ->check(CLI::PositiveNumber);
+      ->check(scale_check());
   app.add_flag("--trim", args.trim, "Trim a pair whose two clips differ in length to the shorter");
   // Checked once the whole command line is read, so a mistake exits 2 like any usage error.
   app.parse_complete_callback([&args] {

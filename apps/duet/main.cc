@@ -1,8 +1,39 @@
 // duet: follow a dancer and answer with a virtual partner. See `duet --help`.
-#include <cstdio>
-#include <map>
+#include <fmt/format.h>
 
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <map>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "command_line_hints.h"
 #include "commands.h"
+
+namespace {
+
+// Runs a command so that no exception ends the tool with an abort (exit 134): the commands report
+// bad input as errors, so anything that escapes is a bug, said as one, with exit 1.
+int run_reporting_exceptions(const duet::app::Command& run) {
+  try {
+    // Lets the tests check this path (tests/apps/cli_first_hour_test.cc).
+    if (std::getenv("DUET_TEST_THROW") != nullptr) throw std::runtime_error("DUET_TEST_THROW");
+    return run();
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr,
+               "duet: out of memory (the input or the options ask for more than this "
+               "machine has)\n");
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "duet: internal error: {} (please report it with the command line)\n",
+               e.what());
+  }
+  return duet::app::kExitFailure;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -32,6 +63,12 @@ int main(int argc, char** argv) {
   add("retarget", "Put a motion onto another skeleton, keeping the body's directions and feet",
       duet::app::register_retarget);
 
+  // Mistakes CLI11 would report misleadingly: a misspelt command, an unknown option.
+  if (const std::optional<std::string> mistake = duet::app::find_command_line_mistake(
+          app, std::vector<std::string>(argv + 1, argv + argc))) {
+    fmt::print(stderr, "{}\n", *mistake);
+    return duet::app::kExitUsage;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -45,7 +82,7 @@ int main(int argc, char** argv) {
     return duet::app::kExitUsage;
   }
   for (auto& [sub, run] : commands) {
-    if (sub->parsed()) return run();
+    if (sub->parsed()) return run_reporting_exceptions(run);
   }
   return duet::app::kExitUsage;
 }

@@ -2,18 +2,20 @@
 
 #include <fmt/format.h>
 
+#include "number_checks.h"
+
 namespace duet::app {
 
 void add_motion_file_options(CLI::App& app, MotionFileOptions& options, const std::string& prefix) {
   app.add_option("--" + prefix + "fps", options.fps,
                  "Frame rate of the file(s), overriding the header (the CMU salsa BVH headers "
                  "say 120; the takes are 60 Hz)")
-      ->check(CLI::PositiveNumber);
+      ->check(fps_check());
   app.add_option("--" + prefix + "scale", options.scale,
                  "Metres per file unit (default: known per skeleton convention: salsa DAZ BVH "
                  "1/0.768, CMU 0.056444; otherwise guessed from the body's height: m, cm, mm, "
                  "inches or CMU units)")
-      ->check(CLI::PositiveNumber);
+      ->check(scale_check());
   app.add_option("--" + prefix + "map", options.map_path,
                  "Skeleton map JSON naming the joint of each role, instead of detecting the roles "
                  "(see docs/skeleton-maps.md)")

@@ -4,6 +4,7 @@
 #include "duet/follow/naive_hmm.h"
 #include "duet/follow/nearest_neighbour.h"
 #include "duet/follow/online_dtw.h"
+#include "number_checks.h"
 
 namespace duet::app {
 
@@ -27,7 +28,7 @@ void add_tracker_options(CLI::App& app, TrackerArgs& args) {
                  "HMM probabilities: default (chosen by measurement) or paper (Mousas 2018)")
       ->check(CLI::IsMember({"default", "paper"}));
   app.add_option("--sigma", args.sigma, "Emission sigma (standardised feature units)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_check());
   app.add_flag("--fixed-band", args.fixed_band,
                "Keep the HMM's band at the template's tempo instead of centring it on the "
                "dancer's tempo (the paper preset always keeps it fixed)");

@@ -51,10 +51,35 @@ Result<GroundTruth> read_ground_truth(const std::string& path) {
     if (f[0] != static_cast<double>(truth.rows.size())) {
       return make_error(path, line_number, "frames must count up from 0");
     }
+    truth.lines.push_back(line_number);
     truth.times_s.push_back(f[1]);
     truth.rows.push_back(TruthFrame{static_cast<int>(f[2]), f[3], f[4] != 0.0, f[5] != 0.0});
   }
   return truth;
+}
+
+Status check_ground_truth(const GroundTruth& truth, const std::string& path,
+                          std::span<const int> take_frames) {
+  const auto takes = static_cast<int>(take_frames.size());
+  for (std::size_t i = 0; i < truth.rows.size(); ++i) {
+    const TruthFrame& row = truth.rows[i];
+    if (row.take < 0 || row.take >= takes) {
+      return make_error(path, truth.lines[i],
+                        fmt::format("take {} is not in the library, which has {} take(s) "
+                                    "(0..{}): is this the truth of a performance made from "
+                                    "another library or --pair list?",
+                                    row.take, takes, takes - 1));
+    }
+    // One frame of slack: improvise writes positions up to the last frame.
+    const int frames = take_frames[static_cast<std::size_t>(row.take)];
+    if (!(row.template_frame >= -1.0 && row.template_frame <= frames)) {
+      return make_error(path, truth.lines[i],
+                        fmt::format("template frame {} is outside take {} (frames 0..{}): is "
+                                    "the library read at another frame rate (--fps)?",
+                                    row.template_frame, row.take, frames - 1));
+    }
+  }
+  return Ok{};
 }
 
 void print_accuracy_summary(const GroundTruth& truth, std::span<const FollowResult> results,

@@ -1,11 +1,14 @@
 #include "duet/eval/performance.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <random>
 
 #include "duet/math/rotation.h"
+#include "duet/motion/limits.h"
 #include "duet/motion/retarget.h"
 
 namespace duet {
@@ -225,6 +228,22 @@ Performance perform_script(std::span<const SourceTake> sources,
 
 double last_time(const Clip& clip) { return (clip.frame_count() - 1) / clip.frame_rate(); }
 
+// At most how many frames the recipe makes from `take`: the duration (improvise: the given one,
+// else the take's; play: the take at its slowest tempo) times the sensor rate.
+double frames_bound(const Clip& take, const PerformanceRecipe& recipe) {
+  const double rate_hz = recipe.improvise ? recipe.improvise_options.rate_hz : recipe.play.rate_hz;
+  const double rate = rate_hz > 0.0 ? rate_hz : take.frame_rate();
+  double seconds = 0.0;
+  if (recipe.improvise) {
+    const double duration = recipe.improvise_options.duration_s;
+    seconds = duration > 0.0 ? duration : last_time(take);
+  } else {
+    const TempoOptions& tempo = recipe.play.tempo;
+    seconds = last_time(take) / (tempo.drifting() ? tempo.drift_low : tempo.factor);
+  }
+  return std::ceil(seconds * rate) + 1.0;
+}
+
 }  // namespace
 
 Performance play(const SourceTake& source, const PlayOptions& options) {
@@ -426,6 +445,15 @@ Result<Performance> with_rig(Performance performance, std::shared_ptr<const Skel
 Result<Performance> make_performance(std::span<const SourceTake> sources,
                                      const PerformanceRecipe& recipe, std::uint64_t seed) {
   if (sources.empty() || sources[0].clip == nullptr) return Error{"no take to perform from"};
+  if (sources[0].clip->frame_count() >= 2) {
+    const double frames = frames_bound(*sources[0].clip, recipe);
+    if (!(frames <= static_cast<double>(kMaxClipFrames))) {
+      return Error{fmt::format(
+          "the performance would have up to {:.4g} frames, over the limit of {} frames per "
+          "clip: ask for a shorter duration, a lower rate or a faster tempo",
+          frames, kMaxClipFrames)};
+    }
+  }
   Performance performance;
   if (recipe.improvise) {
     ImproviseOptions options = recipe.improvise_options;

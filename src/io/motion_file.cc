@@ -24,6 +24,33 @@ std::string lowercase_extension(const std::string& path) {
   return ext;
 }
 
+// How the units of a file with no --scale are decided (a BVH; an ASF states its own).
+struct UnitsDecision {
+  double metres_per_unit = 1.0;
+  std::string source, name, warning;  // as in LoadedMotion
+};
+
+// `height_in_file_units` is read only when the roles are complete.
+UnitsDecision decide_units(const RoleDetection& detection, double height_in_file_units) {
+  UnitsDecision units;
+  const std::string& convention = detection.roles.convention;
+  if (const std::optional<double> known = known_metres_per_unit(convention)) {
+    units.metres_per_unit = *known;
+    units.source = "convention " + convention;
+  } else if (detection.complete()) {
+    const UnitGuess guess = guess_units_from_height(height_in_file_units);
+    units.metres_per_unit = guess.metres_per_unit;
+    units.name = guess.name;
+    units.warning = guess.warning;
+    units.source = guess.warning.empty() ? "guessed from height" : "default (metres)";
+  } else {
+    units.name = "metres";
+    units.source = "default (metres)";
+    units.warning = "cannot guess the units without the body's roles; kept metres";
+  }
+  return units;
+}
+
 }  // namespace
 
 std::optional<double> known_metres_per_unit(const std::string& convention) {
@@ -71,6 +98,29 @@ UnitGuess guess_units_from_height(double height_in_file_units) {
         height_in_file_units, kPlausibleHeightM[0], kPlausibleHeightM[1]);
   }
   return guess;
+}
+
+double metres_per_unit_read_back(const Skeleton& skeleton, double metres_per_unit) {
+  const RoleDetection detection = detect_roles_report(skeleton);
+  const double height_in_file_units =
+      detection.complete()
+          ? measure_body(skeleton, detection.roles, 1.0 / metres_per_unit).standing_height_m
+          : 0.0;
+  return decide_units(detection, height_in_file_units).metres_per_unit;
+}
+
+double readable_metres_per_unit(const Skeleton& skeleton, double preferred) {
+  const auto reads_back = [&](double metres_per_unit) {
+    const double back = metres_per_unit_read_back(skeleton, metres_per_unit);
+    return std::abs(back - metres_per_unit) <= 1e-9 * metres_per_unit;
+  };
+  if (preferred > 0.0 && std::isfinite(preferred) && reads_back(preferred)) return preferred;
+  const RoleDetection detection = detect_roles_report(skeleton);
+  if (const std::optional<double> known = known_metres_per_unit(detection.roles.convention)) {
+    return *known;  // the reader always assumes these for this convention
+  }
+  // Metres: the height guess recognises an adult in metres, and keeps metres when it cannot guess.
+  return 1.0;
 }
 
 Result<LoadedMotion> load_motion(const std::vector<std::string>& paths,
@@ -131,20 +181,13 @@ Result<LoadedMotion> load_motion(const std::vector<std::string>& paths,
     loaded.units_source = "given (--scale)";
   } else if (lengths_in_metres) {
     loaded.units_source = "ASF file";
-  } else if (const std::optional<double> known = known_metres_per_unit(loaded.roles.convention)) {
-    loaded.metres_per_unit = *known;
-    loaded.units_source = "convention " + loaded.roles.convention;
-  } else if (have_roles) {
-    const UnitGuess guess =
-        guess_units_from_height(measure_body(skeleton, loaded.roles, 1.0).standing_height_m);
-    loaded.metres_per_unit = guess.metres_per_unit;
-    loaded.units_name = guess.name;
-    loaded.units_warning = guess.warning;
-    loaded.units_source = guess.warning.empty() ? "guessed from height" : "default (metres)";
   } else {
-    loaded.units_name = "metres";
-    loaded.units_source = "default (metres)";
-    loaded.units_warning = "cannot guess the units without the body's roles; kept metres";
+    UnitsDecision units = decide_units(
+        detection, have_roles ? measure_body(skeleton, loaded.roles, 1.0).standing_height_m : 0.0);
+    loaded.metres_per_unit = units.metres_per_unit;
+    loaded.units_source = std::move(units.source);
+    loaded.units_name = std::move(units.name);
+    loaded.units_warning = std::move(units.warning);
   }
   if (!lengths_in_metres) {
     if (options.metres_per_unit) loaded.metres_per_unit = *options.metres_per_unit;

@@ -15,6 +15,7 @@
 
 #include "duet/io/known_datasets.h"
 #include "duet/io/motion_argument.h"
+#include "duet/motion/limits.h"
 
 namespace duet {
 
@@ -106,10 +107,15 @@ class FileReader {
     out = *node.value<std::string>();
     return true;
   }
-  bool get_positive(const std::string& key, const toml::node& node, std::optional<double>& out) {
+  // A number within [low, high] (nan and inf are not).
+  bool get_between(const std::string& key, const toml::node& node, double low, double high,
+                   const std::string& unit, std::optional<double>& out) {
     if (!node.is_number()) return fail_type(key, node, "a number");
     const double v = *node.value<double>();
-    if (!(v > 0.0)) return fail(line_of(node), "key '" + key + "' must be positive");
+    if (!(v >= low && v <= high)) {
+      return fail(line_of(node), fmt::format("key '{}' must be between {:g} and {:g} {}, got {:g}",
+                                             key, low, high, unit, v));
+    }
     out = v;
     return true;
   }
@@ -145,8 +151,14 @@ class FileReader {
       }
       if (key == "name" && !get_string(key, node, spec_.name)) return false;
       if (key == "description" && !get_string(key, node, spec_.description)) return false;
-      if (key == "fps" && !get_positive(key, node, spec_.frame_rate)) return false;
-      if (key == "scale" && !get_positive(key, node, spec_.metres_per_unit)) return false;
+      if (key == "fps" && !get_between(key, node, kMinFrameRate, kMaxFrameRate, "fps",
+                                       spec_.frame_rate)) {
+        return false;
+      }
+      if (key == "scale" && !get_between(key, node, kMinMetresPerUnit, kMaxMetresPerUnit,
+                                         "metres per file unit", spec_.metres_per_unit)) {
+        return false;
+      }
       if (key == "trim") {
         if (!node.is_boolean()) return fail_type(key, node, "true or false");
         spec_.trim_to_shorter = *node.value<bool>();
@@ -283,6 +295,17 @@ bool parse_cmu_name(const fs::path& p, std::string& subject, std::string& trial)
   return true;
 }
 
+// Whether the digit string `a` is a smaller number than `b`, at any length (std::stoll throws
+// past 19 digits).
+bool smaller_number(const std::string& a, const std::string& b) {
+  const auto digits = [](const std::string& s) {
+    const std::size_t first = s.find_first_not_of('0');
+    return first == std::string::npos ? std::string() : s.substr(first);
+  };
+  const std::string x = digits(a), y = digits(b);
+  return x.size() != y.size() ? x.size() < y.size() : x < y;
+}
+
 Result<LibrarySpec> recognise_pairs(const fs::path& dir) {
   // subject -> trial -> files by extension; subject -> .asf
   std::map<std::string, std::map<std::string, std::map<std::string, std::vector<fs::path>>>> takes;
@@ -325,7 +348,7 @@ Result<LibrarySpec> recognise_pairs(const fs::path& dir) {
   spec.source = dir.string();
   spec.name = dir.filename().string();
   std::string first = takes.begin()->first, second = std::next(takes.begin())->first;
-  if (std::stoll(second) < std::stoll(first)) std::swap(first, second);
+  if (smaller_number(second, first)) std::swap(first, second);
   std::string leader = first, partner = second;
   const KnownDataset* known = nullptr;
   for (const KnownDataset& d : known_datasets()) {

@@ -15,6 +15,7 @@
 #endif
 
 #include "duet/io/bvh.h"
+#include "duet/io/motion_file.h"
 #include "duet/math/rotation.h"
 
 namespace duet {
@@ -185,11 +186,13 @@ Result<std::unique_ptr<SessionRecorder>> SessionRecorder::start(
 
   Result<BvhStreamWriter> user_writer =
       BvhStreamWriter::open(recorder->user_path_, user, frame_rate,
-                            BvhWriteOptions::in_file_units(options.user_metres_per_unit));
+                            BvhWriteOptions::in_file_units(
+                                readable_metres_per_unit(*user, options.user_metres_per_unit)));
   if (!user_writer) return user_writer.error();
   Result<BvhStreamWriter> partner_writer =
       BvhStreamWriter::open(recorder->partner_path_, partner, frame_rate,
-                            BvhWriteOptions::in_file_units(options.partner_metres_per_unit));
+                            BvhWriteOptions::in_file_units(readable_metres_per_unit(
+                                *partner, options.partner_metres_per_unit)));
   if (!partner_writer) return partner_writer.error();
   recorder->user_ = std::move(user_writer).value();
   recorder->partner_ = std::move(partner_writer).value();

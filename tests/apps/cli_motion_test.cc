@@ -67,11 +67,12 @@ TEST(CliConvert, AsfAmcToBvhResampledAndBack) {
   CommandResult r = run_duet("convert " + kAsf + " " + kAmc + " --input-fps 60 --fps 30 -o " +
                              out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = run_duet("inspect --json --scale 1 " + out.string());
+  r = run_duet("inspect --json " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto doc = nlohmann::json::parse(r.output);
   EXPECT_EQ(doc["frames"], 1121);  // 2242 frames at 60 Hz span 37.35 s
   EXPECT_EQ(doc["fps"], 30.0);
+  EXPECT_NEAR(doc["body_m"]["standing_height"].get<double>(), 1.71, 0.05);  // no --scale needed
   std::filesystem::remove(out);
 }
 

@@ -93,6 +93,30 @@ TEST(MotionUnits, GuessPicksThePlausibleUnit) {
   EXPECT_NE(guess_units_from_height(0.0).warning, "");
 }
 
+// A BVH states no units, so a writer must pick the ones the reader will infer (issue 14: a
+// converted ASF read back 10 cm tall, a converted salsa take 1.3x too big).
+TEST(MotionUnits, ReadableUnitsAreTheOnesTheReaderInfers) {
+  Result<LoadedMotion> salsa = load_motion({kData + "/cmu-salsa/bvh/60/60_01_scaled.bvh"});
+  Result<LoadedMotion> asf =
+      load_motion({kData + "/cmu-salsa/asf-amc/60.asf", kData + "/cmu-salsa/asf-amc/60_01.amc"});
+  Result<LoadedMotion> bandai = load_motion({kData + "/bandai/dataset-1_walk_normal_001.bvh"});
+  ASSERT_TRUE(salsa && asf && bandai);
+  const Skeleton& daz = salsa.value().clip.skeleton();
+  const Skeleton& cmu = asf.value().clip.skeleton();
+  const Skeleton& names = bandai.value().clip.skeleton();
+  // Metres would read back in the convention's units.
+  EXPECT_DOUBLE_EQ(metres_per_unit_read_back(daz, 1.0), 1.0 / 0.768);
+  EXPECT_DOUBLE_EQ(metres_per_unit_read_back(cmu, 1.0), 0.0254 / 0.45);
+  EXPECT_DOUBLE_EQ(readable_metres_per_unit(daz, 1.0), 1.0 / 0.768);
+  EXPECT_DOUBLE_EQ(readable_metres_per_unit(cmu, asf.value().metres_per_unit), 0.0254 / 0.45);
+  // A rig with no known units keeps the source's when the height guess finds them again.
+  EXPECT_DOUBLE_EQ(readable_metres_per_unit(names, 0.01), 0.01);
+  EXPECT_DOUBLE_EQ(readable_metres_per_unit(names, 0.001), 0.001);
+  EXPECT_DOUBLE_EQ(readable_metres_per_unit(names, 1.0), 1.0);
+  // Units the guess would not find (a 1.5 m body as 0.3 units of 5 m): metres.
+  EXPECT_DOUBLE_EQ(readable_metres_per_unit(names, 5.0), 1.0);
+}
+
 class UnknownRigTest : public ::testing::Test {
  protected:
   void SetUp() override {

@@ -100,7 +100,18 @@ TEST(LibraryFile, ErrorsNameTheFileTheLineAndTheKey) {
   e = error_of("fps = \"sixty\"\n" + pair);
   EXPECT_NE(e.find("lib.toml:1: key 'fps' must be a number, not a string"), std::string::npos) << e;
   e = error_of("fps = -60\n" + pair);
-  EXPECT_NE(e.find("lib.toml:1: key 'fps' must be positive"), std::string::npos) << e;
+  EXPECT_NE(e.find("lib.toml:1: key 'fps' must be between 1 and 1000 fps, got -60"),
+            std::string::npos)
+      << e;
+  // The command line's ranges: no frame rate of 1e9 or scale of 1e-300 from a file either.
+  e = error_of("fps = inf\n" + pair);
+  EXPECT_NE(e.find("lib.toml:1: key 'fps' must be between 1 and 1000 fps, got inf"),
+            std::string::npos)
+      << e;
+  e = error_of("\nscale = 1e-300\n" + pair);
+  EXPECT_NE(e.find("lib.toml:2: key 'scale' must be between 0.0001 and 1000 metres per file unit"),
+            std::string::npos)
+      << e;
   e = error_of("name = \"x\"\n" + pair + "\n[[pair]]\nleader = \"" + bvh("60", "10") +
                "\"\npartner = \"61_99.bvh\"\n");
   EXPECT_NE(e.find("lib.toml:8: key 'pair 2.partner': no such file: "), std::string::npos) << e;

@@ -12,6 +12,7 @@
 
 #include "duet/base/result.h"
 #include "duet/motion/clip.h"
+#include "duet/motion/limits.h"
 
 namespace duet {
 
@@ -21,7 +22,7 @@ struct AsfAmcReadOptions {
   // Metres per ASF length unit *after* the file's `:units length` is undone. CMU files are in
   // inches times `length` (0.45): metres = value / length * 0.0254. Give a value to override.
   std::optional<double> metres_per_unit;
-  long long max_frames = 10'000'000;
+  long long max_frames = kMaxClipFrames;
 };
 
 Result<Clip> read_asf_amc(const std::string& asf_path, const std::string& amc_path,

@@ -8,7 +8,9 @@
 
 namespace duet {
 
-// On failure the temporary file is removed and the error names `path` and the reason.
+// On failure the temporary file is removed and the error names `path` and the reason. A `path`
+// that exists and is no regular file (/dev/null, /dev/stdout, a FIFO) is written directly: a
+// rename would replace the device itself (as root, `-o /dev/null` turned /dev/null into a file).
 Status write_file_atomically(const std::string& path, std::string_view content);
 
 }  // namespace duet

@@ -15,6 +15,7 @@
 #include "duet/base/result.h"
 #include "duet/math/rotation.h"
 #include "duet/motion/clip.h"
+#include "duet/motion/limits.h"
 
 namespace duet {
 
@@ -25,7 +26,7 @@ struct BvhReadOptions {
   double scale = 1.0;
   // Upper bound on frames a header may claim, so a bad header cannot make us allocate without
   // bound. The actual number of motion lines is checked against the header either way.
-  long long max_frames = 10'000'000;
+  long long max_frames = kMaxClipFrames;
 };
 
 Result<Clip> read_bvh(const std::string& path, const BvhReadOptions& options = {});

@@ -53,6 +53,19 @@ struct UnitGuess {
 };
 UnitGuess guess_units_from_height(double height_in_file_units);
 
+// The metres per file unit that load_motion finds, without --scale, in a BVH file of `skeleton`
+// (lengths in metres) written at `metres_per_unit`: the convention's known units, else the unit
+// guessed from the body's height, else metres.
+double metres_per_unit_read_back(const Skeleton& skeleton, double metres_per_unit);
+
+// The metres per unit to write a BVH file of `skeleton` (in metres) in, so that every duet command
+// reads it back at its true size with no flags: the first of `preferred` (say, the units of the
+// file the motion came from), the convention's known units and metres that reads back as
+// written. A BVH has no field for its units: the reader can only infer them, so the writer must
+// write what the reader will infer (a salsa skeleton written in metres would read back 1.3x too
+// big, a CMU one 18x too small).
+double readable_metres_per_unit(const Skeleton& skeleton, double preferred);
+
 // `paths` is {file.bvh} or {skeleton.asf, motion.amc} (in either order).
 Result<LoadedMotion> load_motion(const std::vector<std::string>& paths,
                                  const MotionLoadOptions& options = {});

@@ -74,7 +74,8 @@ struct RecorderOptions {
   std::string stem = "session";
   int ring_frames = 2048;  // frames the loop may run ahead of the disk (17 s at 120 Hz)
   // The units the two BVH files are written in (metres per file unit): the source's and the
-  // response takes', so duet reads the recordings back at the size they were danced.
+  // response takes', so duet reads the recordings back at the size they were danced (units the
+  // reader would not infer, such as an ASF source's metres, give way to readable_metres_per_unit).
   double user_metres_per_unit = 1.0;
   double partner_metres_per_unit = 1.0;
   double checkpoint_interval_s = 1.0;
