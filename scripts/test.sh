@@ -30,7 +30,10 @@ ctest --test-dir build-asan --output-on-failure -j"$jobs"
 stage "Fuzzing each reader for ${FUZZ_SECONDS:-30} s"
 CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DDUET_BUILD_FUZZERS=ON -DDUET_BUILD_TESTS=OFF -DDUET_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build build-fuzz -j"$jobs"
+# Only the fuzz targets (and the core library they link): the tool and the server are not fuzzed.
+fuzz_targets=()
+for source in fuzz/*_fuzz.cc; do fuzz_targets+=("$(basename "$source" .cc)"); done
+cmake --build build-fuzz -j"$jobs" --target "${fuzz_targets[@]}"
 for fuzzer in build-fuzz/fuzz/*_fuzz; do
   name=$(basename "$fuzzer" _fuzz)
   corpus=$(mktemp -d)
