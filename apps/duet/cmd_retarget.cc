@@ -4,9 +4,11 @@
 
 #include "commands.h"
 #include "duet/io/bvh.h"
+#include "duet/io/motion_argument.h"
 #include "duet/io/motion_file.h"
 #include "duet/motion/retarget.h"
 #include "duet/motion/rig_variants.h"
+#include "library_options.h"
 #include "motion_options.h"
 #include "number_checks.h"
 
@@ -64,9 +66,22 @@ int run_retarget(const RetargetArgs& args) {
     return kExitUsage;
   }
 
+  // One word may be SKELETON.asf+MOTION.amc, as everywhere else a motion is taken.
+  std::vector<std::string> inputs = args.inputs;
+  std::vector<std::string> rig_files = args.rig;
+  for (std::vector<std::string>* files : {&inputs, &rig_files}) {
+    if (files->size() != 1) continue;
+    Result<std::vector<std::string>> split = split_motion_argument(files->front());
+    if (!split) {
+      fmt::print(stderr, "duet retarget: {}\n", split.error().message);
+      return kExitUsage;
+    }
+    *files = split.value();
+  }
+
   MotionLoadOptions load_options;
   if (!make_load_options(args.input, load_options)) return kExitFailure;
-  Result<LoadedMotion> source = load_motion(args.inputs, load_options);
+  Result<LoadedMotion> source = load_motion(inputs, load_options);
   if (!source) {
     fmt::print(stderr, "duet retarget: {}\n", source.error().message);
     return kExitFailure;
@@ -77,13 +92,13 @@ int run_retarget(const RetargetArgs& args) {
   JointRoles rig_roles = source.value().roles;
   double rig_metres_per_unit = source.value().metres_per_unit;
   std::string rig_name = source.value().description;
-  if (!args.rig.empty()) {
+  if (!rig_files.empty()) {
     MotionFileOptions rig_input;
     rig_input.scale = args.rig_scale;
     rig_input.map_path = args.rig_map_path;
     MotionLoadOptions rig_options;
     if (!make_load_options(rig_input, rig_options)) return kExitFailure;
-    Result<LoadedMotion> rig = load_motion(args.rig, rig_options);
+    Result<LoadedMotion> rig = load_motion(rig_files, rig_options);
     if (!rig) {
       fmt::print(stderr, "duet retarget: rig: {}\n", rig.error().message);
       return kExitFailure;
@@ -136,16 +151,18 @@ int run_retarget(const RetargetArgs& args) {
 
 Command register_retarget(CLI::App& app) {
   auto args = std::make_shared<RetargetArgs>();
-  app.add_option("inputs", args->inputs, "The motion: a .bvh file, or an .asf and an .amc file")
+  app.add_option("inputs", args->inputs,
+                 "The motion: a .bvh file, or an .asf and an .amc file (as two words or as one, "
+                 "SKELETON.asf+MOTION.amc)")
       ->required()
       ->expected(1, 2)
-      ->check(CLI::ExistingFile);
+      ->check(motion_word_check());
   app.add_option("--rig", args->rig,
                  "The target skeleton: a .bvh file (its motion is ignored), or an .asf and an "
-                 ".amc file; the output is written in its units. Put it after the input (it takes "
-                 "up to two files)")
+                 ".amc file (two words, or SKELETON.asf+MOTION.amc); the output is written in its "
+                 "units. Put it after the input (it takes up to two files)")
       ->expected(1, 2)
-      ->check(CLI::ExistingFile);
+      ->check(motion_word_check());
   app.add_option("-o,--output", args->output, "Output BVH file (written atomically)")->required();
   add_motion_file_options(app, args->input);
   app.add_option("--rig-scale", args->rig_scale,

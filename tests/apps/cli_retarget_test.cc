@@ -83,6 +83,24 @@ TEST(CliRetarget, ProportionsWithoutARigUseTheInputsOwnSkeleton) {
   std::filesystem::remove(out);
 }
 
+TEST(CliRetarget, TakesTheAsfRigAsOneWordLikeEveryOtherMotionOption) {
+  const std::string asf_word =
+      data_path("cmu-salsa/asf-amc/60.asf") + "+" + data_path("cmu-salsa/asf-amc/60_01.amc");
+  const auto out = temp("asf_word.bvh");
+  const CommandResult r =
+      run_duet("retarget --fps 60 " + kSalsa + " --rig " + asf_word + " -o " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const LoadedMotion written = load({out.string()});
+  EXPECT_EQ(written.roles.convention, "cmu-asf");
+  EXPECT_NEAR(written.body.standing_height_m, 1.71, 0.05);
+  // A word whose AMC is missing is a usage error naming the missing part.
+  const CommandResult bad = run_duet("retarget " + data_path("cmu-salsa/asf-amc/60.asf") +
+                                     "+missing.amc --rig " + kHandshake + " -o " + out.string());
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("missing.amc"), std::string::npos) << bad.output;
+  std::filesystem::remove(out);
+}
+
 TEST(CliRetarget, BadInputFailsWithReasonAndWritesNothing) {
   const auto out = temp("bad.bvh");
   std::filesystem::remove(out);
