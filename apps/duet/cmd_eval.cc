@@ -37,6 +37,8 @@ struct EvalArgs {
   CaseSettings settings;
   double noise_cm = 1.0;
   // Tuning of the "hmm" tracker (FollowParams fields); unset keeps the follower's defaults.
+  std::optional<float> jump_hold;
+  std::optional<int> jump_tolerance;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
       pause_distance, lost_distance, velocity_cap;
   std::optional<double> tempo_time_constant;
@@ -186,6 +188,8 @@ int run_eval(EvalArgs& args) {
   if (args.velocity_cap) hmm.velocity_distance_cap = *args.velocity_cap;
   if (args.tempo_time_constant) hmm.tempo_time_constant_s = *args.tempo_time_constant;
   if (args.fixed_band) hmm.tempo_adaptive = false;
+  if (args.jump_hold) hmm.jump_hold_s = *args.jump_hold;
+  if (args.jump_tolerance) hmm.jump_tolerance_frames = *args.jump_tolerance;
   if (Status s = hmm.validate(1); !s) return usage_error(s.error().message);
   if (args.dtw_back) options.dtw.window_back = *args.dtw_back;
   if (args.dtw_ahead) options.dtw.window_ahead = *args.dtw_ahead;
@@ -263,12 +267,13 @@ int run_eval(EvalArgs& args) {
   fmt::print(
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
-      "lost_distance {} velocity_cap {} tempo {}\n\n",
+      "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {}\n\n",
       library->takes().size(), library->model().num_states(), library->frame_rate(),
       args.library.role, takes, options.seed, hmm.self_prob, hmm.next_prob, hmm.skip_prob,
       hmm.leave_prob, hmm.pause_stay_prob, hmm.emission_sigma, hmm.pause_distance_per_dim,
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
-      hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed");
+      hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
+      hmm.jump_hold_s, hmm.jump_tolerance_frames);
   fmt::print("{}", format_eval_table(report.value()));
   std::fflush(stdout);
 
@@ -375,6 +380,15 @@ Command register_eval(CLI::App& app) {
       ->check(positive_check());
   tuning->add_flag("--fixed-band", args->fixed_band,
                    "Keep the band fixed at the template's tempo (tempo_adaptive = false)");
+  tuning
+      ->add_option("--jump-hold", args->jump_hold,
+                   "jump_hold_s: how long a far place must hold the posterior's maximum before "
+                   "it is reported as a jump (template seconds; 0 for at once)")
+      ->check(number_between(0.0, 10.0));
+  tuning
+      ->add_option("--jump-tolerance", args->jump_tolerance,
+                   "jump_tolerance_frames: a move back by up to this many frames is no jump")
+      ->check(CLI::Range(0, 1000));
   tuning->add_option("--dtw-back", args->dtw_back, "online DTW window behind the estimate")
       ->check(non_negative_check());
   tuning->add_option("--dtw-ahead", args->dtw_ahead, "online DTW window ahead of the estimate")

@@ -20,6 +20,8 @@ FollowParams FollowParams::paper() {
   params.leave_prob = 0.165f;
   params.pause_stay_prob = 1.0f - 0.165f;
   params.tempo_adaptive = false;
+  params.jump_hold_s = 0.0f;
+  params.jump_tolerance_frames = 0;
   return params;
 }
 
@@ -65,6 +67,13 @@ Status FollowParams::validate(int num_states) const {
   if (confidence_window_frames < 0) {
     return params_error("confidence_window_frames must be >= 0, got " +
                         std::to_string(confidence_window_frames));
+  }
+  if (!(jump_hold_s >= 0.0f && jump_hold_s <= 10.0f)) {
+    return params_error("jump_hold_s must be in [0, 10] s, got " + std::to_string(jump_hold_s));
+  }
+  if (jump_tolerance_frames < 0 || jump_tolerance_frames > 1000) {
+    return params_error("jump_tolerance_frames must be in [0, 1000], got " +
+                        std::to_string(jump_tolerance_frames));
   }
   if (max_steps_per_frame < 1 || max_steps_per_frame > 1000) {
     return params_error("max_steps_per_frame must be in [1, 1000], got " +

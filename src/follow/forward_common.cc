@@ -145,6 +145,19 @@ bool is_jump(const TemplateModel& model, int previous_state, int state, int step
   return model.take_of(previous_state) != model.take_of(state);
 }
 
+void describe_state(const TemplateModel& model, const float* posterior, float total, int state,
+                    int window, FollowResult& result) noexcept {
+  const int take = model.take_of(state);
+  const int begin = std::max(model.take_begin(take), state - window);
+  const int end = std::min(model.take_end(take), state + window + 1);
+  float mass = 0.0f;
+  for (int i = begin; i < end; ++i) mass += posterior[i];
+  result.state = state;
+  result.take = take;
+  result.frame_in_take = state - model.take_begin(take);
+  result.confidence = total > 0.0f ? std::clamp(mass / total, 0.0f, 1.0f) : 0.0f;
+}
+
 void decide(const TemplateModel& model, const float* posterior, float total, float pause_mass,
             int previous_state, int steps, int window, FollowResult& result) noexcept {
   const int num_states = model.num_states();
@@ -156,16 +169,7 @@ void decide(const TemplateModel& model, const float* posterior, float total, flo
       state = i;
     }
   }
-  const int take = model.take_of(state);
-  const int begin = std::max(model.take_begin(take), state - window);
-  const int end = std::min(model.take_end(take), state + window + 1);
-  float mass = 0.0f;
-  for (int i = begin; i < end; ++i) mass += posterior[i];
-
-  result.state = state;
-  result.take = take;
-  result.frame_in_take = state - model.take_begin(take);
-  result.confidence = total > 0.0f ? std::clamp(mass / total, 0.0f, 1.0f) : 0.0f;
+  describe_state(model, posterior, total, state, window, result);
   result.in_pause = pause_mass > 0.5f * total;
   result.jumped = is_jump(model, previous_state, state, steps);
 }

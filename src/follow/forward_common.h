@@ -75,6 +75,11 @@ double weigh_and_normalise(const float* predicted, const float* distance_sq, flo
 // uniform over the first uniform_count entries.
 void normalise(float* mass, int count, int uniform_count) noexcept;
 
+// Fills state (= `state`), take, frame_in_take and confidence (mass within +/- window frames in
+// the same take, divided by total).
+void describe_state(const TemplateModel& model, const float* posterior, float total, int state,
+                    int window, FollowResult& result) noexcept;
+
 // Fills state (argmax of posterior over the M template states, eq. 8-9), take, frame_in_take,
 // confidence (mass within +/- window frames in the same take, divided by total), in_pause
 // (pause_mass > 0.5) and jumped (relative to previous_state, -1 for none).

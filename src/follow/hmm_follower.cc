@@ -33,6 +33,7 @@ void ForwardContext::reset() noexcept {
   previous_state_ = -1;
   previous_lost_ = false;
   tempo_.reset();
+  jump_gate_.reset();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -153,8 +154,8 @@ void HmmForward::transition(const float* alpha, const BandProbabilities& band,
       band_interior<true>(alpha, next, begin + 2, end, band.self, band.next, band.skip, pause_out,
                           resume);
     } else {
-      band_interior<false>(alpha, next, begin + 2, end, band.self, band.next, band.skip,
-                           pause_out, resume);
+      band_interior<false>(alpha, next, begin + 2, end, band.self, band.next, band.skip, pause_out,
+                           resume);
     }
     // The first two targets have fewer sources; the last two have sources whose rows are cut by
     // the end of the take. Recompute those with the exact rows (O(takes) per frame).
@@ -162,7 +163,8 @@ void HmmForward::transition(const float* alpha, const BandProbabilities& band,
     for (const int i : edges) {
       if (i < begin || i >= end) continue;
       float value = uniform ? pause_out : pause_out * resume[i];
-      for (int d = 0; d <= 2 && i - d >= begin; ++d) value += alpha[i - d] * row(i - d, band).band[d];
+      for (int d = 0; d <= 2 && i - d >= begin; ++d)
+        value += alpha[i - d] * row(i - d, band).band[d];
       next[i] = value;
     }
     if (jump) {
@@ -214,6 +216,8 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   const float* alpha = context.alpha_.data();
   follow_detail::decide(model, alpha, 1.0f, alpha[num_states], context.previous_state_,
                         result.steps, params_.confidence_window_frames, result);
+  context.jump_gate_.apply(model, params_, alpha, 1.0f, context.previous_state_,
+                           context.previous_lost_, result);
   result.lost = result.missing ? context.previous_lost_ : (result.lost || result.in_pause);
   if (params_.tempo_adaptive) {
     const bool band_move = !result.missing && !result.lost && !result.jumped;

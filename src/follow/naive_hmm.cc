@@ -76,13 +76,13 @@ void NaiveHmmFollower::set_template_columns(const BandProbabilities& band) noexc
     if (j + 1 < end) a(j + 1, j) = band.next;
     if (j + 2 < end) a(j + 2, j) = band.skip;
     // L_j; at the end of a take, next/skip lead into the pause state.
-    a(pause, j) = jump ? leave_ + (j + 1 >= end ? band.next : 0.0f) +
-                             (j + 2 >= end ? band.skip : 0.0f)
-                       : 0.0f;
+    a(pause, j) =
+        jump ? leave_ + (j + 1 >= end ? band.next : 0.0f) + (j + 2 >= end ? band.skip : 0.0f)
+             : 0.0f;
     if (!jump) {
       // Left-to-right: renormalise what stays in the take; nothing left -> keep the mass.
-      const float sum = a(j, j) + (j + 1 < end ? a(j + 1, j) : 0.0f) +
-                        (j + 2 < end ? a(j + 2, j) : 0.0f);
+      const float sum =
+          a(j, j) + (j + 1 < end ? a(j + 1, j) : 0.0f) + (j + 2 < end ? a(j + 2, j) : 0.0f);
       if (sum > 0.0f) {
         a(j, j) /= sum;
         if (j + 1 < end) a(j + 1, j) /= sum;
@@ -101,6 +101,7 @@ void NaiveHmmFollower::reset() noexcept {
   previous_state_ = -1;
   previous_lost_ = false;
   tempo_.reset();
+  jump_gate_.reset();
 }
 
 FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s) noexcept {
@@ -138,6 +139,7 @@ FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s
 
   follow_detail::decide(model, alpha_.data(), 1.0f, alpha_[static_cast<std::size_t>(num_states)],
                         previous_state_, result.steps, params_.confidence_window_frames, result);
+  jump_gate_.apply(model, params_, alpha_.data(), 1.0f, previous_state_, previous_lost_, result);
   result.lost = result.missing ? previous_lost_ : (result.lost || result.in_pause);
   if (params_.tempo_adaptive) {
     const bool band_move = !result.missing && !result.lost && !result.jumped;

@@ -127,6 +127,9 @@ TEST(FollowParams, RejectsBadValues) {
   check([](FollowParams& p) { p.min_tempo = 0.0f; }, "tempo range");
   check([](FollowParams& p) { p.skip_prob = 0.0f; }, "tempo_adaptive needs");
   check([](FollowParams& p) { p.max_steps_per_frame = 0; }, "max_steps_per_frame");
+  check([](FollowParams& p) { p.jump_hold_s = -0.1f; }, "jump_hold_s");
+  check([](FollowParams& p) { p.jump_hold_s = std::nanf(""); }, "jump_hold_s");
+  check([](FollowParams& p) { p.jump_tolerance_frames = -1; }, "jump_tolerance_frames");
   check([](FollowParams& p) { p.resume_weights.assign(9, 1.0f); }, "resume_weights has 9");
   check([](FollowParams& p) { p.resume_weights.assign(10, 0.0f); }, "sum to zero");
   check(

@@ -16,6 +16,7 @@
 
 #include "duet/base/result.h"
 #include "duet/follow/follow_params.h"
+#include "duet/follow/jump_gate.h"
 #include "duet/follow/tempo_band.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tracker.h"
@@ -57,6 +58,7 @@ class ForwardContext {
   int previous_state_ = -1;
   bool previous_lost_ = false;
   TempoEstimator tempo_;
+  JumpGate jump_gate_;
 };
 
 class HmmForward {

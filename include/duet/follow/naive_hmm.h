@@ -11,6 +11,7 @@
 
 #include "duet/base/result.h"
 #include "duet/follow/follow_params.h"
+#include "duet/follow/jump_gate.h"
 #include "duet/follow/tempo_band.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tracker.h"
@@ -45,6 +46,7 @@ class NaiveHmmFollower final : public Tracker {
   float leave_ = 0.0f;
   TempoLimits tempo_limits_;
   TempoEstimator tempo_;
+  JumpGate jump_gate_;
   float inv_two_sigma_sq_ = 0.0f;
   float log_pause_emission_ = 0.0f;
   float lost_distance_sq_ = 0.0f;

@@ -46,6 +46,8 @@ class FollowSession {
   PostureBias bias_;  // the user's rig's posture offset, learnt online
   double previous_time_s_ = 0.0;
   bool has_previous_ = false;
+  int previous_state_ = -1;  // the estimate of the previous frame
+  int previous_take_ = -1;
 };
 
 }  // namespace duet

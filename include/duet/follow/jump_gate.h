@@ -1,0 +1,44 @@
+// Jump decisions that hold (issue 11). The estimate is the posterior's most likely state; under a
+// noisy sensor that maximum flickers, one frame to a look-alike place elsewhere in the library and
+// back, and every such excursion would be reported as a jump (the partner restarts its playhead
+// and blends: 67 false jumps a minute at 3 degrees of noise, nearly all of them the maximum
+// stepping back a frame or two). A small move backwards (up to jump_tolerance_frames) is jitter,
+// not a jump. Optionally (FollowParams::jump_hold_s > 0) a move out of the band's reach is
+// reported only once the new place has held the maximum for that long in template time (a
+// bounded decision delay); until then the best state near the old place is reported.
+// After a lost frame (or in the pause state) the new place is taken at once.
+#pragma once
+
+#include "duet/follow/follow_params.h"
+#include "duet/follow/template_model.h"
+#include "duet/follow/tracker.h"
+
+namespace duet {
+
+class JumpGate {
+ public:
+  void reset() noexcept {
+    candidate_state_ = -1;
+    held_s_ = 0.0;
+  }
+
+  // `result` holds the posterior's maximum (follow_detail::decide); on return it holds the state
+  // to report, with take, frame, confidence and jumped set for it. `posterior` has M entries
+  // (mass `total` over M + 1 with the pause state); `previous_state` is the state reported for
+  // the previous frame (-1 at the start). After a lost frame there is no place to hold on to: the
+  // maximum is taken at once. Allocates nothing.
+  void apply(const TemplateModel& model, const FollowParams& params, const float* posterior,
+             float total, int previous_state, bool previous_lost, FollowResult& result) noexcept;
+
+  // Whether `state` is out of the band's reach from `from` in `steps` template steps (another
+  // take, backwards by more than `tolerance` frames, or forwards by more than 2 * steps +
+  // tolerance).
+  static bool out_of_reach(const TemplateModel& model, int from, int state, int steps,
+                           int tolerance) noexcept;
+
+ private:
+  int candidate_state_ = -1;  // the far place that currently holds the maximum
+  double held_s_ = 0.0;       // how long (template time) it has held it
+};
+
+}  // namespace duet

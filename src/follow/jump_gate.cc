@@ -1,0 +1,60 @@
+#include "duet/follow/jump_gate.h"
+
+#include <algorithm>
+
+#include "forward_common.h"
+
+namespace duet {
+
+bool JumpGate::out_of_reach(const TemplateModel& model, int from, int state, int steps,
+                            int tolerance) noexcept {
+  if (from < 0 || state < 0) return false;
+  if (model.take_of(from) != model.take_of(state)) return true;
+  const int moved = state - from;
+  return moved < -tolerance || moved > 2 * steps + tolerance;
+}
+
+void JumpGate::apply(const TemplateModel& model, const FollowParams& params, const float* posterior,
+                     float total, int previous_state, bool previous_lost,
+                     FollowResult& result) noexcept {
+  const int tolerance = params.jump_tolerance_frames;
+  const int steps = std::max(result.steps, 1);
+  if (previous_state < 0 || result.missing || result.state < 0 ||
+      !out_of_reach(model, previous_state, result.state, steps, tolerance)) {
+    // Within reach of the old place: no jump, whatever the raw maximum's step was.
+    result.jumped = false;
+    reset();
+    return;
+  }
+  if (previous_lost || result.in_pause || params.jump_hold_s <= 0.0f) {
+    result.jumped = true;  // nothing to hold on to, or no delay asked for
+    reset();
+    return;
+  }
+  // The maximum is far from the old place. The same far place (moving along its take) holds on;
+  // another one starts over.
+  const double step_s = static_cast<double>(steps) / model.frame_rate_hz();
+  const bool same_candidate =
+      candidate_state_ >= 0 &&
+      !out_of_reach(model, candidate_state_, result.state, steps, tolerance);
+  held_s_ = same_candidate ? held_s_ + step_s : step_s;
+  candidate_state_ = result.state;
+  if (held_s_ + 1e-6 >= params.jump_hold_s) {  // (3 frames of 1/60 s make 0.05 s)
+    result.jumped = true;
+    reset();
+    return;
+  }
+  // Not yet: report the best state within reach of the old place.
+  const int take = model.take_of(previous_state);
+  const int begin = std::max(model.take_begin(take), previous_state - tolerance);
+  const int end = std::min(model.take_end(take), previous_state + 2 * steps + tolerance + 1);
+  int best = begin;
+  for (int i = begin + 1; i < end; ++i) {
+    if (posterior[i] > posterior[best]) best = i;
+  }
+  follow_detail::describe_state(model, posterior, total, best, params.confidence_window_frames,
+                                result);
+  result.jumped = false;
+}
+
+}  // namespace duet

@@ -1,0 +1,103 @@
+// JumpGate (issue 11): which moves of the posterior's maximum are reported as jumps.
+#include "duet/follow/jump_gate.h"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace duet {
+namespace {
+
+// Two takes of 100 frames at 60 Hz; features do not matter to the gate.
+TemplateModel two_takes() {
+  FeatureMatrix f = FeatureMatrix::Zero(200, 2);
+  return std::move(TemplateModel::build(std::move(f), {0, 100}, 60.0, 0)).value();
+}
+
+// A posterior with all its mass on `peak` and a little on `also`.
+std::vector<float> posterior(int peak, int also = -1) {
+  std::vector<float> p(201, 0.0f);
+  p[static_cast<std::size_t>(peak)] = 0.9f;
+  if (also >= 0) p[static_cast<std::size_t>(also)] = 0.1f;
+  return p;
+}
+
+FollowResult maximum_at(const TemplateModel& model, const std::vector<float>& p, int state) {
+  FollowResult r;
+  r.steps = 1;
+  r.state = state;
+  r.take = model.take_of(state);
+  r.frame_in_take = state - model.take_begin(r.take);
+  r.jumped = true;  // what decide() says of any move out of the band
+  (void)p;
+  return r;
+}
+
+TEST(JumpGate, SmallStepsBackAreJitterLargerOnesAndOtherTakesAreJumps) {
+  const TemplateModel model = two_takes();
+  FollowParams params;
+  params.jump_hold_s = 0.0f;
+  params.jump_tolerance_frames = 6;
+  JumpGate gate;
+  for (const auto& [from, to, jump] : {std::tuple{50, 47, false},
+                                       {50, 44, false},
+                                       {50, 43, true},
+                                       {50, 52, false},
+                                       {50, 58, false},
+                                       {50, 59, true},
+                                       {50, 150, true}}) {
+    gate.reset();
+    const std::vector<float> p = posterior(to);
+    FollowResult r = maximum_at(model, p, to);
+    gate.apply(model, params, p.data(), 1.0f, from, false, r);
+    EXPECT_EQ(r.jumped, jump) << from << " -> " << to;
+    EXPECT_EQ(r.state, to);
+  }
+}
+
+TEST(JumpGate, AFarPlaceIsReportedOnlyOnceItHolds) {
+  const TemplateModel model = two_takes();
+  FollowParams params;
+  params.jump_hold_s = 0.05f;  // 3 template frames
+  JumpGate gate;
+  // One frame's excursion to take 1 and back: never reported; the old place goes on.
+  std::vector<float> p = posterior(150, 41);
+  FollowResult r = maximum_at(model, p, 150);
+  gate.apply(model, params, p.data(), 1.0f, 40, false, r);
+  EXPECT_FALSE(r.jumped);
+  EXPECT_EQ(r.state, 41);
+  EXPECT_EQ(r.take, 0);
+  EXPECT_EQ(r.frame_in_take, 41);
+  EXPECT_NEAR(r.confidence, 0.1f, 1e-6);
+  p = posterior(42);
+  r = maximum_at(model, p, 42);
+  r.jumped = false;
+  gate.apply(model, params, p.data(), 1.0f, 41, false, r);
+  EXPECT_FALSE(r.jumped);
+  EXPECT_EQ(r.state, 42);
+  // A real move to take 1 (advancing there) is reported on its third frame.
+  int previous = 42;
+  for (int k = 0; k < 3; ++k) {
+    p = posterior(150 + k, previous + 1);
+    r = maximum_at(model, p, 150 + k);
+    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+    EXPECT_EQ(r.jumped, k == 2) << k;
+    EXPECT_EQ(r.state, k == 2 ? 152 : previous + 1) << k;
+    previous = r.state;
+  }
+}
+
+TEST(JumpGate, AfterALostFrameTheNewPlaceIsTakenAtOnce) {
+  const TemplateModel model = two_takes();
+  FollowParams params;
+  params.jump_hold_s = 0.5f;
+  JumpGate gate;
+  const std::vector<float> p = posterior(150, 41);
+  FollowResult r = maximum_at(model, p, 150);
+  gate.apply(model, params, p.data(), 1.0f, 40, /*previous_lost=*/true, r);
+  EXPECT_TRUE(r.jumped);
+  EXPECT_EQ(r.state, 150);
+}
+
+}  // namespace
+}  // namespace duet
