@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace duet {
 
@@ -48,6 +49,30 @@ void MetricsAccumulator::add(std::span<const TruthFrame> truth, std::span<const 
     errors_ms_.push_back(errors[i]);
     if (estimates[i].take < 0 || estimates[i].take != truth[i].take) ++misses_;
     if (estimates[i].lost) ++lost_;
+    if (errors[i] <= 100.0) {
+      ++tracked_;
+      if (estimates[i].lost) ++lost_on_tracked_;
+    }
+  }
+  if (n > 1) duration_s_ += times_s[n - 1] - times_s[0];
+
+  // Reported jumps that answer no true jump: outside every window that opens just before a true
+  // jump's pause (or the jump) and closes jump_answer_window_s after the jump.
+  std::vector<std::pair<double, double>> answer_windows;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!truth[k].jump) continue;
+    std::size_t first = k;
+    while (first > 0 && truth[first - 1].in_pause) --first;
+    answer_windows.emplace_back(times_s[first] - options_.jump_answer_lead_s,
+                                times_s[k] + options_.jump_answer_window_s);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!estimates[i].jumped) continue;
+    ++reported_jumps_;
+    const bool answers = std::ranges::any_of(answer_windows, [&](const auto& w) {
+      return times_s[i] >= w.first && times_s[i] <= w.second;
+    });
+    if (!answers) ++false_jumps_;
   }
 
   // Jump recovery: first frame after the jump from which the error stays within tolerance for
@@ -86,6 +111,11 @@ void MetricsAccumulator::merge(const MetricsAccumulator& other) {
   pause_frames_ += other.pause_frames_;
   lost_ += other.lost_;
   misses_ += other.misses_;
+  tracked_ += other.tracked_;
+  lost_on_tracked_ += other.lost_on_tracked_;
+  reported_jumps_ += other.reported_jumps_;
+  false_jumps_ += other.false_jumps_;
+  duration_s_ += other.duration_s_;
   step_us_sum_ += other.step_us_sum_;
 }
 
@@ -112,6 +142,12 @@ Metrics MetricsAccumulator::summary() const {
     m.median_error_ms = median(errors_ms_);
     m.lost_fraction = static_cast<double>(lost_) / scored;
   }
+  m.lost_on_tracked_fraction =
+      tracked_ > 0 ? static_cast<double>(lost_on_tracked_) / static_cast<double>(tracked_) : 0.0;
+  m.reported_jumps = reported_jumps_;
+  m.false_jumps = false_jumps_;
+  m.false_jumps_per_minute =
+      duration_s_ > 0.0 ? static_cast<double>(false_jumps_) / (duration_s_ / 60.0) : 0.0;
   m.jumps = static_cast<long long>(recovery_s_.size());
   double recovered_sum = 0.0;
   for (const double r : recovery_s_) {

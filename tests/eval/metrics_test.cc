@@ -141,6 +141,35 @@ TEST(Metrics, UnrecoveredJumpsAndRecoveryEndingAtThePause) {
   EXPECT_EQ(m.scored_frames, 190);
 }
 
+TEST(Metrics, FalseJumpsAreReportedJumpsThatAnswerNoTrueJump) {
+  // 60 s at 60 Hz; a true jump at frame 1800 after a 0.5 s pause (frames 1770-1799).
+  Trace t(3600);
+  for (int k = 1770; k < 1800; ++k) t.truth[static_cast<std::size_t>(k)].in_pause = true;
+  t.truth[1800].jump = true;
+  // Answers: at the pause's start (within the 0.1 s lead) and 0.9 s after the jump.
+  t.estimates[1766].jumped = true;
+  t.estimates[1854].jumped = true;
+  // False: 0.2 s before the pause, 1.2 s after the jump, and one in the middle of nowhere.
+  t.estimates[1758].jumped = true;
+  t.estimates[1872].jumped = true;
+  t.estimates[600].jumped = true;
+  const Metrics m = t.metrics();
+  EXPECT_EQ(m.reported_jumps, 5);
+  EXPECT_EQ(m.false_jumps, 3);
+  EXPECT_NEAR(m.false_jumps_per_minute, 3.0 / (3599.0 / 60.0 / 60.0), 1e-9);
+}
+
+TEST(Metrics, LostOnTrackedFramesCountsOnlyFramesWithin100Ms) {
+  Trace t(100);
+  for (int k = 0; k < 10; ++k) t.estimates[static_cast<std::size_t>(k)].lost = true;  // tracked
+  for (int k = 50; k < 70; ++k) {
+    t.estimates[static_cast<std::size_t>(k)] = {1, 0, true, false, 10.0};  // wrong take, lost
+  }
+  const Metrics m = t.metrics();
+  EXPECT_NEAR(m.lost_fraction, 30.0 / 100.0, 1e-12);
+  EXPECT_NEAR(m.lost_on_tracked_fraction, 10.0 / 80.0, 1e-12);
+}
+
 TEST(Metrics, PoolsPerformances) {
   Trace a(100), b(300);
   for (auto& e : b.estimates) e.take = 2;  // b is all misses

@@ -27,6 +27,10 @@ struct MetricsOptions {
   double miss_error_ms = 1000.0;         // error of a miss, and cap of every error
   double recovery_tolerance_ms = 100.0;  // recovered: within this of the truth ...
   double recovery_hold_s = 0.1;          // ... for this long (at least 3 frames)
+  // A reported jump answers a true one when it falls from just before that jump's pause (or the
+  // jump itself) to this long after the jump; any other reported jump is false.
+  double jump_answer_window_s = 1.0;
+  double jump_answer_lead_s = 0.1;
 };
 
 // Error of one frame in ms of template time, capped at options.miss_error_ms (a wrong take or no
@@ -55,7 +59,15 @@ struct Metrics {
   double median_recovery_s = 0.0;  // +inf when half or more are unrecovered; 0 without jumps
   double mean_recovery_s = 0.0;    // over the recovered jumps only
   double lost_fraction = 0.0;      // scored frames the tracker flagged as lost
-  double mean_step_us = 0.0;       // mean wall-clock time per session step (measured)
+  // Lost among the frames the tracker actually follows (scored, within 100 ms): a lost flag there
+  // is a false alarm (issue 11).
+  double lost_on_tracked_fraction = 0.0;
+  // Jumps the tracker reported (FrameEstimate::jumped) and those that answer no true jump (see
+  // MetricsOptions::jump_answer_window_s), per minute of performance.
+  long long reported_jumps = 0;
+  long long false_jumps = 0;
+  double false_jumps_per_minute = 0.0;
+  double mean_step_us = 0.0;  // mean wall-clock time per session step (measured)
 };
 
 // Collects per-frame errors of several performances and summarises them (pooled over frames and
@@ -80,6 +92,8 @@ class MetricsAccumulator {
   std::vector<double> errors_ms_;   // scored frames
   std::vector<double> recovery_s_;  // one per jump, +inf when unrecovered
   long long frames_ = 0, pause_frames_ = 0, lost_ = 0, misses_ = 0;
+  long long tracked_ = 0, lost_on_tracked_ = 0, reported_jumps_ = 0, false_jumps_ = 0;
+  double duration_s_ = 0.0;
   double step_us_sum_ = 0.0;
 };
 
