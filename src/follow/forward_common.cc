@@ -169,11 +169,18 @@ void decide(const TemplateModel& model, const float* posterior, float total, flo
             int previous_state, int steps, int window, FollowResult& result) noexcept {
   const int num_states = model.num_states();
   int state = 0;
-  float best = posterior[0];
-  for (int i = 1; i < num_states; ++i) {
-    if (posterior[i] > best) {
-      best = posterior[i];
-      state = i;
+#if defined(__x86_64__)
+  if (simd_level() == SimdLevel::kAvx2) {
+    state = avx2::argmax(posterior, num_states);
+  } else
+#endif
+  {
+    float best = posterior[0];
+    for (int i = 1; i < num_states; ++i) {
+      if (posterior[i] > best) {
+        best = posterior[i];
+        state = i;
+      }
     }
   }
   const int take = model.take_of(state);

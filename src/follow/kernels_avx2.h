@@ -15,6 +15,10 @@ float emission_distances(const float* blocked, int num_states, int dims, int vel
 float weigh_emissions(const float* predicted, const float* distance_sq, float inv_two_sigma_sq,
                       float shift, int num_states, float* out) noexcept;
 
+// The first index of the largest of values[0..count), count >= 1, values not NaN (as the scalar
+// loop in decide).
+int argmax(const float* values, int count) noexcept;
+
 // out[i] = exp(x[i]): relative error < 1e-6 where exp(x) is a normal float, 0 below
 // ln(FLT_MIN) = -87.34 (denormals are flushed on the per-frame path anyway).
 void exp(const float* x, int count, float* out) noexcept;
