@@ -1,6 +1,6 @@
 // The AVX2+FMA kernels against the portable scalar/Eigen path they replace at run time: the
-// emission distances (eq. 7), the exp, and the posterior of whole forward steps (eq. 11). Where
-// the CPU has no AVX2 the dispatcher must have chosen the scalar path.
+// emission distances (eq. 7), the exp, the argmax (eq. 8-9) and the posterior of whole forward
+// steps (eq. 11). Where the CPU has no AVX2 the dispatcher must have chosen the scalar path.
 #include <gtest/gtest.h>
 
 #include <cfloat>
@@ -123,6 +123,32 @@ TEST(SimdKernels, Avx2ExpIsWithinOneMillionthOfExpOverTheUsedRange) {
   std::printf("exp: worst relative error %.3g over %zu points\n", worst, x.size());
   EXPECT_LT(worst, 1e-6);
   EXPECT_EQ(y[0], 1.0f);
+}
+
+TEST(SimdKernels, Avx2ArgmaxIsTheFirstLargestValueLikeTheScalarLoop) {
+  if (!cpu_has_avx2()) {
+    EXPECT_EQ(simd_level(), SimdLevel::kScalar);
+    return;
+  }
+  std::mt19937 rng(17);
+  std::uniform_int_distribution<int> level(0, 5);  // few distinct values: many ties
+  for (const int count : {1, 7, 8, 31, 32, 33, 100, 1003, 27495}) {
+    std::vector<float> values(static_cast<std::size_t>(count));
+    for (int trial = 0; trial < 20; ++trial) {
+      for (float& v : values) v = 0.1f * static_cast<float>(level(rng));
+      int expected = 0;
+      for (int i = 1; i < count; ++i) {
+        if (values[static_cast<std::size_t>(i)] > values[static_cast<std::size_t>(expected)]) {
+          expected = i;
+        }
+      }
+      ASSERT_EQ(follow_detail::avx2::argmax(values.data(), count), expected) << count;
+    }
+    // A single largest value in the last element (the scalar tail).
+    std::fill(values.begin(), values.end(), 0.0f);
+    values.back() = 1.0f;
+    EXPECT_EQ(follow_detail::avx2::argmax(values.data(), count), count - 1);
+  }
 }
 
 // Both followers step through the same frames, one on each path; posteriors within 1e-5.
