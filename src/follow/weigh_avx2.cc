@@ -57,8 +57,8 @@ __attribute__((target("avx2,fma"))) float weigh_emissions(const float* predicted
     sum0 = _mm256_add_ps(sum0, a);
   }
   if (i < num_states) {
-    // Masked lanes load as 0: weigh gives 0 * exp(-shift), which is 0 or (shift < -88) 0 * inf;
-    // the and with the mask keeps NaN out of the sum.
+    // Lanes past the end load as 0 (0 * a finite exp, exp8 being clamped); the and with the mask
+    // zeroes them anyway, so nothing past the end can reach the sum.
     const __m256i mask = tail_mask(num_states - i);
     const __m256 a =
         _mm256_and_ps(weigh(_mm256_maskload_ps(predicted + i, mask),
