@@ -11,6 +11,8 @@
 #include "duet/follow/naive_hmm.h"
 #include "duet/follow/nearest_neighbour.h"
 #include "duet/follow/online_dtw.h"
+#include "duet/follow/simd.h"
+#include "follow/forward_common.h"
 
 namespace duet {
 namespace {
@@ -18,10 +20,10 @@ namespace {
 constexpr int kDims = 60;
 constexpr int kQueries = 64;
 
-TemplateModel random_model(int states) {
+TemplateModel random_model(int states, int dims = kDims) {
   std::mt19937 rng(static_cast<unsigned>(states));
   std::normal_distribution<float> normal(0.0f, 1.0f);
-  FeatureMatrix f(states, kDims);
+  FeatureMatrix f(states, dims);
   for (Eigen::Index i = 0; i < f.size(); ++i) f.data()[i] = normal(rng);
   // A library of takes of about 2000 frames, like the salsa takes.
   std::vector<int> starts;
@@ -37,8 +39,8 @@ std::vector<std::vector<float>> queries(const TemplateModel& model) {
   std::vector<std::vector<float>> out;
   for (int q = 0; q < kQueries; ++q) {
     const int i = (q * 37) % model.num_states();
-    std::vector<float> phi(kDims);
-    for (int d = 0; d < kDims; ++d)
+    std::vector<float> phi(static_cast<std::size_t>(model.num_dims()));
+    for (int d = 0; d < model.num_dims(); ++d)
       phi[static_cast<std::size_t>(d)] = model.features()(i, d) + normal(rng);
     out.push_back(std::move(phi));
   }
@@ -103,6 +105,88 @@ void BM_OnlineDtw(benchmark::State& state) {
   run(state, dtw, model, 1.0 / 60);
 }
 BENCHMARK(BM_OnlineDtw)->Arg(27495)->Unit(benchmark::kMicrosecond);
+
+// ---------------------------------------------------------------------------------------------
+// The step's kernels on each instruction set in one run (src/follow/kernels_avx2.h, issue 13):
+// 27495 states and D = 50 like the salsa library. per_state is the time per template state.
+
+constexpr int kLibraryStates = 27495;
+constexpr int kLibraryDims = 50;
+
+// Selects level for one benchmark; false (and the benchmark skipped) when the CPU lacks it.
+bool use_level(benchmark::State& state, SimdLevel level) {
+  if (set_simd_level(level)) return true;
+  state.SkipWithError("this CPU cannot run this instruction set");
+  return false;
+}
+
+void count_states(benchmark::State& state, int states) {
+  state.counters["states"] = states;
+  // Seconds per state (printed with its SI prefix, e.g. 2.1ns).
+  state.counters["per_state"] = benchmark::Counter(
+      states, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+void BM_EmissionDistances(benchmark::State& state, SimdLevel level) {
+  if (!use_level(state, level)) return;
+  const TemplateModel model = random_model(kLibraryStates, kLibraryDims);
+  const auto inputs = queries(model);
+  std::vector<float> out(static_cast<std::size_t>(model.num_states()));
+  const float cap = FollowParams{}.velocity_distance_cap;
+  std::size_t q = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        follow_detail::emission_distances(model, inputs[q].data(), cap, out.data()));
+    benchmark::ClobberMemory();
+    q = (q + 1) % inputs.size();
+  }
+  count_states(state, model.num_states());
+  set_simd_level(detect_simd_level());
+}
+BENCHMARK_CAPTURE(BM_EmissionDistances, scalar, SimdLevel::kScalar)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_EmissionDistances, avx2, SimdLevel::kAvx2)->Unit(benchmark::kMicrosecond);
+
+// The exp pass of eq. 11 (weigh_and_normalise) on the distances of a real-looking query.
+void BM_WeighAndNormalise(benchmark::State& state, SimdLevel level) {
+  if (!use_level(state, level)) return;
+  const TemplateModel model = random_model(kLibraryStates, kLibraryDims);
+  const int m = model.num_states();
+  const auto size = static_cast<std::size_t>(m);
+  std::vector<float> distance_sq(size), predicted(size + 1, 1.0f / static_cast<float>(m + 1));
+  std::vector<float> out(size + 1);
+  // The dancer exactly on a template frame: the common, fast path (a query far from every
+  // template would, with uniform predicted mass, take the rare rescaling path instead).
+  const Eigen::RowVectorXf on_template = model.features().row(m / 3);
+  const float best = follow_detail::emission_distances(
+      model, on_template.data(), FollowParams{}.velocity_distance_cap, distance_sq.data());
+  // The default parameters, as HmmForward::create derives them.
+  const FollowParams params;
+  const float inv_two_sigma_sq = 1.0f / (2.0f * params.emission_sigma * params.emission_sigma);
+  const float log_b_pause = -params.pause_distance_per_dim * kLibraryDims * inv_two_sigma_sq;
+  const follow_detail::ScopedFlushDenormals flush_denormals;  // as in HmmForward::step
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        follow_detail::weigh_and_normalise(predicted.data(), distance_sq.data(), best,
+                                           inv_two_sigma_sq, m, log_b_pause, true, out.data()));
+    benchmark::ClobberMemory();
+  }
+  count_states(state, m);
+  set_simd_level(detect_simd_level());
+}
+BENCHMARK_CAPTURE(BM_WeighAndNormalise, scalar, SimdLevel::kScalar)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_WeighAndNormalise, avx2, SimdLevel::kAvx2)->Unit(benchmark::kMicrosecond);
+
+// The whole forward step (BM_ForwardStep) on each instruction set, D = 50.
+void BM_ForwardStepSimd(benchmark::State& state, SimdLevel level) {
+  if (!use_level(state, level)) return;
+  const TemplateModel model = random_model(kLibraryStates, kLibraryDims);
+  HmmFollower hmm = HmmFollower::create(model, {}).value();
+  run(state, hmm, model, 1.0 / 60);
+  count_states(state, model.num_states());
+  set_simd_level(detect_simd_level());
+}
+BENCHMARK_CAPTURE(BM_ForwardStepSimd, scalar, SimdLevel::kScalar)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ForwardStepSimd, avx2, SimdLevel::kAvx2)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace duet

@@ -4,6 +4,7 @@
 //
 // BM_FollowSessionStep/0: take 01 on the library's own rig (DAZ BVH, 43 joints).
 // BM_FollowSessionStep/1: take 01 on the CMU ASF rig (31 joints).
+// BM_FollowSessionStepScalar/*: the same on the scalar kernels (DUET_SIMD=scalar), same run.
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "duet/follow/hmm_follower.h"
+#include "duet/follow/simd.h"
 #include "duet/io/motion_file.h"
 #include "duet/live/duet_library.h"
 #include "duet/live/follow_session.h"
@@ -25,8 +27,8 @@ const std::string kSalsa = std::string(DUET_DATA_DIR) + "/cmu-salsa";
 const DuetLibrary* salsa_library() {
   static const std::optional<DuetLibrary> library = []() -> std::optional<DuetLibrary> {
     std::vector<PairFiles> pairs;
-    for (const char* t : {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13",
-                          "14", "15"}) {
+    for (const char* t :
+         {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13", "14", "15"}) {
       pairs.push_back(PairFiles{{kSalsa + "/bvh/60/60_" + t + "_scaled.bvh"},
                                 {kSalsa + "/bvh/61/61_" + t + "_scaled.bvh"}});
     }
@@ -39,7 +41,11 @@ const DuetLibrary* salsa_library() {
   return library ? &*library : nullptr;
 }
 
-void BM_FollowSessionStep(benchmark::State& state) {
+void follow_session_step(benchmark::State& state, SimdLevel level) {
+  if (!set_simd_level(level)) {
+    state.SkipWithError("this CPU cannot run this instruction set");
+    return;
+  }
   const DuetLibrary* library = salsa_library();
   if (library == nullptr) {
     state.SkipWithError("salsa data not found");
@@ -48,9 +54,9 @@ void BM_FollowSessionStep(benchmark::State& state) {
   MotionLoadOptions load;
   load.frame_rate = 60.0;
   const std::vector<std::string> input_files =
-      state.range(0) == 0 ? std::vector<std::string>{kSalsa + "/bvh/60/60_01_scaled.bvh"}
-                          : std::vector<std::string>{kSalsa + "/asf-amc/60.asf",
-                                                     kSalsa + "/asf-amc/60_01.amc"};
+      state.range(0) == 0
+          ? std::vector<std::string>{kSalsa + "/bvh/60/60_01_scaled.bvh"}
+          : std::vector<std::string>{kSalsa + "/asf-amc/60.asf", kSalsa + "/asf-amc/60_01.amc"};
   Result<LoadedMotion> input = load_motion(input_files, load);
   if (!input) {
     state.SkipWithError(input.error().message.c_str());
@@ -58,9 +64,9 @@ void BM_FollowSessionStep(benchmark::State& state) {
   }
   const Clip& clip = input.value().clip;
   Result<HmmFollower> follower = HmmFollower::create(library->model(), FollowParams{});
-  Result<FollowSession> session = FollowSession::create(
-      *library, clip.skeleton_ptr(), input.value().roles,
-      std::make_unique<HmmFollower>(std::move(follower).value()));
+  Result<FollowSession> session =
+      FollowSession::create(*library, clip.skeleton_ptr(), input.value().roles,
+                            std::make_unique<HmmFollower>(std::move(follower).value()));
   if (!session) {
     state.SkipWithError(session.error().message.c_str());
     return;
@@ -75,8 +81,20 @@ void BM_FollowSessionStep(benchmark::State& state) {
   }
   state.counters["states"] = library->model().num_states();
   state.counters["dims"] = library->model().num_dims();
+  set_simd_level(detect_simd_level());
+}
+
+// The kernels the dispatcher picks on this CPU (AVX2 where it has it, unless DUET_SIMD=scalar).
+void BM_FollowSessionStep(benchmark::State& state) {
+  follow_session_step(state, detect_simd_level());
 }
 BENCHMARK(BM_FollowSessionStep)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->MinTime(3.0);
+
+// The portable scalar/Eigen kernels, for the ratio in the same run.
+void BM_FollowSessionStepScalar(benchmark::State& state) {
+  follow_session_step(state, SimdLevel::kScalar);
+}
+BENCHMARK(BM_FollowSessionStepScalar)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->MinTime(3.0);
 
 }  // namespace
 }  // namespace duet

@@ -7,6 +7,9 @@
 #include <cmath>
 #include <limits>
 
+#include "duet/follow/simd.h"
+#include "kernels_avx2.h"
+
 namespace duet::follow_detail {
 namespace {
 
@@ -53,7 +56,14 @@ float emission_distances(const TemplateModel& model, const float* phi, float vel
   const FeatureMatrix& features = model.features();
   const int num_states = model.num_states();
   const Eigen::Index velocity = model.velocity_dims();
-  if (velocity == 0 || !(velocity_cap < FLT_MAX)) {
+  const bool capped = velocity > 0 && velocity_cap < FLT_MAX;
+#if defined(__x86_64__)
+  if (simd_level() == SimdLevel::kAvx2) {
+    return avx2::emission_distances(model.blocked_features().data(), num_states, model.num_dims(),
+                                    capped ? model.velocity_dims() : 0, velocity_cap, phi, out);
+  }
+#endif
+  if (!capped) {
     return squared_distances(features, phi, 0, num_states, out);
   }
   const Eigen::Index posture = features.cols() - velocity;
@@ -80,9 +90,19 @@ double weigh_and_normalise(const float* predicted, const float* distance_sq, flo
   const float max_template = log_emission(best_distance_sq, inv_two_sigma_sq);
   const float shift = with_pause ? std::max(max_template, log_b_pause) : max_template;
   // One fused, vectorised pass: log-emission, shift, exp, times the prediction.
-  post = pred * ((d2 * -inv_two_sigma_sq).max(kMinLogEmission) - shift).exp();
+  float weighted_sum = 0.0f;
+#if defined(__x86_64__)
+  if (simd_level() == SimdLevel::kAvx2) {
+    weighted_sum =
+        avx2::weigh_emissions(predicted, distance_sq, inv_two_sigma_sq, shift, num_states, out);
+  } else
+#endif
+  {
+    post = pred * ((d2 * -inv_two_sigma_sq).max(kMinLogEmission) - shift).exp();
+    weighted_sum = post.sum();
+  }
   float pause = with_pause ? predicted[num_states] * std::exp(log_b_pause - shift) : 0.0f;
-  double sum = static_cast<double>(post.sum()) + pause;
+  double sum = static_cast<double>(weighted_sum) + pause;
   double log_c = static_cast<double>(shift);
 
   if (!(sum >= kMinNormaliser)) {
@@ -162,11 +182,18 @@ void decide(const TemplateModel& model, const float* posterior, float total, flo
             int previous_state, int steps, int window, FollowResult& result) noexcept {
   const int num_states = model.num_states();
   int state = 0;
-  float best = posterior[0];
-  for (int i = 1; i < num_states; ++i) {
-    if (posterior[i] > best) {
-      best = posterior[i];
-      state = i;
+#if defined(__x86_64__)
+  if (simd_level() == SimdLevel::kAvx2) {
+    state = avx2::argmax(posterior, num_states);
+  } else
+#endif
+  {
+    float best = posterior[0];
+    for (int i = 1; i < num_states; ++i) {
+      if (posterior[i] > best) {
+        best = posterior[i];
+        state = i;
+      }
     }
   }
   describe_state(model, posterior, total, state, window, result);

@@ -11,6 +11,23 @@ namespace {
 
 Error model_error(const std::string& reason) { return make_error("template model", 0, reason); }
 
+// The layout of TemplateModel::blocked_features().
+std::vector<float> blocked(const FeatureMatrix& features) {
+  constexpr Eigen::Index kBlock = TemplateModel::kStateBlock;
+  const Eigen::Index rows = features.rows();
+  const Eigen::Index dims = features.cols();
+  const Eigen::Index blocks = (rows + kBlock - 1) / kBlock;
+  std::vector<float> out(static_cast<std::size_t>(blocks * dims * kBlock), 0.0f);
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    const Eigen::Index b = i / kBlock;
+    const Eigen::Index lane = i % kBlock;
+    for (Eigen::Index d = 0; d < dims; ++d) {
+      out[static_cast<std::size_t>((b * dims + d) * kBlock + lane)] = features(i, d);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 Result<TemplateModel> TemplateModel::build(FeatureMatrix features, std::vector<int> take_start,
@@ -63,6 +80,7 @@ Result<TemplateModel> TemplateModel::build(FeatureMatrix features, std::vector<i
   model.take_start_ = std::move(take_start);
   model.frame_rate_hz_ = frame_rate_hz;
   model.velocity_dims_ = velocity_dims;
+  model.blocked_features_ = blocked(model.features_);
   return model;
 }
 

@@ -44,6 +44,12 @@ class TemplateModel {
   int velocity_dims() const { return velocity_dims_; }
 
   const FeatureMatrix& features() const { return features_; }
+  // The same features blocked for the SIMD emission kernel: states in blocks of kStateBlock, and
+  // within a block dimension-major, so one load gives dimension d of kStateBlock states:
+  // blocked_features()[(b * D + d) * kStateBlock + l] = phi_{b * kStateBlock + l}(d). The last
+  // block is padded with zeros. Built once with the model (a second copy of the features).
+  static constexpr int kStateBlock = 8;
+  std::span<const float> blocked_features() const { return blocked_features_; }
   // First state of take k, and one past its last state.
   int take_begin(int take) const { return take_start_[static_cast<std::size_t>(take)]; }
   int take_end(int take) const { return take_start_[static_cast<std::size_t>(take) + 1]; }
@@ -54,7 +60,8 @@ class TemplateModel {
   TemplateModel() = default;
 
   FeatureMatrix features_;
-  std::vector<int> take_start_;  // num_takes + 1 entries; the last one is M
+  std::vector<float> blocked_features_;  // see blocked_features()
+  std::vector<int> take_start_;          // num_takes + 1 entries; the last one is M
   double frame_rate_hz_ = 0.0;
   int velocity_dims_ = 0;
 };
