@@ -17,7 +17,10 @@ bool JumpGate::out_of_reach(const TemplateModel& model, int from, int state, int
 void JumpGate::apply(const TemplateModel& model, const FollowParams& params, const float* posterior,
                      float total, int previous_state, bool previous_lost,
                      FollowResult& result) noexcept {
-  const int tolerance = params.jump_tolerance_frames;
+  // Right after a lost frame (a jump's first landing is often one: a poor match on the way in)
+  // every move past the band is a jump again: the landing is refined, and the partner must
+  // restart at the refined place (else it plays on from the poor one).
+  const int tolerance = previous_lost ? 0 : params.jump_tolerance_frames;
   const int steps = std::max(result.steps, 1);
   if (previous_state < 0 || result.missing || result.state < 0 ||
       !out_of_reach(model, previous_state, result.state, steps, tolerance)) {

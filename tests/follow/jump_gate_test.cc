@@ -87,6 +87,20 @@ TEST(JumpGate, AFarPlaceIsReportedOnlyOnceItHolds) {
   }
 }
 
+TEST(JumpGate, AfterALostFrameEveryMovePastTheBandIsAJump) {
+  const TemplateModel model = two_takes();
+  FollowParams params;
+  params.jump_tolerance_frames = 6;
+  JumpGate gate;
+  const std::vector<float> p = posterior(53);
+  FollowResult r = maximum_at(model, p, 53);
+  gate.apply(model, params, p.data(), 1.0f, 50, /*previous_lost=*/true, r);
+  EXPECT_TRUE(r.jumped);
+  r = maximum_at(model, p, 53);
+  gate.apply(model, params, p.data(), 1.0f, 50, /*previous_lost=*/false, r);
+  EXPECT_FALSE(r.jumped);
+}
+
 TEST(JumpGate, AfterALostFrameTheNewPlaceIsTakenAtOnce) {
   const TemplateModel model = two_takes();
   FollowParams params;
