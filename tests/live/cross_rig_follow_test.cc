@@ -8,47 +8,14 @@
 #include "duet/io/motion_file.h"
 #include "duet/live/duet_library.h"
 #include "duet/live/follow_session.h"
+#include "salsa_library.h"
 
 namespace duet {
 namespace {
 
 const std::string kData = DUET_DATA_DIR;
 
-std::vector<PairFiles> salsa_library() {
-  std::vector<PairFiles> pairs;
-  for (const char* trial :
-       {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13", "14", "15"}) {
-    pairs.push_back({{kData + "/cmu-salsa/bvh/60/60_" + trial + "_scaled.bvh"},
-                     {kData + "/cmu-salsa/bvh/61/61_" + trial + "_scaled.bvh"}});
-  }
-  return pairs;
-}
-
-const DuetLibrary& library() {
-  static const DuetLibrary loaded = [] {
-    LibraryOptions options;
-    options.load.frame_rate = 60.0;
-    Result<DuetLibrary> l = DuetLibrary::load(salsa_library(), options);
-    if (!l) throw std::runtime_error(l.error().message);
-    return std::move(l).value();
-  }();
-  return loaded;
-}
-
-std::vector<FollowResult> follow(const LoadedMotion& input) {
-  Result<HmmFollower> follower = HmmFollower::create(library().model(), FollowParams{});
-  EXPECT_TRUE(follower) << follower.error().message;
-  Result<FollowSession> session =
-      FollowSession::create(library(), input.clip.skeleton_ptr(), input.roles,
-                            std::make_unique<HmmFollower>(std::move(follower).value()));
-  EXPECT_TRUE(session) << session.error().message;
-  std::vector<FollowResult> results;
-  for (int f = 0; f < input.clip.frame_count(); ++f) {
-    results.push_back(session.value().step(
-        input.clip.translations_ls(f), input.clip.rotations_ls(f), f / input.clip.frame_rate()));
-  }
-  return results;
-}
+std::vector<FollowResult> follow(const LoadedMotion& input) { return test::follow_clip(input); }
 
 TEST(CrossRigFollow, TakeOneFromTheCmuAsfAmcIsFollowedAgainstTheSalsaLibrary) {
   MotionLoadOptions options;

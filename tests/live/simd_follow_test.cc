@@ -13,43 +13,16 @@
 #include "duet/io/motion_file.h"
 #include "duet/live/duet_library.h"
 #include "duet/live/follow_session.h"
+#include "salsa_library.h"
 
 namespace duet {
 namespace {
 
-const std::string kData = DUET_DATA_DIR;
-
-const DuetLibrary& library() {
-  static const DuetLibrary loaded = [] {
-    std::vector<PairFiles> pairs;
-    for (const char* trial :
-         {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13", "14", "15"}) {
-      pairs.push_back({{kData + "/cmu-salsa/bvh/60/60_" + trial + "_scaled.bvh"},
-                       {kData + "/cmu-salsa/bvh/61/61_" + trial + "_scaled.bvh"}});
-    }
-    LibraryOptions options;
-    options.load.frame_rate = 60.0;
-    Result<DuetLibrary> l = DuetLibrary::load(pairs, options);
-    if (!l) throw std::runtime_error(l.error().message);
-    return std::move(l).value();
-  }();
-  return loaded;
-}
+using test::kSalsaData;
 
 std::vector<FollowResult> follow(const LoadedMotion& input, SimdLevel level) {
   EXPECT_TRUE(set_simd_level(level));
-  Result<HmmFollower> follower = HmmFollower::create(library().model(), FollowParams{});
-  EXPECT_TRUE(follower) << follower.error().message;
-  Result<FollowSession> session =
-      FollowSession::create(library(), input.clip.skeleton_ptr(), input.roles,
-                            std::make_unique<HmmFollower>(std::move(follower).value()));
-  EXPECT_TRUE(session) << session.error().message;
-  std::vector<FollowResult> results;
-  for (int f = 0; f < input.clip.frame_count(); ++f) {
-    results.push_back(session.value().step(
-        input.clip.translations_ls(f), input.clip.rotations_ls(f), f / input.clip.frame_rate()));
-  }
-  return results;
+  return test::follow_clip(input);
 }
 
 TEST(SimdFollow, TheDispatchedKernelsEstimateTheSameStatesAsTheScalarPathOnRealData) {
@@ -74,9 +47,9 @@ TEST(SimdFollow, TheDispatchedKernelsEstimateTheSameStatesAsTheScalarPathOnRealD
   options.frame_rate = 60.0;
   int frames = 0, different = 0, different_take = 0;
   for (const std::vector<std::string>& files :
-       {std::vector<std::string>{kData + "/cmu-salsa/asf-amc/60.asf",
-                                 kData + "/cmu-salsa/asf-amc/60_01.amc"},
-        std::vector<std::string>{kData + "/cmu-salsa/bvh/60/60_05_scaled.bvh"}}) {
+       {std::vector<std::string>{kSalsaData + "/cmu-salsa/asf-amc/60.asf",
+                                 kSalsaData + "/cmu-salsa/asf-amc/60_01.amc"},
+        std::vector<std::string>{kSalsaData + "/cmu-salsa/bvh/60/60_05_scaled.bvh"}}) {
     Result<LoadedMotion> input = load_motion(files, options);
     ASSERT_TRUE(input) << input.error().message;
     const std::vector<FollowResult> scalar = follow(input.value(), SimdLevel::kScalar);
