@@ -158,10 +158,11 @@ void normalise(float* mass, int count, int uniform_count) noexcept {
   m.head(uniform_count).setConstant(1.0f / static_cast<float>(uniform_count));
 }
 
-bool is_jump(const TemplateModel& model, int previous_state, int state, int steps) noexcept {
-  if (previous_state < 0) return false;
+bool is_jump(const TemplateModel& model, int previous_state, int state, int steps,
+             int tolerance) noexcept {
+  if (previous_state < 0 || state < 0) return false;
   const int moved = state - previous_state;
-  if (moved < 0 || moved > 2 * steps) return true;
+  if (moved < -tolerance || moved > 2 * steps + tolerance) return true;
   return model.take_of(previous_state) != model.take_of(state);
 }
 

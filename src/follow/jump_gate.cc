@@ -6,14 +6,6 @@
 
 namespace duet {
 
-bool JumpGate::out_of_reach(const TemplateModel& model, int from, int state, int steps,
-                            int tolerance) noexcept {
-  if (from < 0 || state < 0) return false;
-  if (model.take_of(from) != model.take_of(state)) return true;
-  const int moved = state - from;
-  return moved < -tolerance || moved > 2 * steps + tolerance;
-}
-
 void JumpGate::apply(const TemplateModel& model, const FollowParams& params, const float* posterior,
                      float total, int previous_state, bool previous_lost,
                      FollowResult& result) noexcept {
@@ -23,7 +15,7 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
   const int tolerance = previous_lost ? 0 : params.jump_tolerance_frames;
   const int steps = std::max(result.steps, 1);
   if (previous_state < 0 || result.missing || result.state < 0 ||
-      !out_of_reach(model, previous_state, result.state, steps, tolerance)) {
+      !follow_detail::is_jump(model, previous_state, result.state, steps, tolerance)) {
     // Within reach of the old place: no jump, whatever the raw maximum's step was.
     result.jumped = false;
     reset();
@@ -39,7 +31,7 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
   const double step_s = static_cast<double>(steps) / model.frame_rate_hz();
   const bool same_candidate =
       candidate_state_ >= 0 &&
-      !out_of_reach(model, candidate_state_, result.state, steps, tolerance);
+      !follow_detail::is_jump(model, candidate_state_, result.state, steps, tolerance);
   held_s_ = same_candidate ? held_s_ + step_s : step_s;
   candidate_state_ = result.state;
   if (held_s_ + 1e-6 >= params.jump_hold_s) {  // (3 frames of 1/60 s make 0.05 s)

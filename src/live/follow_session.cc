@@ -40,10 +40,9 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
   // stay lost, not teach the offset that would make it look like one. A step of the estimate
   // backwards (jitter the follower does not call a jump) says the match is off by a frame or
   // two in the direction of motion: it teaches nothing either.
-  const bool stepped_back =
-      previous_state_ >= 0 && result.take == previous_take_ && result.state < previous_state_;
+  const bool stepped_back = previous_state_ >= 0 && result.state < previous_state_ &&
+                            library_->model().take_of(previous_state_) == result.take;
   previous_state_ = result.state;
-  previous_take_ = result.take;
   if (!result.jumped && !stepped_back && !result.missing && !result.lost &&
       result.best_distance_per_dim <= bias_.params().max_learn_distance_per_dim &&
       result.state >= 0 && result.state < library_->model().num_states()) {
@@ -62,7 +61,6 @@ void FollowSession::reset() noexcept {
   bias_.reset();
   has_previous_ = false;
   previous_state_ = -1;
-  previous_take_ = -1;
 }
 
 }  // namespace duet

@@ -131,10 +131,6 @@ constexpr double kShortBone = 0.01;
 // one axis) 77 and 103.
 const double kSameRestDirectionCos = std::cos(45.0 * 3.14159265358979323846 / 180.0);
 
-// The rest alignment of a role joint's rule (identity where it has none).
-Quat rules_of_parent_alignment(const std::vector<JointRule>& rules, int joint) {
-  return rules[static_cast<std::size_t>(joint)].alignment;
-}
 constexpr Role kFeet[] = {Role::kLeftAnkle, Role::kLeftToe, Role::kRightAnkle, Role::kRightToe};
 
 std::vector<Vec3> rest_positions(const Skeleton& skeleton, std::vector<Vec3>& offsets,
@@ -325,7 +321,7 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
         s_rest[static_cast<std::size_t>(sj)] - s_rest[static_cast<std::size_t>(source_start)];
     if (!(t_dir.norm() > kShortBone) || !(s_dir.norm() > kShortBone)) continue;
     if (rule_of(clavicle).rule == Rule::kCopy) {
-      const Vec3 t_dir_in_source = rules_of_parent_alignment(r.rules_, tp) * t_dir;
+      const Vec3 t_dir_in_source = rule_of(tp).alignment * t_dir;
       if (t_dir_in_source.normalized().dot(s_dir.normalized()) > kSameRestDirectionCos) continue;
     } else if (rule_of(clavicle).rule != Rule::kRest) {
       continue;

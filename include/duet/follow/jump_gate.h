@@ -30,12 +30,6 @@ class JumpGate {
   void apply(const TemplateModel& model, const FollowParams& params, const float* posterior,
              float total, int previous_state, bool previous_lost, FollowResult& result) noexcept;
 
-  // Whether `state` is out of the band's reach from `from` in `steps` template steps (another
-  // take, backwards by more than `tolerance` frames, or forwards by more than 2 * steps +
-  // tolerance).
-  static bool out_of_reach(const TemplateModel& model, int from, int state, int steps,
-                           int tolerance) noexcept;
-
  private:
   int candidate_state_ = -1;  // the far place that currently holds the maximum
   double held_s_ = 0.0;       // how long (template time) it has held it

@@ -47,7 +47,6 @@ class FollowSession {
   double previous_time_s_ = 0.0;
   bool has_previous_ = false;
   int previous_state_ = -1;  // the estimate of the previous frame
-  int previous_take_ = -1;
 };
 
 }  // namespace duet
