@@ -1,11 +1,15 @@
 // duet convert INPUT... -o OUT.bvh [--fps F] [--scale S] [--units-per-metre U]
+// duet convert INPUT... --points head,hands -o OUT.csv   (a three-point recording)
 #include <fmt/format.h>
 
 #include <cmath>
 
 #include "commands.h"
+#include "duet/io/atomic_write.h"
 #include "duet/io/bvh.h"
 #include "duet/io/motion_file.h"
+#include "duet/io/points_csv.h"
+#include "duet/motion/head_hands.h"
 #include "duet/motion/limits.h"
 #include "duet/motion/resample.h"
 #include "motion_options.h"
@@ -15,15 +19,49 @@ namespace duet::app {
 
 namespace {
 
+std::string io_lower(std::string text) {
+  for (char& c : text) c = (c >= 'A' && c <= 'Z') ? static_cast<char>(c + 32) : c;
+  return text;
+}
+
 struct ConvertArgs {
   std::vector<std::string> inputs;
   std::string output;
   MotionFileOptions input;
   std::optional<double> output_fps;
   std::optional<double> output_units_per_metre;  // default: units duet reads back unaided
+  std::string points;  // "head,hands": write the three-point CSV of the motion
 };
 
+bool has_csv_extension(const std::string& path) {
+  return path.size() >= 4 && io_lower(path.substr(path.size() - 4)) == ".csv";
+}
+
+// The three points a headset and controllers would have reported (duet/io/points_csv.h).
+int write_points(const LoadedMotion& loaded, const Clip& clip, const std::string& output) {
+  Result<Clip> points = head_hands_clip(clip, loaded.roles);
+  if (!points) {
+    fmt::print(stderr, "duet convert: {}: {}\n", loaded.description, points.error().message);
+    return kExitFailure;
+  }
+  Status written = write_file_atomically(output, format_points_csv(points.value()));
+  if (!written) {
+    fmt::print(stderr, "duet convert: {}\n", written.error().message);
+    return kExitFailure;
+  }
+  fmt::print(stderr, "wrote {}: {} samples of head and hands at {:.6g} Hz\n", output,
+             points.value().frame_count(), points.value().frame_rate());
+  return kExitOk;
+}
+
 int run_convert(const ConvertArgs& args) {
+  if (args.points.empty() && has_csv_extension(args.output)) {
+    fmt::print(stderr,
+               "duet convert: {} is a .csv: a CSV output holds three points; add --points "
+               "head,hands (or name a .bvh output)\n",
+               args.output);
+    return kExitFailure;
+  }
   MotionLoadOptions load_options;
   if (!make_load_options(args.input, load_options)) return kExitFailure;
   Result<LoadedMotion> loaded = load_motion(args.inputs, load_options);
@@ -44,6 +82,7 @@ int run_convert(const ConvertArgs& args) {
     }
     clip = resample(clip, *args.output_fps);
   }
+  if (!args.points.empty()) return write_points(loaded.value(), clip, args.output);
   // A BVH cannot say its units: by default write the ones the reader will infer for this
   // skeleton (the source's, or its convention's), so the file reads back at its true size.
   const double readable_units_per_metre =
@@ -76,7 +115,13 @@ Command register_convert(CLI::App& app) {
       ->required()
       ->expected(1, 2)
       ->check(CLI::ExistingFile);
-  app.add_option("-o,--output", args->output, "Output BVH file (written atomically)")->required();
+  app.add_option("-o,--output", args->output,
+                 "Output BVH file, or CSV with --points (written atomically)")
+      ->required();
+  app.add_option("--points", args->points,
+                 "Write only the head and both hands as a three-point CSV (the only value: "
+                 "head,hands; docs/file-formats.md)")
+      ->check(CLI::IsMember({"head,hands"}));
   app.add_option("--input-fps", args->input.fps, "Frame rate of the input, overriding its header")
       ->check(fps_check());
   app.add_option("--scale", args->input.scale,

@@ -36,6 +36,9 @@ struct EvalArgs {
   std::string partner_csv_path;
   CaseSettings settings;
   double noise_cm = 1.0;
+  std::string input_points = "full";
+  double point_noise_mm = 5.0;
+  double point_noise_deg = 1.0;
   // Tuning of the "hmm" tracker (FollowParams fields); unset keeps the follower's defaults.
   std::optional<float> jump_hold;
   std::optional<int> jump_tolerance;
@@ -199,6 +202,9 @@ int run_eval(EvalArgs& args) {
   if (args.root_velocity_weight) features.root_velocity_weight = *args.root_velocity_weight;
   if (args.effector_speed_weight) features.effector_speed_weight = *args.effector_speed_weight;
   if (args.velocity_window) features.velocity_window_s = *args.velocity_window;
+  if (!parse_input_points(args.input_points, features.input_points)) {
+    return usage_error("--input-points: '" + args.input_points + "' is neither full nor head,hands");
+  }
 
   std::string gnuplot;
   if (!args.plots_dir.empty()) {
@@ -248,6 +254,14 @@ int run_eval(EvalArgs& args) {
     return kExitFailure;
   }
   options.cases = cases_on_rigs(options.cases, rigs.value());
+  // Three points: every case's performance is delivered as a headset's head and hands.
+  if (features.input_points == InputPoints::kHeadHands) {
+    for (EvalCase& eval_case : options.cases) {
+      eval_case.recipe.head_hands = true;
+      eval_case.recipe.point_noise.position_m = args.point_noise_mm / 1000.0;
+      eval_case.recipe.point_noise.rotation_deg = args.point_noise_deg;
+    }
+  }
 
   ProgressBar bar("evaluating");
   Result<EvalReport> report = run_evaluation(
@@ -319,6 +333,17 @@ Command register_eval(CLI::App& app) {
                  "Followers, comma-separated (default all): hmm, hmm-paper, left-to-right, "
                  "nearest, online-dtw, naive-hmm (O(M^2), run on the first take alone)")
       ->delimiter(',');
+  app.add_option("--input-points", args->input_points,
+                 "full, or head,hands: deliver every case as three points (a headset and two "
+                 "controllers, with --point-noise-mm and --point-noise-deg of tracking noise) and "
+                 "follow with the three-point follower")
+      ->check(CLI::IsMember({"full", "head,hands"}));
+  app.add_option("--point-noise-mm", args->point_noise_mm,
+                 "Three points: position noise per axis of each point, mm (default 5)")
+      ->check(number_between(0.0, 100.0, "point noise"));
+  app.add_option("--point-noise-deg", args->point_noise_deg,
+                 "Three points: orientation noise of each point, RMS degrees (default 1)")
+      ->check(number_between(0.0, 45.0, "point noise"));
   app.add_option("--seed", args->seed, "Seed of every random choice (same seed, same numbers)");
   app.add_option("--csv", args->csv_path, "Write the metrics per case, tracker and take as CSV");
   app.add_option("--plots", args->plots_dir,

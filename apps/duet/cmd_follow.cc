@@ -1,4 +1,5 @@
-// duet follow --pair LEADER PARTNER [...] --input USER.bvh [--trace T.csv] [-o PARTNER.bvh]
+// duet follow --pair LEADER PARTNER [...] --input USER.bvh|USER.csv [--input-points P]
+//             [--trace T.csv] [-o PARTNER.bvh]
 // Runs the run-time loop of method.md 6 over a recorded performance: features, follower, partner
 // synthesis with the corrections that are switched on.
 #include <fmt/format.h>
@@ -10,6 +11,7 @@
 #include "duet/live/follow_session.h"
 #include "duet/live/live_loop.h"
 #include "duet/motion/retarget.h"
+#include "input_points.h"
 #include "lost_diagnosis.h"
 #include "library_options.h"
 #include "motion_options.h"
@@ -32,6 +34,7 @@ struct FollowArgs {
   std::string output_path;
   std::string user_output_path;
   std::string truth_path;
+  std::string input_points;  // "", "full" or "head,hands" (--input-points)
   std::string partner_rig;  // a motion word whose skeleton the partner is written on
   MotionFileOptions partner_rig_motion;
   bool allow_lost = false;
@@ -60,10 +63,10 @@ Status write_partner_on_rig(const FollowArgs& args, const Clip& partner,
 // The share of lost frames when the input is followed as the other dancer (at most the first
 // minute): tells a swapped role or pair order from input that is no part of the dance.
 std::optional<double> lost_as_other_role(const FollowArgs& args, const Clip& user,
-                                         const JointRoles& roles) {
+                                         const JointRoles& roles, const FeatureSpec& features) {
   LibraryArgs other = args.library;
   other.role = other.role == "partner" ? "leader" : "partner";
-  std::optional<DuetLibrary> library = load_library(other, "follow");
+  std::optional<DuetLibrary> library = load_library(other, "follow", features);
   if (!library) return std::nullopt;
   Result<std::unique_ptr<Tracker>> tracker = make_tracker(args.tracker, library->model());
   if (!tracker) return std::nullopt;
@@ -103,7 +106,28 @@ Status write_outputs(const FollowArgs& args, const std::string& trace, const Cli
 }
 
 int run_follow(const FollowArgs& args) {
-  std::optional<DuetLibrary> loaded = load_library(args.library, "follow");
+  MotionLoadOptions load_options;
+  if (!make_load_options(args.input_motion, load_options)) return kExitFailure;
+  Result<std::vector<std::string>> input_paths = split_motion_argument(args.input);
+  if (!input_paths) {
+    fmt::print(stderr, "duet follow: --input: {}\n", input_paths.error().message);
+    return kExitUsage;
+  }
+  Result<LoadedMotion> input = load_motion(input_paths.value(), load_options);
+  if (!input) {
+    fmt::print(stderr, "duet follow: {}\n", input.error().message);
+    return kExitFailure;
+  }
+  // Three points (a headset's recording, or --input-points head,hands) pick the three-point
+  // follower; the library's templates then give the same three points.
+  Result<InputPoints> points = choose_input_points(args.input_points, input.value());
+  if (!points) {
+    fmt::print(stderr, "duet follow: {}\n", points.error().message);
+    return kExitUsage;
+  }
+  FeatureSpec features;
+  features.input_points = points.value();
+  std::optional<DuetLibrary> loaded = load_library(args.library, "follow", features);
   if (!loaded) return kExitFailure;
   auto library = std::make_shared<const DuetLibrary>(std::move(*loaded));
 
@@ -125,18 +149,6 @@ int run_follow(const FollowArgs& args) {
     }
   }
 
-  MotionLoadOptions load_options;
-  if (!make_load_options(args.input_motion, load_options)) return kExitFailure;
-  Result<std::vector<std::string>> input_paths = split_motion_argument(args.input);
-  if (!input_paths) {
-    fmt::print(stderr, "duet follow: --input: {}\n", input_paths.error().message);
-    return kExitUsage;
-  }
-  Result<LoadedMotion> input = load_motion(input_paths.value(), load_options);
-  if (!input) {
-    fmt::print(stderr, "duet follow: {}\n", input.error().message);
-    return kExitFailure;
-  }
   const Clip& user = input.value().clip;
   if (truth && truth->rows.size() != static_cast<std::size_t>(user.frame_count())) {
     fmt::print(stderr, "duet follow: {}: {} rows of ground truth for {} input frames\n",
@@ -215,7 +227,7 @@ int run_follow(const FollowArgs& args) {
   for (const FollowResult& r : results) tempos.push_back(r.tempo);
   std::ranges::nth_element(tempos, tempos.begin() + static_cast<std::ptrdiff_t>(tempos.size() / 2));
   context.median_tempo = tempos[tempos.size() / 2];
-  context.other_role_lost_fraction = lost_as_other_role(args, user, input.value().roles);
+  context.other_role_lost_fraction = lost_as_other_role(args, user, input.value().roles, features);
   fmt::print(stderr, "duet follow: {:.0f}% of the input's frames are lost (no part of the library "
              "explains them). Likely causes:\n", 100.0 * summary.lost_fraction());
   for (const std::string& cause : diagnose_lost(summary, context)) {
@@ -233,8 +245,11 @@ Command register_follow(CLI::App& app) {
   add_library_options(app, args->library);
   app.add_option("--input", args->input,
                  "The user's motion: a BVH file, or SKELETON.asf+MOTION.amc; any rig whose body "
-                 "roles are found (duet inspect shows them)")
+                 "roles are found (duet inspect shows them); or a three-point CSV (head and "
+                 "hands, docs/file-formats.md)")
       ->required();
+  app.add_option("--input-points", args->input_points, kInputPointsHelp)
+      ->check(CLI::IsMember({"full", "head,hands"}));
   add_motion_file_options(app, args->input_motion, "input-");
   add_tracker_options(app, args->tracker);
   add_partner_options(app, args->partner);

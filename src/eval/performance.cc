@@ -8,6 +8,7 @@
 #include <random>
 
 #include "duet/math/rotation.h"
+#include "duet/motion/head_hands.h"
 #include "duet/motion/limits.h"
 #include "duet/motion/retarget.h"
 
@@ -364,6 +365,30 @@ Performance with_sensor_noise(Performance performance, const SensorNoiseOptions&
   return performance;
 }
 
+Result<Performance> with_head_hands(Performance performance, const PointNoiseOptions& noise) {
+  Result<Clip> points = head_hands_clip(performance.motion, performance.roles);
+  if (!points) return points.error();
+  performance.motion = std::move(points).value();
+  performance.roles = head_hands_roles();
+  Rng rng(derive_seed(noise.seed, 5));
+  std::normal_distribution<double> angle(0.0, deg_to_rad(noise.rotation_deg) / std::sqrt(3.0));
+  std::normal_distribution<double> position(0.0, noise.position_m);
+  Clip& motion = performance.motion;
+  for (int f = 0; f < motion.frame_count(); ++f) {
+    for (int j = kPointsHead; j <= kPointsRightHand; ++j) {
+      const auto i = static_cast<std::size_t>(j);
+      if (noise.position_m > 0.0) {
+        motion.translations_ls(f)[i] += Vec3(position(rng), position(rng), position(rng));
+      }
+      if (noise.rotation_deg > 0.0) {
+        const Vec3 v(angle(rng), angle(rng), angle(rng));
+        motion.rotations_ls(f)[i] = (motion.rotations_ls(f)[i] * exp_map(v)).normalized();
+      }
+    }
+  }
+  return performance;
+}
+
 Performance with_frame_loss(Performance performance, const FrameLossOptions& options) {
   Rng rng(derive_seed(options.seed, 4));
   const int frames = performance.frame_count();
@@ -482,6 +507,13 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     SensorNoiseOptions options = recipe.noise;
     options.seed = derive_seed(seed, 12);
     performance = with_sensor_noise(std::move(performance), options);
+  }
+  if (recipe.head_hands) {
+    PointNoiseOptions options = recipe.point_noise;
+    options.seed = derive_seed(seed, 14);
+    Result<Performance> points = with_head_hands(std::move(performance), options);
+    if (!points) return points.error();
+    performance = std::move(points).value();
   }
   if (recipe.loss.active()) {
     FrameLossOptions options = recipe.loss;

@@ -1,12 +1,14 @@
 #include "duet/features/feature_extractor.h"
 
 #include <cassert>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "duet/math/rotation.h"
 #include "duet/motion/body_space.h"
 #include "duet/motion/forward_kinematics.h"
+#include "duet/motion/head_hands.h"
 
 namespace duet {
 
@@ -31,6 +33,7 @@ bool all_finite(std::span<const Quat> values) {
 void FeatureExtractor::Context::reset() noexcept {
   newest_ = -1;
   count_ = 0;
+  head_height_max_m_ = 0.0;
 }
 
 Result<FeatureExtractor> FeatureExtractor::create(std::shared_ptr<const Skeleton> skeleton,
@@ -40,15 +43,19 @@ Result<FeatureExtractor> FeatureExtractor::create(std::shared_ptr<const Skeleton
   if (!(spec.velocity_window_s > 0.0)) {
     return Error{"feature extractor: velocity window must be positive"};
   }
+  const bool head_hands = spec.input_points == InputPoints::kHeadHands;
   // Every role the canonical points are built from, and every role the spec names.
-  std::vector<Role> needed = {Role::kHips,      Role::kLeftHip,      Role::kRightHip,
-                              Role::kLeftWrist, Role::kRightWrist,   Role::kLeftAnkle,
-                              Role::kRightAnkle, Role::kLeftShoulder, Role::kRightShoulder};
-  for (const BodySegment& segment : spec.posture_segments) {
-    needed.push_back(segment.from);
-    needed.push_back(segment.to);
+  std::vector<Role> needed = {Role::kHead, Role::kLeftWrist, Role::kRightWrist};
+  if (!head_hands) {
+    needed = {Role::kHips,       Role::kLeftHip,      Role::kRightHip,
+              Role::kLeftWrist,  Role::kRightWrist,   Role::kLeftAnkle,
+              Role::kRightAnkle, Role::kLeftShoulder, Role::kRightShoulder};
+    for (const BodySegment& segment : spec.posture_segments) {
+      needed.push_back(segment.from);
+      needed.push_back(segment.to);
+    }
+    for (Role role : spec.posture_points) needed.push_back(role);
   }
-  for (Role role : spec.posture_points) needed.push_back(role);
   std::string missing;
   for (Role role : needed) {
     const int joint = roles[role];
@@ -61,17 +68,24 @@ Result<FeatureExtractor> FeatureExtractor::create(std::shared_ptr<const Skeleton
   if (!missing.empty()) {
     return Error{"feature extractor: the skeleton has no joint for role(s) " + missing};
   }
-  const BodyDimensions body = measure_body(*skeleton, roles);
-  if (!(body.leg_length_m > 1e-3) || !std::isfinite(body.leg_length_m)) {
-    return Error{"feature extractor: the skeleton's legs have no length (hip, knee and ankle "
-                 "joints at one place?)"};
-  }
   FeatureExtractor extractor;
+  if (head_hands) {
+    Result<Quat> correction = rest_pose_correction(*skeleton, roles);
+    if (!correction) return Error{"feature extractor: " + correction.error().message};
+    extractor.head_correction_ = correction.value();
+  } else {
+    const BodyDimensions body = measure_body(*skeleton, roles);
+    if (!(body.leg_length_m > 1e-3) || !std::isfinite(body.leg_length_m)) {
+      return Error{"feature extractor: the skeleton's legs have no length (hip, knee and ankle "
+                   "joints at one place?)"};
+    }
+    extractor.leg_length_m_ = body.leg_length_m;
+  }
   extractor.spec_ = spec;
   extractor.roles_ = roles;
-  extractor.leg_length_m_ = body.leg_length_m;
   extractor.effector_joints_ = {roles[Role::kLeftWrist], roles[Role::kRightWrist],
                                 roles[Role::kLeftAnkle], roles[Role::kRightAnkle]};
+  if (head_hands) extractor.effector_joints_[2] = extractor.effector_joints_[3] = -1;
   extractor.skeleton_ = std::move(skeleton);
   return extractor;
 }
@@ -101,11 +115,18 @@ void FeatureExtractor::extract(Context& context, std::span<const Vec3> translati
   }
   forward_kinematics(*skeleton_, translations_ls, rotations_ls, context.positions_ws_,
                      context.rotations_ws_);
-  const std::span<const Vec3> positions(context.positions_ws_);
+  const Context::Sample now = spec_.input_points == InputPoints::kHeadHands
+                                  ? extract_head_hands(context, time_s, out)
+                                  : extract_full_body(context, time_s, out);
+  remember(context, now);
+}
 
+FeatureExtractor::Context::Sample FeatureExtractor::extract_full_body(
+    const Context& context, double time_s, std::span<float> out) const noexcept {
+  const std::span<const Vec3> positions(context.positions_ws_);
   Context::Sample now;
   now.time_s = time_s;
-  now.pelvis = pelvis_centre(positions, roles_);
+  now.root = pelvis_centre(positions, roles_);
   now.yaw = body_heading_yaw(positions, roles_);
   for (std::size_t e = 0; e < 4; ++e) {
     now.effectors[e] = positions[static_cast<std::size_t>(effector_joints_[e])];
@@ -125,26 +146,15 @@ void FeatureExtractor::extract(Context& context, std::span<const Vec3> translati
     put(length > 1e-9 ? Vec3(to_heading * (delta / length)) : Vec3::Zero());
   }
   for (Role role : spec_.posture_points) {
-    put(to_heading * (body_point(positions, role) - now.pelvis) * per_leg);
-  }
-
-  // The reference sample: the newest one at least velocity_window_s older than now, else the
-  // oldest we have (the first frames of a performance).
-  const Context::Sample* reference = nullptr;
-  for (int age = 0; age < context.count_; ++age) {
-    const int index = (context.newest_ - age + Context::kHistory) % Context::kHistory;
-    const Context::Sample& sample = context.history_[static_cast<std::size_t>(index)];
-    if (sample.time_s >= now.time_s) continue;  // out-of-order timestamps carry no velocity
-    reference = &sample;
-    if (now.time_s - sample.time_s >= spec_.velocity_window_s) break;
+    put(to_heading * (body_point(positions, role) - now.root) * per_leg);
   }
 
   Vec3 root_velocity_heading = Vec3::Zero();
   double yaw_rate = 0.0;
   std::array<double, 4> effector_speed{};
-  if (reference != nullptr) {
+  if (const Context::Sample* reference = velocity_reference(context, time_s)) {
     const double dt = now.time_s - reference->time_s;
-    root_velocity_heading = to_heading * ((now.pelvis - reference->pelvis) * (per_leg / dt));
+    root_velocity_heading = to_heading * ((now.root - reference->root) * (per_leg / dt));
     yaw_rate = wrap_angle(now.yaw - reference->yaw) / dt;
     for (std::size_t e = 0; e < 4; ++e) {
       effector_speed[e] = (now.effectors[e] - reference->effectors[e]).norm() * per_leg / dt;
@@ -155,9 +165,71 @@ void FeatureExtractor::extract(Context& context, std::span<const Vec3> translati
   out[d++] = static_cast<float>(root_velocity_heading.y());  // vertical
   out[d++] = static_cast<float>(yaw_rate);
   for (double speed : effector_speed) out[d++] = static_cast<float>(speed);
+  return now;
+}
 
+FeatureExtractor::Context::Sample FeatureExtractor::extract_head_hands(
+    Context& context, double time_s, std::span<float> out) const noexcept {
+  const auto at = [&](Role role) { return static_cast<std::size_t>(roles_[role]); };
+  const Vec3 head = context.positions_ws_[at(Role::kHead)];
+  const Quat head_canonical = context.rotations_ws_[at(Role::kHead)] * head_correction_;
+  Context::Sample now;
+  now.time_s = time_s;
+  now.root = head;
+  now.yaw = heading_yaw(head_canonical);
+  now.effectors[0] = context.positions_ws_[at(Role::kLeftWrist)];
+  now.effectors[1] = context.positions_ws_[at(Role::kRightWrist)];
+  // Lengths in head heights: the highest the head has been, which a dancer reaches standing in
+  // the first moments (a floor keeps a first frame on the ground from dividing by ~0).
+  constexpr double kLowestHeadHeightM = 0.5;
+  context.head_height_max_m_ = std::max({context.head_height_max_m_, head.y(), kLowestHeadHeightM});
+  const double per_height = 1.0 / context.head_height_max_m_;
+  const Quat to_heading = yaw_rotation(-now.yaw);
+
+  std::size_t d = 0;
+  auto put = [&](const Vec3& v) {
+    for (int k = 0; k < 3; ++k) out[d++] = static_cast<float>(v[k]);
+  };
+  put(to_heading * (now.effectors[0] - head) * per_height);
+  put(to_heading * (now.effectors[1] - head) * per_height);
+  out[d++] = static_cast<float>(head.y() * per_height);
+  put(to_heading * (head_canonical * Vec3::UnitY()));  // the head's tilt: nod and roll
+
+  Vec3 head_velocity_heading = Vec3::Zero();
+  double yaw_rate = 0.0;
+  std::array<double, 2> hand_speed{};
+  if (const Context::Sample* reference = velocity_reference(context, time_s)) {
+    const double dt = now.time_s - reference->time_s;
+    head_velocity_heading = to_heading * ((now.root - reference->root) * (per_height / dt));
+    yaw_rate = wrap_angle(now.yaw - reference->yaw) / dt;
+    for (std::size_t e = 0; e < 2; ++e) {
+      hand_speed[e] = (now.effectors[e] - reference->effectors[e]).norm() * per_height / dt;
+    }
+  }
+  out[d++] = static_cast<float>(head_velocity_heading.z());
+  out[d++] = static_cast<float>(head_velocity_heading.x());
+  out[d++] = static_cast<float>(head_velocity_heading.y());
+  out[d++] = static_cast<float>(yaw_rate);
+  for (double speed : hand_speed) out[d++] = static_cast<float>(speed);
+  return now;
+}
+
+const FeatureExtractor::Context::Sample* FeatureExtractor::velocity_reference(
+    const Context& context, double time_s) const noexcept {
+  const Context::Sample* reference = nullptr;
+  for (int age = 0; age < context.count_; ++age) {
+    const int index = (context.newest_ - age + Context::kHistory) % Context::kHistory;
+    const Context::Sample& sample = context.history_[static_cast<std::size_t>(index)];
+    if (sample.time_s >= time_s) continue;  // out-of-order timestamps carry no velocity
+    reference = &sample;
+    if (time_s - sample.time_s >= spec_.velocity_window_s) break;
+  }
+  return reference;
+}
+
+void FeatureExtractor::remember(Context& context, const Context::Sample& sample) noexcept {
   context.newest_ = (context.newest_ + 1) % Context::kHistory;
-  context.history_[static_cast<std::size_t>(context.newest_)] = now;
+  context.history_[static_cast<std::size_t>(context.newest_)] = sample;
   if (context.count_ < Context::kHistory) ++context.count_;
 }
 

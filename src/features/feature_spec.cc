@@ -2,6 +2,22 @@
 
 namespace duet {
 
+bool parse_input_points(std::string_view text, InputPoints& points) {
+  if (text == "full") {
+    points = InputPoints::kFullBody;
+    return true;
+  }
+  if (text == "head,hands" || text == "hands,head") {
+    points = InputPoints::kHeadHands;
+    return true;
+  }
+  return false;
+}
+
+const char* input_points_name(InputPoints points) {
+  return points == InputPoints::kHeadHands ? "head,hands" : "full";
+}
+
 int FeatureSpec::block_begin(FeatureBlock block) const {
   switch (block) {
     case FeatureBlock::kPosture:
@@ -23,7 +39,7 @@ int FeatureSpec::block_size(FeatureBlock block) const {
     case FeatureBlock::kRootVelocity:
       return kRootVelocityDims;
     case FeatureBlock::kEffectorSpeed:
-      return kEffectorSpeedDims;
+      return effector_speed_dims();
     case FeatureBlock::kCount:
       break;
   }

@@ -10,6 +10,8 @@
 
 #include "duet/io/asf_amc.h"
 #include "duet/io/bvh.h"
+#include "duet/io/points_csv.h"
+#include "duet/motion/head_hands.h"
 
 namespace duet {
 
@@ -123,6 +125,36 @@ double readable_metres_per_unit(const Skeleton& skeleton, double preferred) {
   return 1.0;
 }
 
+namespace {
+
+// A three-point recording (duet/io/points_csv.h): in metres by definition, with its own roles.
+Result<LoadedMotion> load_points_csv(const std::string& path, const MotionLoadOptions& options) {
+  if (options.map) return Error{path + ": a three-point CSV takes no skeleton map"};
+  PointsCsvReadOptions csv;
+  csv.frame_rate = options.frame_rate;
+  Result<Clip> clip = read_points_csv(path, csv);
+  if (!clip) return clip.error();
+  LoadedMotion loaded;
+  loaded.clip = std::move(clip).value();
+  if (options.metres_per_unit) {
+    loaded.metres_per_unit = *options.metres_per_unit;
+    loaded.clip.scale_lengths(loaded.metres_per_unit);
+    loaded.units_source = "given (--scale)";
+  } else {
+    loaded.units_source = "three-point CSV (metres)";
+    loaded.units_name = "metres";
+  }
+  loaded.roles = head_hands_roles();
+  loaded.role_detection.roles = loaded.roles;
+  for (Role role : {Role::kHead, Role::kLeftWrist, Role::kRightWrist}) {
+    loaded.role_detection.notes[static_cast<std::size_t>(role)] = "three-point CSV column";
+  }
+  loaded.description = path;
+  return loaded;
+}
+
+}  // namespace
+
 Result<LoadedMotion> load_motion(const std::vector<std::string>& paths,
                                  const MotionLoadOptions& options) {
   LoadedMotion loaded;
@@ -134,6 +166,8 @@ Result<LoadedMotion> load_motion(const std::vector<std::string>& paths,
     if (!clip) return clip.error();
     loaded.clip = std::move(clip).value();
     loaded.description = paths[0];
+  } else if (paths.size() == 1 && lowercase_extension(paths[0]) == ".csv") {
+    return load_points_csv(paths[0], options);
   } else if (paths.size() == 2) {
     std::string asf = paths[0], amc = paths[1];
     if (lowercase_extension(asf) == ".amc") std::swap(asf, amc);
@@ -150,7 +184,7 @@ Result<LoadedMotion> load_motion(const std::vector<std::string>& paths,
     loaded.description = asf + " + " + amc;
     lengths_in_metres = true;  // the ASF reader applies the file's own units
   } else {
-    return Error{"expected a .bvh file, or an .asf and an .amc file"};
+    return Error{"expected a .bvh file, a three-point .csv file, or an .asf and an .amc file"};
   }
 
   const Skeleton& skeleton = loaded.clip.skeleton();

@@ -116,7 +116,7 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
   library.normalizer_ = FeatureNormalizer::fit(all, options.features);
   library.normalizer_.apply(all);
   // The feature vector ends with its velocity blocks (root velocity, effector speed).
-  const int velocity_dims = FeatureSpec::kRootVelocityDims + FeatureSpec::kEffectorSpeedDims;
+  const int velocity_dims = options.features.velocity_dims();
   Result<TemplateModel> model =
       TemplateModel::build(std::move(all), std::move(take_start),
                            library.takes_[0].template_motion.clip.frame_rate(), velocity_dims);

@@ -5,6 +5,7 @@
 
 #include "duet/motion/body_space.h"
 #include "duet/motion/forward_kinematics.h"
+#include "duet/motion/head_hands.h"
 
 namespace duet {
 
@@ -75,7 +76,45 @@ Result<LiveLoop> LiveLoop::create(std::shared_ptr<const DuetLibrary> library,
   Result<FollowSession> session =
       FollowSession::create(*library, user.skeleton, user.roles, std::move(tracker));
   if (!session) return session.error();
-  return LiveLoop(std::move(library), user, std::move(session).value(), std::move(models), params);
+  std::vector<HeadHandsBody> head_hands_bodies;
+  if (is_head_hands_input(user.roles)) {
+    for (const DuetTake& take : library->takes()) {
+      Result<HeadHandsBody> body =
+          HeadHandsBody::build(take.template_motion.clip, take.template_motion.roles);
+      if (!body) return Error{"take " + take.name + ": " + body.error().message};
+      head_hands_bodies.push_back(std::move(body).value());
+    }
+  }
+  LiveLoop loop(std::move(library), user, std::move(session).value(), std::move(models), params);
+  loop.head_hands_bodies_ = std::move(head_hands_bodies);
+  loop.head_correction_ = head_hands_device_correction();
+  loop.set_params(params);
+  return loop;
+}
+
+void LiveLoop::set_params(const PartnerParams& params) noexcept {
+  params_ = params;
+  // A controller's orientation says nothing of how the captured grip was turned: the partner's
+  // wrist goes to the controller itself.
+  if (!head_hands_bodies_.empty()) params_.ik_target = IkTarget::kUserWrist;
+}
+
+void LiveLoop::place_head_hands_user(int take, int frame) noexcept {
+  const auto head = static_cast<std::size_t>(user_.roles[Role::kHead]);
+  const Vec3& head_position = out_.user_positions_ws[head];
+  if (!head_position.allFinite()) return;
+  head_height_max_m_ = std::max(head_height_max_m_, head_position.y());
+  const HeadHandsBody& body = head_hands_bodies_[static_cast<std::size_t>(take)];
+  const PartnerModel& model = models_[static_cast<std::size_t>(take)];
+  const double size_ratio = body.template_head_height_m() > 0.0
+                                ? head_height_max_m_ / body.template_head_height_m()
+                                : 1.0;
+  const Transform head_frame =
+      head_heading_frame(head_position, out_.user_rotations_ws[head] * head_correction_);
+  user_pose_.body_heading = body.body_heading(head_frame, frame, size_ratio);
+  user_pose_.body_heading_valid = user_pose_.body_heading.translation.allFinite() &&
+                                  user_pose_.body_heading.rotation.coeffs().allFinite();
+  user_pose_.height_m = model.template_height_m() * size_ratio;
 }
 
 LiveLoop::LiveLoop(std::shared_ptr<const DuetLibrary> library, const SourceSkeleton& user,
@@ -121,6 +160,7 @@ void LiveLoop::reset() noexcept {
   previous_take_ = -1;
   previous_frame_ = 0;
   has_previous_ = false;
+  head_height_max_m_ = 0.0;
 }
 
 const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
@@ -146,6 +186,7 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   }
   const PartnerModel& model = models_[static_cast<std::size_t>(take)];
   const Clip& response = library_->takes()[static_cast<std::size_t>(take)].response_motion.clip;
+  if (!head_hands_bodies_.empty()) place_head_hands_user(take, frame_in_take);
 
   PartnerSynthesisJob job;
   job.model = &model;

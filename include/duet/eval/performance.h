@@ -149,8 +149,19 @@ Performance with_room_placement(Performance performance, double yaw_rad, const V
 Result<Performance> with_rig(Performance performance, std::shared_ptr<const Skeleton> rig,
                              const JointRoles& rig_roles);
 
+// What a headset and two controllers would report of the performance (issue 12): its head and
+// wrists on the head-and-hands skeleton (duet/motion/head_hands.h), each point with its own
+// tracking noise: normal per-axis position noise (standard deviation position_m) and a random
+// rotation whose rotation vector has normal components (RMS angle rotation_deg).
+struct PointNoiseOptions {
+  double position_m = 0.005;
+  double rotation_deg = 1.0;
+  std::uint64_t seed = 1;
+};
+Result<Performance> with_head_hands(Performance performance, const PointNoiseOptions& noise);
+
 // A composition of the above, applied in this order: play or improvise (at rate_hz), body scale,
-// room placement, another rig, sensor noise, frame loss. Each stage's seed is derived from `seed`.
+// room placement, another rig, sensor noise, head and hands, frame loss. Each stage's seed is derived from `seed`.
 struct PerformanceRecipe {
   bool improvise = false;
   PlayOptions play;                    // when !improvise (seed ignored)
@@ -162,6 +173,9 @@ struct PerformanceRecipe {
   JointRoles rig_roles;
   std::string rig_name;      // for reports ("asf", "bandai", ...)
   SensorNoiseOptions noise;  // seed ignored
+  // Delivered as three points (head and hands) with point_noise (seed ignored).
+  bool head_hands = false;
+  PointNoiseOptions point_noise;
   FrameLossOptions loss;     // seed ignored
 };
 

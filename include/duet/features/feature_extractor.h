@@ -35,7 +35,7 @@ class FeatureExtractor {
     friend class FeatureExtractor;
     struct Sample {
       double time_s = 0.0;
-      Vec3 pelvis = Vec3::Zero();
+      Vec3 root = Vec3::Zero();  // the pelvis centre (full body) or the head (head and hands)
       double yaw = 0.0;
       std::array<Vec3, 4> effectors;  // left hand, right hand, left foot, right foot
     };
@@ -43,12 +43,16 @@ class FeatureExtractor {
     std::array<Sample, kHistory> history_{};
     int newest_ = -1;
     int count_ = 0;
+    // Head and hands: the highest the head has been (metres), the unit of lengths there, since a
+    // headset says nothing of the body's size.
+    double head_height_max_m_ = 0.0;
     std::vector<Vec3> positions_ws_;
     std::vector<Quat> rotations_ws_;
   };
 
   Context make_context() const;
-  // The body's leg length (metres): the unit of the position and velocity features.
+  // The body's leg length (metres): the unit of the position and velocity features of the full
+  // body (0 for head-and-hands features, whose unit is the head's height).
   double leg_length_m() const { return leg_length_m_; }
   int dimension() const { return spec_.dimension(); }
   const FeatureSpec& spec() const { return spec_; }
@@ -68,11 +72,23 @@ class FeatureExtractor {
   // A role's point in the canonical body (see BodySegment): the pelvis centre for kHips, the
   // shoulder centre for kChest, else the role's joint.
   Vec3 body_point(std::span<const Vec3> positions_ws, Role role) const noexcept;
+  // The two layouts of FeatureSpec::InputPoints, from the world pose of `context`; both return
+  // the sample to remember.
+  Context::Sample extract_full_body(const Context& context, double time_s,
+                                    std::span<float> out) const noexcept;
+  Context::Sample extract_head_hands(Context& context, double time_s,
+                                     std::span<float> out) const noexcept;
+  // The newest remembered sample at least velocity_window_s older than time_s, else the oldest
+  // (the first frames of a performance); null when there is none.
+  const Context::Sample* velocity_reference(const Context& context, double time_s) const noexcept;
+  static void remember(Context& context, const Context::Sample& sample) noexcept;
 
   FeatureSpec spec_;
   JointRoles roles_;
   double leg_length_m_ = 1.0;
   std::array<int, 4> effector_joints_{};
+  // Head and hands: R_canonical = R_world * head_correction_ for the head (head_hands.h).
+  Quat head_correction_ = Quat::Identity();
   std::shared_ptr<const Skeleton> skeleton_;
 };
 

@@ -13,6 +13,7 @@
 // the skeleton's bones (duet::measure_body).
 #pragma once
 
+#include <string_view>
 #include <vector>
 
 #include "duet/motion/skeleton_map.h"
@@ -20,6 +21,15 @@
 namespace duet {
 
 enum class FeatureBlock : int { kPosture, kRootVelocity, kEffectorSpeed, kCount };
+
+// Which points of the body the features see. kHeadHands (issue 12) is what a VR headset and two
+// controllers give: the head's and both hands' positions and the head's orientation. The library's
+// templates then give the same three points from their head and wrist roles (docs/features.md,
+// "Three points").
+enum class InputPoints { kFullBody, kHeadHands };
+// "full" | "head,hands" (the command line's --input-points).
+bool parse_input_points(std::string_view text, InputPoints& points);
+const char* input_points_name(InputPoints points);
 constexpr int kFeatureBlockCount = static_cast<int>(FeatureBlock::kCount);
 
 // A body segment from one role's point to another's. Two roles stand for canonical points rather
@@ -31,6 +41,8 @@ struct BodySegment {
 };
 
 struct FeatureSpec {
+  InputPoints input_points = InputPoints::kFullBody;
+
   // Segments whose direction is a posture feature: the trunk, neck and head, the shoulder line
   // (the chest's twist against the hips), and the four limbs' two long bones each.
   std::vector<BodySegment> posture_segments = {
@@ -65,12 +77,20 @@ struct FeatureSpec {
   double speed_std_floor = 0.05;
   double yaw_rate_std_floor_radps = 0.2;
 
+  // Head and hands: both hands relative to the head (6), the head's height (1) and its up
+  // direction (3), all in the head's heading frame.
+  static constexpr int kHeadHandsPostureDims = 10;
   int posture_dims() const {
+    if (input_points == InputPoints::kHeadHands) return kHeadHandsPostureDims;
     return 3 * static_cast<int>(posture_segments.size() + posture_points.size());
   }
+  // Forward, lateral and vertical velocity of the root (the pelvis centre, or the head) and the
+  // heading's yaw rate.
   static constexpr int kRootVelocityDims = 4;
-  static constexpr int kEffectorSpeedDims = 4;
-  int dimension() const { return posture_dims() + kRootVelocityDims + kEffectorSpeedDims; }
+  // Speeds of the hands and feet (full body) or of the hands (head and hands).
+  int effector_speed_dims() const { return input_points == InputPoints::kHeadHands ? 2 : 4; }
+  int velocity_dims() const { return kRootVelocityDims + effector_speed_dims(); }
+  int dimension() const { return posture_dims() + velocity_dims(); }
   // First dimension and size of a block.
   int block_begin(FeatureBlock block) const;
   int block_size(FeatureBlock block) const;

@@ -17,6 +17,7 @@
 #include "duet/live/duet_library.h"
 #include "duet/live/follow_session.h"
 #include "duet/live/source_frame.h"
+#include "duet/partner/head_hands_body.h"
 #include "duet/partner/partner_synthesis.h"
 
 namespace duet {
@@ -70,7 +71,7 @@ class LiveLoop {
   void reset() noexcept;
   // Switch a correction (protocol name); false for an unknown name.
   bool set_correction(std::string_view name, bool enabled) noexcept;
-  void set_params(const PartnerParams& params) noexcept { params_ = params; }
+  void set_params(const PartnerParams& params) noexcept;
   const PartnerParams& params() const noexcept { return params_; }
 
   const DuetLibrary& library() const noexcept { return *library_; }
@@ -86,6 +87,9 @@ class LiveLoop {
  private:
   LiveLoop(std::shared_ptr<const DuetLibrary> library, const SourceSkeleton& user,
            FollowSession session, std::vector<PartnerModel> models, const PartnerParams& params);
+  // A user tracked by three points: their body heading frame and height, from the head and the
+  // template frame `frame` of `take` (HeadHandsBody).
+  void place_head_hands_user(int take, int frame) noexcept;
 
   std::shared_ptr<const DuetLibrary> library_;
   SourceSkeleton user_;
@@ -96,6 +100,10 @@ class LiveLoop {
   LiveOutput out_;
   UserPose user_pose_;
   double user_height_m_ = 0.0;  // measure_body of the user's skeleton: fits the partner's spacing
+  // Three-point users (head and hands only): one HeadHandsBody per take; empty for a full body.
+  std::vector<HeadHandsBody> head_hands_bodies_;
+  Quat head_correction_ = Quat::Identity();  // the head's device rotation -> canonical
+  double head_height_max_m_ = 0.0;           // the highest the user's head has been
   ResponsePlayhead playhead_;
   Pose shown_pose_;  // the response sampled at the playhead
   int previous_take_ = -1;

@@ -1,0 +1,44 @@
+// Three tracked points, as a VR headset and two controllers give them (issue 12): the head's and
+// both hands' positions and orientations, in metres, Y up, right-handed. Duet carries them as a
+// motion on a tiny skeleton (an origin and three children), so every reader, source and recorder
+// that moves a skeleton moves three points too.
+//
+// Orientation convention (the devices', WebXR's and OpenXR's): the identity faces -Z with +Y up.
+// From a full-body take, a point's orientation is its joint's world rotation relative to the rest
+// pose, turned so the rest pose faces -Z: a dancer standing in the rest pose looks straight ahead
+// with the "controllers" pointing forward.
+#pragma once
+
+#include <memory>
+
+#include "duet/base/result.h"
+#include "duet/motion/clip.h"
+#include "duet/motion/skeleton_map.h"
+
+namespace duet {
+
+// Joint indices of the head-and-hands skeleton.
+enum HeadHandsJoint : int { kPointsOrigin = 0, kPointsHead, kPointsLeftHand, kPointsRightHand };
+constexpr int kHeadHandsJointCount = 4;
+
+// The skeleton: "origin" (the root, never moved) with children "head", "left_hand" and
+// "right_hand", each animated by position and rotation channels.
+std::shared_ptr<const Skeleton> make_head_hands_skeleton();
+// Its roles: head, left_wrist and right_wrist; convention "head-hands"; every other role -1.
+JointRoles head_hands_roles();
+// Whether `roles` describe three points only (a head and two hands, no hips): the input a
+// headset gives, which the follower follows with InputPoints::kHeadHands.
+bool is_head_hands_input(const JointRoles& roles);
+
+// The rotation that takes a point's world rotation to the canonical body frame (x left, y up,
+// z forward): R_canonical = R_world * correction. For a head-and-hands skeleton it is the device
+// convention's half turn about Y; for a full-body rig, the heading of its rest pose (whose world
+// rotations are the identity).
+Quat head_hands_device_correction();
+Result<Quat> rest_pose_correction(const Skeleton& skeleton, const JointRoles& roles);
+
+// The three points of a full-body clip (any rig with head and wrist roles), on the head-and-hands
+// skeleton, at the clip's rate: what a headset and controllers would have reported.
+Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles);
+
+}  // namespace duet

@@ -1,0 +1,42 @@
+// Where the body of a user tracked by three points is (issue 12). The partner is placed relative
+// to the user's body heading frame (the pelvis centre on the floor, turned by the hips' heading),
+// which a headset and two controllers do not show. At the template frame the follower estimates,
+// the captured dancer's head stood at a known place and yaw in their own body heading frame; the
+// user's body heading frame is the user's head frame with that relation undone (scaled to the
+// user's size). Dancing as the template danced, that puts the user's hips where they are.
+#pragma once
+
+#include <vector>
+
+#include "duet/base/result.h"
+#include "duet/math/types.h"
+#include "duet/motion/clip.h"
+#include "duet/motion/skeleton_map.h"
+
+namespace duet {
+
+// A head's heading frame: its position on the floor (y = 0), turned about +Y by the facing of its
+// canonical orientation (R_world * correction, duet/motion/head_hands.h).
+Transform head_heading_frame(const Vec3& head_position_ws, const Quat& head_canonical_ws) noexcept;
+
+class HeadHandsBody {
+ public:
+  HeadHandsBody() = default;
+  // Offline, per duet take: the template's head frame in its body heading frame at every frame.
+  static Result<HeadHandsBody> build(const Clip& template_clip, const JointRoles& template_roles);
+
+  int frame_count() const noexcept { return static_cast<int>(head_in_body_.size()); }
+  // The highest the template's head was (metres): the size the user's head height is compared to.
+  double template_head_height_m() const noexcept { return template_head_height_m_; }
+
+  // The user's body heading frame from their head's heading frame at template frame `frame`
+  // (clamped to the take), for a user `size_ratio` times the template's size.
+  Transform body_heading(const Transform& user_head_heading, int frame,
+                         double size_ratio) const noexcept;
+
+ private:
+  std::vector<Transform> head_in_body_;
+  double template_head_height_m_ = 0.0;
+};
+
+}  // namespace duet

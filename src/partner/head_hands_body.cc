@@ -1,0 +1,54 @@
+#include "duet/partner/head_hands_body.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "duet/math/rotation.h"
+#include "duet/motion/forward_kinematics.h"
+#include "duet/motion/head_hands.h"
+#include "duet/partner/alignment.h"
+
+namespace duet {
+
+Transform head_heading_frame(const Vec3& head_position_ws, const Quat& head_canonical_ws) noexcept {
+  Transform frame;
+  frame.rotation = yaw_rotation(heading_yaw(head_canonical_ws));
+  frame.translation = Vec3(head_position_ws.x(), 0.0, head_position_ws.z());
+  return frame;
+}
+
+Result<HeadHandsBody> HeadHandsBody::build(const Clip& template_clip,
+                                           const JointRoles& template_roles) {
+  const int head = template_roles[Role::kHead];
+  if (head < 0 || head >= template_clip.joint_count()) {
+    return Error{"the template has no head joint (role head)"};
+  }
+  Result<Quat> correction = rest_pose_correction(template_clip.skeleton(), template_roles);
+  if (!correction) return Error{"the template: " + correction.error().message};
+  HeadHandsBody body;
+  body.head_in_body_.resize(static_cast<std::size_t>(template_clip.frame_count()));
+  const auto n = static_cast<std::size_t>(template_clip.joint_count());
+  std::vector<Vec3> positions(n);
+  std::vector<Quat> rotations(n);
+  const auto h = static_cast<std::size_t>(head);
+  for (int f = 0; f < template_clip.frame_count(); ++f) {
+    forward_kinematics(template_clip.skeleton(), template_clip.translations_ls(f),
+                       template_clip.rotations_ls(f), positions, rotations);
+    const Transform head_frame = head_heading_frame(positions[h], rotations[h] * correction.value());
+    const Transform body_frame = body_heading_frame(positions, template_roles);
+    body.head_in_body_[static_cast<std::size_t>(f)] = body_frame.inverse() * head_frame;
+    body.template_head_height_m_ = std::max(body.template_head_height_m_, positions[h].y());
+  }
+  return body;
+}
+
+Transform HeadHandsBody::body_heading(const Transform& user_head_heading, int frame,
+                                      double size_ratio) const noexcept {
+  if (head_in_body_.empty()) return user_head_heading;
+  const auto f = static_cast<std::size_t>(std::clamp(frame, 0, frame_count() - 1));
+  Transform relation = head_in_body_[f];
+  if (std::isfinite(size_ratio) && size_ratio > 0.0) relation.translation *= size_ratio;
+  return user_head_heading * relation.inverse();
+}
+
+}  // namespace duet

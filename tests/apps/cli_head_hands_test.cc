@@ -1,0 +1,86 @@
+// End to end with three points (issue 12): `duet convert --points head,hands` makes a headset
+// recording of a take, `duet follow` follows it with the three-point follower, and the options
+// that cannot apply say so.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "apps/run_command.h"
+
+namespace duet::testing {
+namespace {
+
+const std::string kTake = data_path("cmu-salsa/bvh/60/60_07_scaled.bvh");
+const std::string kLibrary =
+    std::string(DUET_TESTDATA_DIR) + "/../../libraries/cmu-salsa.toml --data-dir " + DUET_DATA_DIR;
+
+std::string temp(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("duet_cli_head_hands_" + name)).string();
+}
+
+std::string read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+TEST(CliHeadHands, ConvertThenFollowTheRecording) {
+  const std::string csv = temp("07.csv"), trace = temp("07_trace.csv");
+  CommandResult converted =
+      run_duet("convert " + kTake + " --input-fps 60 --points head,hands -o " + csv);
+  ASSERT_EQ(converted.exit_code, 0) << converted.output;
+  EXPECT_EQ(read(csv).substr(0, 20), "time_s,head_x,head_y");
+
+  CommandResult followed =
+      run_duet("follow --library " + kLibrary + " --input " + csv + " --trace " + trace);
+  ASSERT_EQ(followed.exit_code, 0) << followed.output;
+  // Frame f of take 07 (library index 6) is template frame f.
+  std::istringstream rows(read(trace));
+  std::string row;
+  std::getline(rows, row);
+  int frames = 0, right = 0;
+  while (std::getline(rows, row)) {
+    int frame = 0, take = 0, template_frame = 0;
+    double time = 0;
+    ASSERT_EQ(std::sscanf(row.c_str(), "%d,%lf,%d,%d", &frame, &time, &take, &template_frame), 4);
+    ++frames;
+    right += (take == 6 && std::abs(template_frame - frame) <= 6) ? 1 : 0;
+  }
+  EXPECT_GT(frames, 2000);
+  EXPECT_GE(right, frames * 99 / 100);
+  std::filesystem::remove(csv);
+  std::filesystem::remove(trace);
+}
+
+TEST(CliHeadHands, InputPointsOnAFullBodyTakeFollowsItsThreePoints) {
+  CommandResult followed = run_duet("follow --library " + kLibrary + " --input " + kTake +
+                                    " --input-fps 60 --input-points head,hands");
+  EXPECT_EQ(followed.exit_code, 0) << followed.output;
+  EXPECT_NE(followed.output.find("0 jumps"), std::string::npos) << followed.output;
+}
+
+TEST(CliHeadHands, OptionsThatCannotApplySaySo) {
+  const std::string csv = temp("bad.csv");
+  CommandResult no_points = run_duet("convert " + kTake + " -o " + csv);
+  EXPECT_EQ(no_points.exit_code, 1);
+  EXPECT_NE(no_points.output.find("add --points head,hands"), std::string::npos)
+      << no_points.output;
+  EXPECT_FALSE(std::filesystem::exists(csv));
+
+  ASSERT_EQ(run_duet("convert " + kTake + " --points head,hands -o " + csv).exit_code, 0);
+  CommandResult full = run_duet("follow --library " + kLibrary + " --input " + csv +
+                                " --input-points full");
+  EXPECT_EQ(full.exit_code, 2);
+  EXPECT_NE(full.output.find("has only a head and two hands"), std::string::npos) << full.output;
+
+  CommandResult other = run_duet("convert " + kTake + " --points feet -o " + csv);
+  EXPECT_NE(other.exit_code, 0);
+  EXPECT_NE(other.output.find("--points"), std::string::npos) << other.output;
+  std::filesystem::remove(csv);
+}
+
+}  // namespace
+}  // namespace duet::testing

@@ -1,0 +1,175 @@
+// The three-point follower (issue 12) on the real salsa library: three points made from a take
+// (as `duet convert --points head,hands` makes them, with a headset's noise) are followed and the
+// partner is placed as a full-body user would have it placed.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "duet/eval/performance.h"
+#include "duet/features/feature_extractor.h"
+#include "duet/io/points_csv.h"
+#include "duet/live/live_loop.h"
+#include "duet/math/rotation.h"
+#include "duet/motion/head_hands.h"
+#include "live/salsa_library.h"
+
+namespace duet::test {
+namespace {
+
+const DuetLibrary& head_hands_library() {
+  static const DuetLibrary loaded = [] {
+    std::vector<PairFiles> pairs;
+    for (const char* trial :
+         {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13", "14", "15"}) {
+      pairs.push_back({{kSalsaData + "/cmu-salsa/bvh/60/60_" + trial + "_scaled.bvh"},
+                       {kSalsaData + "/cmu-salsa/bvh/61/61_" + trial + "_scaled.bvh"}});
+    }
+    LibraryOptions options;
+    options.load.frame_rate = 60.0;
+    options.features.input_points = InputPoints::kHeadHands;
+    Result<DuetLibrary> l = DuetLibrary::load(pairs, options);
+    if (!l) throw std::runtime_error(l.error().message);
+    return std::move(l).value();
+  }();
+  return loaded;
+}
+
+LoadedMotion load_take(const std::string& subject_take) {
+  MotionLoadOptions options;
+  options.frame_rate = 60.0;
+  Result<LoadedMotion> loaded = load_motion(
+      {kSalsaData + "/cmu-salsa/bvh/" + subject_take.substr(0, 2) + "/" + subject_take +
+       "_scaled.bvh"},
+      options);
+  EXPECT_TRUE(loaded) << loaded.error().message;
+  return std::move(loaded).value();
+}
+
+// Take 60_07 as a headset would report it: three points, 5 mm and 1 degree of noise per point.
+Performance noisy_points(const LoadedMotion& take, double body_scale = 1.0) {
+  Performance performance;
+  performance.motion = take.clip;
+  performance.roles = take.roles;
+  if (body_scale != 1.0) performance = with_body_scale(std::move(performance), body_scale);
+  Result<Performance> points = with_head_hands(std::move(performance), PointNoiseOptions{});
+  EXPECT_TRUE(points) << points.error().message;
+  return std::move(points).value();
+}
+
+TEST(HeadHandsFeatures, SameNumbersFromTheFullBodyAndFromItsThreePoints) {
+  // The template's extraction (full-body rig, head and wrist roles) and a headset's (the points
+  // skeleton, device orientations) must agree, or no user could be matched to the library.
+  const LoadedMotion take = load_take("60_07");
+  Result<Clip> points = head_hands_clip(take.clip, take.roles);
+  ASSERT_TRUE(points) << points.error().message;
+  // Through the CSV text, as a recording is read back.
+  Result<Clip> read = parse_points_csv(format_points_csv(points.value()), "07.csv");
+  ASSERT_TRUE(read) << read.error().message;
+  FeatureSpec spec;
+  spec.input_points = InputPoints::kHeadHands;
+  Result<FeatureExtractor> full = FeatureExtractor::create(take.clip.skeleton_ptr(), take.roles, spec);
+  Result<FeatureExtractor> three =
+      FeatureExtractor::create(read.value().skeleton_ptr(), head_hands_roles(), spec);
+  ASSERT_TRUE(full) << full.error().message;
+  ASSERT_TRUE(three) << three.error().message;
+  const FeatureMatrix a = full.value().extract_clip(take.clip);
+  const FeatureMatrix b = three.value().extract_clip(read.value());
+  ASSERT_EQ(a.rows(), b.rows());
+  EXPECT_EQ(a.cols(), spec.dimension());
+  // Posture to 1e-3 (5-decimal CSV), velocities to 1e-2 (differences of rounded positions).
+  const int posture = spec.posture_dims();
+  EXPECT_LT((a.leftCols(posture) - b.leftCols(posture)).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_LT((a.rightCols(a.cols() - posture) - b.rightCols(a.cols() - posture)).cwiseAbs().maxCoeff(),
+            1e-2);
+}
+
+TEST(HeadHandsFeatures, IndependentOfThePlaceInTheRoomAndOfBodySize) {
+  const LoadedMotion take = load_take("60_07");
+  Performance base;
+  base.motion = take.clip;
+  base.roles = take.roles;
+  Performance moved = with_room_placement(base, 1.2, Vec3(2.0, 0.0, -1.5));
+  Performance bigger = with_body_scale(base, 1.15);
+  FeatureSpec spec;
+  spec.input_points = InputPoints::kHeadHands;
+  auto features = [&](const Performance& p) {
+    Result<Clip> points = head_hands_clip(p.motion, p.roles);
+    EXPECT_TRUE(points);
+    Result<FeatureExtractor> e =
+        FeatureExtractor::create(points.value().skeleton_ptr(), head_hands_roles(), spec);
+    EXPECT_TRUE(e);
+    return e.value().extract_clip(points.value());
+  };
+  const FeatureMatrix a = features(base);
+  EXPECT_LT((a - features(moved)).cwiseAbs().maxCoeff(), 1e-4);
+  EXPECT_LT((a - features(bigger)).cwiseAbs().maxCoeff(), 1e-4);
+}
+
+TEST(HeadHandsFollow, ANoisyHeadsetTakeIsFollowed) {
+  const LoadedMotion take = load_take("60_07");
+  const Performance performance = noisy_points(take);
+  const DuetLibrary& library = head_hands_library();
+  Result<HmmFollower> follower = HmmFollower::create(library.model(), FollowParams{});
+  ASSERT_TRUE(follower);
+  Result<FollowSession> session = FollowSession::create(
+      library, performance.motion.skeleton_ptr(), performance.roles,
+      std::make_unique<HmmFollower>(std::move(follower).value()));
+  ASSERT_TRUE(session) << session.error().message;
+  int within = 0, lost = 0;
+  const int frames = performance.motion.frame_count();
+  for (int f = 0; f < frames; ++f) {
+    const FollowResult r = session.value().step(performance.motion.translations_ls(f),
+                                                performance.motion.rotations_ls(f), f / 60.0);
+    within += (r.take == 6 && std::abs(r.frame_in_take - f) <= 6) ? 1 : 0;
+    lost += r.lost ? 1 : 0;
+  }
+  EXPECT_GE(within, 0.95 * frames) << within << " of " << frames;
+  EXPECT_LE(lost, 0.05 * frames) << lost << " of " << frames;
+}
+
+// The partner of a three-point user stands where the partner of the same dance on the full body
+// stands: the body heading is rebuilt from the head at the followed template frame.
+TEST(HeadHandsFollow, ThePartnerIsPlacedAsForTheFullBody) {
+  const LoadedMotion take = load_take("60_07");
+  for (const double scale : {1.0, 1.15}) {
+    Performance body;
+    body.motion = take.clip;
+    body.roles = take.roles;
+    if (scale != 1.0) body = with_body_scale(std::move(body), scale);
+    const Performance points = noisy_points(take, scale);
+    auto partner_roots = [](const DuetLibrary& library, const Performance& p) {
+      auto shared = std::shared_ptr<const DuetLibrary>(&library, [](const DuetLibrary*) {});
+      Result<HmmFollower> follower = HmmFollower::create(library.model(), FollowParams{});
+      EXPECT_TRUE(follower);
+      Result<LiveLoop> loop = LiveLoop::create(
+          shared, SourceSkeleton{p.motion.skeleton_ptr(), p.roles, 1.0, 60.0},
+          std::make_unique<HmmFollower>(std::move(follower).value()));
+      EXPECT_TRUE(loop) << loop.error().message;
+      SourceFrame frame;
+      frame.resize(p.motion.joint_count());
+      std::vector<Vec3> roots;
+      const int hips = loop.value().partner_model(0).response_roles()[Role::kHips];
+      for (int f = 0; f < p.motion.frame_count(); ++f) {
+        frame.time_s = f / 60.0;
+        std::ranges::copy(p.motion.translations_ls(f), frame.translations_ls.begin());
+        std::ranges::copy(p.motion.rotations_ls(f), frame.rotations_ls.begin());
+        roots.push_back(loop.value().step(frame).partner_positions_ws[static_cast<std::size_t>(hips)]);
+      }
+      return roots;
+    };
+    const std::vector<Vec3> from_body = partner_roots(salsa_library(), body);
+    const std::vector<Vec3> from_points = partner_roots(head_hands_library(), points);
+    std::vector<double> gaps;
+    for (std::size_t f = 0; f < from_body.size(); ++f) {
+      gaps.push_back((from_body[f] - from_points[f]).norm());
+    }
+    std::ranges::sort(gaps);
+    EXPECT_LT(gaps[gaps.size() / 2], 0.05) << "scale " << scale;   // median under 5 cm
+    EXPECT_LT(gaps[gaps.size() * 95 / 100], 0.15) << "scale " << scale;
+  }
+}
+
+}  // namespace
+}  // namespace duet::test
