@@ -13,7 +13,9 @@
 #include "duet/live/source_pose.h"
 #include "duet/live/source_replay.h"
 #include "duet/live/source_spec.h"
+#include "duet/motion/head_hands.h"
 #include "duet/net/live_server.h"
+#include "input_points.h"
 #include "library_options.h"
 #include "number_checks.h"
 #include "partner_options.h"
@@ -34,6 +36,7 @@ struct ServeArgs {
   std::optional<double> source_fps;
   std::optional<double> source_scale;
   std::string source_map;
+  std::string input_points;  // "", "full" or "head,hands"
   std::string http = "127.0.0.1:8080";
   std::optional<std::string> token;
   std::string web;
@@ -151,6 +154,8 @@ Result<std::unique_ptr<FrameSource>> make_source(const SourceSpec& spec, const S
       if (!ok) return Error{"bad --source-map"};
       Result<LoadedMotion> motion = load_motion({spec.path}, options);
       if (!motion) return motion.error();
+      Result<InputPoints> points = choose_input_points(args.input_points, motion.value());
+      if (!points) return points.error();
       Result<ReplaySource> replay = ReplaySource::create(std::move(motion).value(), spec.replay,
                                                          fs::path(spec.path).filename().string());
       if (!replay) return replay.error();
@@ -197,8 +202,37 @@ Result<std::unique_ptr<FrameSource>> make_source(const SourceSpec& spec, const S
           std::make_unique<PoseSource>(std::move(skeleton), PoseSourceOptions{},
                                        "poses from WebSocket clients (" + which + ")"));
     }
+    case SourceKind::kXr: {
+      SourceSkeleton skeleton{make_head_hands_skeleton(), head_hands_roles(), 1.0,
+                              args.source_fps ? *args.source_fps : 72.0};
+      return std::unique_ptr<FrameSource>(std::make_unique<PoseSource>(
+          std::move(skeleton), PoseSourceOptions{},
+          "a VR headset and two controllers (xr_pose messages over the WebSocket)"));
+    }
   }
   return Error{"unknown source"};
+}
+
+// Which points the follower sees: three for the headset source, a three-point recording or
+// --input-points head,hands; else the whole body. Decided before the library is built, since its
+// templates must give the same points.
+Result<InputPoints> serve_input_points(const SourceSpec& spec, const ServeArgs& args) {
+  const bool csv = spec.kind == SourceKind::kReplay && spec.path.size() >= 4 &&
+                   (spec.path.substr(spec.path.size() - 4) == ".csv" ||
+                    spec.path.substr(spec.path.size() - 4) == ".CSV");
+  InputPoints asked = InputPoints::kFullBody;
+  if (!args.input_points.empty()) parse_input_points(args.input_points, asked);
+  if (spec.kind == SourceKind::kXr || csv) {
+    if (!args.input_points.empty() && asked == InputPoints::kFullBody) {
+      return Error{"--input-points full: the source gives only a head and two hands"};
+    }
+    return InputPoints::kHeadHands;
+  }
+  if (asked == InputPoints::kHeadHands && spec.kind != SourceKind::kReplay) {
+    return Error{"--input-points head,hands applies to a replayed file (a live body source "
+                 "sends the whole body; --source xr sends three points)"};
+  }
+  return asked;
 }
 
 Result<std::unique_ptr<LiveLoop>> make_loop(std::shared_ptr<const DuetLibrary> library,
@@ -225,7 +259,14 @@ int run_serve(const ServeArgs& args) {
     return kExitUsage;
   }
 
-  std::optional<DuetLibrary> loaded = load_library(args.library, "serve");
+  Result<InputPoints> points = serve_input_points(spec.value(), args);
+  if (!points) {
+    fail(points.error().message);
+    return kExitUsage;
+  }
+  FeatureSpec features;
+  features.input_points = points.value();
+  std::optional<DuetLibrary> loaded = load_library(args.library, "serve", features);
   if (!loaded) return kExitFailure;
   auto library = std::make_shared<const DuetLibrary>(std::move(*loaded));
 
@@ -245,8 +286,9 @@ int run_serve(const ServeArgs& args) {
 
   // The other role is built on demand (a `role` message), on a background thread.
   net::LoopFactory factory =
-      [args, user](DancerRole role, const PartnerParams& p) -> Result<std::unique_ptr<LiveLoop>> {
-    Result<LibrarySetup> setup = resolve_library(args.library);
+      [args, user, features](DancerRole role,
+                             const PartnerParams& p) -> Result<std::unique_ptr<LiveLoop>> {
+    Result<LibrarySetup> setup = resolve_library(args.library, features);
     if (!setup) return setup.error();
     setup.value().options.role = role;
     Result<DuetLibrary> other = DuetLibrary::load(setup.value().pairs, setup.value().options);
@@ -331,8 +373,12 @@ Command register_serve(CLI::App& app) {
   add_partner_options(app, args->partner);
   app.add_option("--source", args->source,
                  "Where the user's motion comes from: replay:FILE.bvh[?speed=S&loop=1&start=SEC], "
-                 "neuron-tcp:HOST:PORT, neuron-udp:[ADDR:]PORT, ws[:SKELETON.bvh]")
+                 "neuron-tcp:HOST:PORT, neuron-udp:[ADDR:]PORT, ws[:SKELETON.bvh], xr (a VR "
+                 "headset and controllers from the viewer's VR session); replay also plays a "
+                 "three-point CSV")
       ->capture_default_str();
+  app.add_option("--input-points", args->input_points, kInputPointsHelp)
+      ->check(CLI::IsMember({"full", "head,hands"}));
   app.add_option("--source-skeleton", args->source_skeleton,
                  "BVH whose hierarchy describes the live stream (neuron; ws without a skeleton)")
       ->check(CLI::ExistingFile);

@@ -111,6 +111,8 @@ const char* source_kind_name(SourceKind kind) {
       return "neuron-udp";
     case SourceKind::kWebSocket:
       return "ws";
+    case SourceKind::kXr:
+      return "xr";
   }
   return "?";
 }
@@ -129,6 +131,11 @@ Result<SourceSpec> parse_source_spec(std::string_view text) {
     spec.path = std::string(rest);
     return spec;
   }
+  if (kind == "xr") {
+    if (colon != std::string_view::npos) return spec_error(text, "xr takes nothing after it");
+    spec.kind = SourceKind::kXr;
+    return spec;
+  }
   if (kind == "replay") {
     spec.kind = SourceKind::kReplay;
   } else if (kind == "neuron-tcp") {
@@ -137,7 +144,7 @@ Result<SourceSpec> parse_source_spec(std::string_view text) {
     spec.kind = SourceKind::kNeuronUdp;
   } else {
     return spec_error(text, "unknown source kind '" + std::string(kind) +
-                                "' (replay:FILE.bvh, neuron-tcp:HOST:PORT, neuron-udp:PORT, ws)");
+                                "' (replay:FILE.bvh, neuron-tcp:HOST:PORT, neuron-udp:PORT, ws, xr)");
   }
   // The query starts at the last '?' so a file name may hold one.
   const std::size_t question = rest.rfind('?');

@@ -320,6 +320,18 @@ struct LiveServer::Impl {
         }
         drain();
         return;
+      case ClientMessage::Type::kXrPose:
+        if (pose == nullptr) {
+          reject(id, "xr_pose messages are for the headset source (duet serve --source xr)");
+          return;
+        }
+        if (!pose->push_points(message.time_s, message.point_positions,
+                               message.point_orientations, SteadyClock::now(), pose_reason)) {
+          reject(id, pose_reason);
+          return;
+        }
+        drain();
+        return;
       case ClientMessage::Type::kReplay:
         control_replay(id);
         return;

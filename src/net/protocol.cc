@@ -275,6 +275,50 @@ std::string make_replay_state(const ReplayState& state) {
   return message.dump();
 }
 
+namespace {
+
+// {"type": "xr_pose", "time_s": T, "head": {"position": [x, y, z], "orientation": [w, x, y, z]},
+//  "left": {...}, "right": {...}}: a headset's and its controllers' poses (docs/protocol.md).
+std::optional<std::string> parse_xr_pose(const json& doc, ClientMessage& message) {
+  message.type = ClientMessage::Type::kXrPose;
+  message.time_s = std::nan("");
+  if (const auto time = doc.find("time_s"); time != doc.end()) {
+    if (!get_number(*time, message.time_s)) return "xr_pose: \"time_s\" must be a finite number";
+  }
+  constexpr std::array<const char*, 3> kPoints = {"head", "left", "right"};
+  for (std::size_t p = 0; p < kPoints.size(); ++p) {
+    const auto point = doc.find(kPoints[p]);
+    if (point == doc.end() || !point->is_object()) {
+      return fmt::format("xr_pose: needs \"{}\": {{\"position\": [x, y, z], \"orientation\": "
+                         "[w, x, y, z]}}",
+                         kPoints[p]);
+    }
+    const auto position = point->find("position");
+    const auto orientation = point->find("orientation");
+    if (position == point->end() || !position->is_array() || position->size() != 3 ||
+        orientation == point->end() || !orientation->is_array() || orientation->size() != 4) {
+      return fmt::format("xr_pose: \"{}\" needs \"position\": [x, y, z] and \"orientation\": "
+                         "[w, x, y, z]",
+                         kPoints[p]);
+    }
+    for (std::size_t k = 0; k < 3; ++k) {
+      double v = 0.0;
+      if (!get_number((*position)[k], v)) {
+        return fmt::format("xr_pose: \"{}\" position must hold finite numbers", kPoints[p]);
+      }
+      message.point_positions[p][static_cast<int>(k)] = v;
+    }
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (!get_number((*orientation)[k], message.point_orientations[p * 4 + k])) {
+        return fmt::format("xr_pose: \"{}\" orientation must hold finite numbers", kPoints[p]);
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::optional<std::string> parse_client_message(std::string_view text, ClientMessage& message) {
   if (text.size() > kMaxClientMessageBytes) return "message larger than 1 MiB";
   // Checked before parsing, so no message costs the loop's thread more than a fraction of a
@@ -351,6 +395,7 @@ std::optional<std::string> parse_client_message(std::string_view text, ClientMes
     }
     return std::nullopt;
   }
+  if (type == "xr_pose") return parse_xr_pose(doc, message);
   if (type == "replay") {
     message.type = ClientMessage::Type::kReplay;
     message.replay_paused.reset();
@@ -378,7 +423,7 @@ std::optional<std::string> parse_client_message(std::string_view text, ClientMes
     }
     return std::nullopt;
   }
-  return "unknown message type '" + type.substr(0, 64) + "' (set, role, reset, pose, replay)";
+  return "unknown message type '" + type.substr(0, 64) + "' (set, role, reset, pose, xr_pose, replay)";
 }
 
 }  // namespace duet::net

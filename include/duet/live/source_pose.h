@@ -27,6 +27,13 @@ class PoseSource final : public FrameSource {
   bool push(double time_s, const Vec3& root_position, std::span<const double> rotations_wxyz,
             SteadyClock::time_point arrival, std::string& reason) noexcept;
 
+  // Three points (the `xr_pose` message; the source's skeleton must be the head-and-hands one,
+  // duet/motion/head_hands.h): head, left and right hand positions in metres (within 1 km) and
+  // orientations, 4 numbers each (w, x, y, z). Same checks and queueing as push().
+  bool push_points(double time_s, std::span<const Vec3> positions,
+                   std::span<const double> orientations_wxyz, SteadyClock::time_point arrival,
+                   std::string& reason) noexcept;
+
   const SourceSkeleton& source_skeleton() const noexcept override { return skeleton_; }
   std::string describe() const override { return name_; }
   bool poll(SteadyClock::time_point now, SourceFrame& out) noexcept override;
@@ -39,6 +46,10 @@ class PoseSource final : public FrameSource {
   bool have_epoch_ = false;
   SteadyClock::time_point epoch_{};
   SourceStats stats_;
+
+  bool reject(const char* why, std::string& reason) noexcept;
+  // Stamps and queues the frame begun in `slot`.
+  void commit(SourceFrame& slot, double time_s, SteadyClock::time_point arrival) noexcept;
 };
 
 }  // namespace duet

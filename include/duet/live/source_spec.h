@@ -4,6 +4,8 @@
 //   neuron-tcp:[HOST:]PORT[?reference=0|1]             connect to Axis Neuron's BVH TCP server
 //   neuron-udp:[ADDR:]PORT[?reference=0|1]             receive Axis Neuron's BVH UDP broadcast
 //   ws[:SKELETON.bvh]                                  poses from WebSocket clients
+//   xr                                                 a VR headset and two controllers over
+//                                                      the WebSocket (the viewer's VR session)
 //
 // HOST defaults to 127.0.0.1; ADDR (the local address to bind) too. IPv6 addresses go in
 // brackets: neuron-tcp:[::1]:7001.
@@ -18,7 +20,7 @@
 
 namespace duet {
 
-enum class SourceKind { kReplay, kNeuronTcp, kNeuronUdp, kWebSocket };
+enum class SourceKind { kReplay, kNeuronTcp, kNeuronUdp, kWebSocket, kXr };
 const char* source_kind_name(SourceKind kind);
 
 struct SourceSpec {

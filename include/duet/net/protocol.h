@@ -3,6 +3,7 @@
 // few microseconds per frame); the rare messages use nlohmann::json.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -62,7 +63,7 @@ std::string make_replay_state(const ReplayState& state);
 
 // What a client asked for.
 struct ClientMessage {
-  enum class Type { kSet, kRole, kReset, kPose, kReplay };
+  enum class Type { kSet, kRole, kReset, kPose, kXrPose, kReplay };
   Type type = Type::kReset;
   // set
   std::string correction;
@@ -73,6 +74,9 @@ struct ClientMessage {
   double time_s = 0.0;  // NaN when absent
   Vec3 root = Vec3::Zero();
   std::vector<double> rotations;  // w, x, y, z per joint
+  // xr_pose: head, left hand, right hand; positions in metres, orientations w, x, y, z
+  std::array<Vec3, 3> point_positions{};
+  std::array<double, 12> point_orientations{};
   // replay: each absent field leaves that setting alone (at least one is present)
   std::optional<bool> replay_paused;
   std::optional<double> replay_seek_s;

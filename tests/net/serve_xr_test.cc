@@ -1,0 +1,137 @@
+// `duet serve --source xr` end to end (issue 12): a headset's and controllers' poses arrive as
+// `xr_pose` messages, the three-point follower follows them and the partner stands in front of
+// the user at life size. The performance is take 60_07 as three points with a headset's noise.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include "duet/eval/performance.h"
+#include "duet/io/motion_file.h"
+#include "duet/io/points_csv.h"
+#include "duet/motion/head_hands.h"
+#include "serve_support.h"
+
+namespace duet::test {
+namespace {
+
+std::vector<std::string> library_args() {
+  return {"--library", std::string(DUET_TESTDATA_DIR) + "/../../libraries/cmu-salsa.toml",
+          "--data-dir", DUET_DATA_DIR};
+}
+
+Json point(const Clip& clip, int frame, int joint) {
+  const Vec3& p = clip.translations_ls(frame)[static_cast<std::size_t>(joint)];
+  const Quat& q = clip.rotations_ls(frame)[static_cast<std::size_t>(joint)];
+  return {{"position", {p.x(), p.y(), p.z()}}, {"orientation", {q.w(), q.x(), q.y(), q.z()}}};
+}
+
+TEST(ServeXr, AHeadsetIsFollowedAndThePartnerStandsInFront) {
+  TempDir dir("duet-serve-xr-test");
+  ServeProcess server;
+  std::vector<std::string> args = library_args();
+  args.insert(args.end(), {"--source", "xr", "--no-record"});
+  ASSERT_TRUE(server.start(args, dir.path / "serve.log")) << server.log();
+
+  MotionLoadOptions load;
+  load.frame_rate = 60.0;
+  Result<LoadedMotion> motion = load_motion({salsa("60", "07")}, load);
+  ASSERT_TRUE(motion) << motion.error().message;
+  Performance performance;
+  performance.motion = motion.value().clip;
+  performance.roles = motion.value().roles;
+  Result<Performance> points = with_head_hands(std::move(performance), PointNoiseOptions{});
+  ASSERT_TRUE(points) << points.error().message;
+  const Clip& clip = points.value().motion;
+
+  WsClient dancer;
+  ASSERT_TRUE(dancer.connect(server.port()));
+  const std::optional<Json> hello = dancer.read_type("hello");
+  ASSERT_TRUE(hello);
+  EXPECT_EQ((*hello)["user_skeleton"]["joints"].size(), 4u);
+  EXPECT_EQ((*hello)["user_skeleton"]["roles"]["head"], kPointsHead);
+  const int hips = (*hello)["partner_skeleton"]["roles"]["hips"].get<int>();
+
+  const int poses = 600;  // 10 s
+  int on_take = 0;
+  std::vector<double> spacing;
+  std::vector<long long> latencies;
+  for (int f = 0; f < poses; ++f) {
+    const Json pose = {{"type", "xr_pose"},
+                       {"time_s", f / 60.0},
+                       {"head", point(clip, f, kPointsHead)},
+                       {"left", point(clip, f, kPointsLeftHand)},
+                       {"right", point(clip, f, kPointsRightHand)}};
+    ASSERT_TRUE(dancer.write(pose.dump()));
+    const std::optional<Json> frame = dancer.read_type("frame");
+    ASSERT_TRUE(frame) << server.log();
+    latencies.push_back((*frame)["latency_us"].get<long long>());
+    if (f < 60) continue;  // the first second settles
+    const Json& follower = (*frame)["follower"];
+    on_take += (follower["take"] == 6 &&
+                std::abs(follower["template_frame"].get<int>() - f) <= 6)
+                   ? 1
+                   : 0;
+    // The user's head comes back where it was sent; the partner's hips stand a partner's
+    // distance away on the floor plane.
+    const Json& head = (*frame)["user"]["positions"][kPointsHead];
+    const Json& partner = (*frame)["partner"]["positions"][hips];
+    EXPECT_NEAR(head[1].get<double>(), clip.translations_ls(f)[kPointsHead].y(), 1e-3);
+    spacing.push_back(std::hypot(partner[0].get<double>() - head[0].get<double>(),
+                                 partner[2].get<double>() - head[2].get<double>()));
+  }
+  EXPECT_GE(on_take, (poses - 60) * 95 / 100) << server.log();
+  std::ranges::sort(spacing);
+  // Salsa partners stand 0.3-1.2 m apart; a partner placed from a wrong body heading would be
+  // metres off or inside the user.
+  EXPECT_GT(spacing[spacing.size() / 2], 0.3);
+  EXPECT_LT(spacing[spacing.size() / 2], 1.2);
+  std::ranges::sort(latencies);
+  std::printf("xr_pose -> frame latency: p50 %lld us, p99 %lld us\n",
+              latencies[latencies.size() / 2], latencies[latencies.size() * 99 / 100]);
+
+  // A full-body pose is refused by the headset source, and the next xr_pose is accepted.
+  ASSERT_TRUE(dancer.write(R"({"type": "pose", "root": [0, 1, 0], "rotations": []})"));
+  ASSERT_TRUE(dancer.read_type("error"));
+  ASSERT_TRUE(dancer.write(R"({"type": "xr_pose", "head": {"position": [0, 1.6, 0]}})"));
+  ASSERT_TRUE(dancer.read_type("error"));
+  ASSERT_EQ(server.stop(SIGTERM), 0) << server.log();
+}
+
+TEST(ServeXr, ReplaysAThreePointRecording) {
+  TempDir dir("duet-serve-xr-replay-test");
+  MotionLoadOptions load;
+  load.frame_rate = 60.0;
+  Result<LoadedMotion> motion = load_motion({salsa("60", "07")}, load);
+  ASSERT_TRUE(motion);
+  Result<Clip> points = head_hands_clip(motion.value().clip, motion.value().roles);
+  ASSERT_TRUE(points);
+  Clip short_clip(points.value().skeleton_ptr(), 60.0, 240);
+  for (int f = 0; f < 240; ++f) {
+    std::ranges::copy(points.value().translations_ls(f), short_clip.translations_ls(f).begin());
+    std::ranges::copy(points.value().rotations_ls(f), short_clip.rotations_ls(f).begin());
+  }
+  const fs::path csv = dir.path / "07.csv";
+  {
+    std::ofstream out(csv);
+    out << format_points_csv(short_clip);
+  }
+  ServeProcess server;
+  std::vector<std::string> args = library_args();
+  args.insert(args.end(), {"--source", "replay:" + csv.string() + "?speed=4", "--no-record",
+                           "--exit-at-end"});
+  ASSERT_TRUE(server.start(args, dir.path / "serve.log")) << server.log();
+  WsClient viewer;
+  ASSERT_TRUE(viewer.connect(server.port()));
+  ASSERT_TRUE(viewer.read_type("hello"));
+  std::optional<Json> last;
+  for (std::optional<Json> frame; (frame = viewer.read_type("frame"));) last = frame;
+  ASSERT_TRUE(last) << server.log();
+  EXPECT_EQ((*last)["follower"]["take"], 6) << server.log();
+  EXPECT_NEAR((*last)["follower"]["template_frame"].get<int>(), 239, 6);
+  EXPECT_EQ(server.wait_exit(), 0) << server.log();
+}
+
+}  // namespace
+}  // namespace duet::test
