@@ -254,12 +254,16 @@ int run_eval(EvalArgs& args) {
     return kExitFailure;
   }
   options.cases = cases_on_rigs(options.cases, rigs.value());
-  // Three points: every case's performance is delivered as a headset's head and hands.
+  // Three points: every case's performance is delivered as a headset's head and hands with the
+  // headset's tracking noise. A suit's per-joint noise is no headset's: the noisy cases get twice
+  // the point noise instead.
   if (features.input_points == InputPoints::kHeadHands) {
     for (EvalCase& eval_case : options.cases) {
+      const double factor = eval_case.recipe.noise.active() ? 2.0 : 1.0;
+      eval_case.recipe.noise = SensorNoiseOptions{};
       eval_case.recipe.head_hands = true;
-      eval_case.recipe.point_noise.position_m = args.point_noise_mm / 1000.0;
-      eval_case.recipe.point_noise.rotation_deg = args.point_noise_deg;
+      eval_case.recipe.point_noise.position_m = factor * args.point_noise_mm / 1000.0;
+      eval_case.recipe.point_noise.rotation_deg = factor * args.point_noise_deg;
     }
   }
 
@@ -335,8 +339,9 @@ Command register_eval(CLI::App& app) {
       ->delimiter(',');
   app.add_option("--input-points", args->input_points,
                  "full, or head,hands: deliver every case as three points (a headset and two "
-                 "controllers, with --point-noise-mm and --point-noise-deg of tracking noise) and "
-                 "follow with the three-point follower")
+                 "controllers, with --point-noise-mm and --point-noise-deg of tracking noise, "
+                 "twice that on the noisy cases instead of their per-joint noise) and follow with "
+                 "the three-point follower")
       ->check(CLI::IsMember({"full", "head,hands"}));
   app.add_option("--point-noise-mm", args->point_noise_mm,
                  "Three points: position noise per axis of each point, mm (default 5)")

@@ -193,7 +193,7 @@ FeatureExtractor::Context::Sample FeatureExtractor::extract_head_hands(
   put(to_heading * (now.effectors[0] - head) * per_height);
   put(to_heading * (now.effectors[1] - head) * per_height);
   out[d++] = static_cast<float>(head.y() * per_height);
-  put(to_heading * (head_canonical * Vec3::UnitY()));  // the head's tilt: nod and roll
+  if (spec_.head_tilt) put(to_heading * (head_canonical * Vec3::UnitY()));  // nod and roll
 
   Vec3 head_velocity_heading = Vec3::Zero();
   double yaw_rate = 0.0;

@@ -77,11 +77,11 @@ struct FeatureSpec {
   double speed_std_floor = 0.05;
   double yaw_rate_std_floor_radps = 0.2;
 
-  // Head and hands: both hands relative to the head (6), the head's height (1) and its up
-  // direction (3), all in the head's heading frame.
-  static constexpr int kHeadHandsPostureDims = 10;
+  // Head and hands: both hands relative to the head (6), the head's height (1) and, with
+  // head_tilt, its up direction (3), all in the head's heading frame.
+  bool head_tilt = false;
   int posture_dims() const {
-    if (input_points == InputPoints::kHeadHands) return kHeadHandsPostureDims;
+    if (input_points == InputPoints::kHeadHands) return head_tilt ? 10 : 7;
     return 3 * static_cast<int>(posture_segments.size() + posture_points.size());
   }
   // Forward, lateral and vertical velocity of the root (the pelvis centre, or the head) and the
