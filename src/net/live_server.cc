@@ -92,7 +92,7 @@ struct LiveServer::Impl {
     pose = dynamic_cast<PoseSource*>(source.get());
     replay = dynamic_cast<ReplaySource*>(source.get());
     frame.resize(source->source_skeleton().joint_count());
-    hello = std::make_shared<const std::string>(make_hello(*loop, source->describe()));
+    hello = std::make_shared<const std::string>(make_hello(*loop, source->describe(), source_kind_name(spec.kind)));
     initial_params = loop->params();
     wanted_role = loop->role();
   }
@@ -410,7 +410,8 @@ struct LiveServer::Impl {
       }
       if (loaded->loop) {
         loaded->hello = std::make_shared<const std::string>(
-            make_hello(*loaded->loop.value(), source_description));
+            make_hello(*loaded->loop.value(), source_description,
+                       source_kind_name(spec.kind)));
         if (!stem.empty()) {
           Result<std::unique_ptr<SessionRecorder>> r =
               open_recording(directory, stem, user, *loaded->loop.value());

@@ -162,7 +162,8 @@ bool get_number(const json& value, double& out) {
 
 }  // namespace
 
-std::string make_hello(const LiveLoop& loop, const std::string& source_description) {
+std::string make_hello(const LiveLoop& loop, const std::string& source_description,
+                       std::string_view source_kind) {
   const DuetLibrary& library = loop.library();
   json takes = json::array();
   for (std::size_t t = 0; t < library.takes().size(); ++t) {
@@ -192,6 +193,7 @@ std::string make_hello(const LiveLoop& loop, const std::string& source_descripti
       {"takes", std::move(takes)},
       {"corrections", corrections_json(loop.params())},
       {"source", source_description},
+      {"source_kind", source_kind},
   };
   return hello.dump(-1, ' ', false, json::error_handler_t::replace);
 }

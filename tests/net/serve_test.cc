@@ -73,6 +73,7 @@ TEST(Serve, ServesFramesSurvivesBadClientsAndRecordsEverything) {
   EXPECT_EQ((*hello)["type"], "hello");
   EXPECT_EQ((*hello)["version"], 1);
   EXPECT_EQ((*hello)["role"], "leader");
+  EXPECT_EQ((*hello)["source_kind"], "replay");
   EXPECT_DOUBLE_EQ((*hello)["fps"].get<double>(), 60.0);
   const std::size_t user_joints = (*hello)["user_skeleton"]["joints"].size();
   const std::size_t partner_joints = (*hello)["partner_skeleton"]["joints"].size();

@@ -49,6 +49,7 @@ TEST(ServeXr, AHeadsetIsFollowedAndThePartnerStandsInFront) {
   ASSERT_TRUE(dancer.connect(server.port()));
   const std::optional<Json> hello = dancer.read_type("hello");
   ASSERT_TRUE(hello);
+  EXPECT_EQ((*hello)["source_kind"], "xr");  // the viewer sends xr_pose on this
   EXPECT_EQ((*hello)["user_skeleton"]["joints"].size(), 4u);
   EXPECT_EQ((*hello)["user_skeleton"]["roles"]["head"], kPointsHead);
   const int hips = (*hello)["partner_skeleton"]["roles"]["hips"].get<int>();

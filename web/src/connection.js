@@ -43,6 +43,11 @@ export class Connection {
     return true;
   }
 
+  /** Bytes sent but not yet on the wire (0 while disconnected): how far the link is behind. */
+  get bufferedAmount() {
+    return this.socket_?.bufferedAmount ?? 0;
+  }
+
   open_() {
     this.timer_ = null;
     let socket;

@@ -7,7 +7,8 @@ export const kRoleColors = { leader: 0x2f6fff, partner: 0xff4fa3 };
 const kBoneRadius_m = 0.028;
 const kJointRadius_m = 0.04;
 const kHeadRadius_m = 0.1;
-const kMinBoneLength_m = 1e-3; // zero-length bones (coincident joints) get no cylinder
+const kMinBoneLength_m = 1e-3;
+const kHandMarker_m = [0.05, 0.04, 0.12]; // width, height, length of a controller-like hand // zero-length bones (coincident joints) get no cylinder
 
 // Joint names per role in the conventions of docs/skeleton-maps.md (daz, cmu-bvh, cmu-asf),
 // plus common spellings of other rigs; matched case-insensitively.
@@ -35,7 +36,8 @@ const kUp = new THREE.Vector3(0, 1, 0);
 const kBoneAxis = new THREE.Vector3(0, 1, 0); // the unit cylinder spans y in [0, 1]
 
 /**
- * One dancer: a sphere per joint, a cylinder per bone (joint -> parent), a bigger head.
+ * One dancer: a sphere per joint, a cylinder per bone (joint -> parent), a bigger head; or, for
+ * a head-and-hands skeleton (a headset user), a head sphere and two hand blocks only.
  * Owns its meshes under `this.group`; `dispose()` frees them.
  */
 export class StickFigure {
@@ -52,23 +54,41 @@ export class StickFigure {
     }));
     this.group = new THREE.Group();
     this.material = new THREE.MeshStandardMaterial({ color, roughness: 0.55, metalness: 0.05 });
+    // Roles by joint name first (as before), then the server's `roles` for what names missed.
+    const given = skeleton?.roles && typeof skeleton.roles === 'object' ? skeleton.roles : {};
+    const index = (i) => (Number.isInteger(i) && i >= 0 && i < this.joints.length ? i : -1);
     this.roles = {};
-    for (const role of Object.keys(kRoleNames)) this.roles[role] = findRoleJoint(this.joints, role);
+    for (const role of Object.keys(kRoleNames)) {
+      const found = findRoleJoint(this.joints, role);
+      this.roles[role] = found >= 0 ? found : index(given[role]);
+    }
+    this.roles.hips = index(given.hips);
+    /** A head and two hands only (a VR headset and its controllers): no bones are drawn. */
+    this.pointsOnly = this.roles.head >= 0 && this.roles.left_wrist >= 0 &&
+      this.roles.right_wrist >= 0 && this.roles.hips < 0 && this.roles.left_hip < 0;
 
     const joint_geo = new THREE.SphereGeometry(kJointRadius_m, 12, 8);
     const head_geo = new THREE.SphereGeometry(kHeadRadius_m, 20, 14);
     const bone_geo = new THREE.CylinderGeometry(kBoneRadius_m, kBoneRadius_m, 1, 10, 1);
     bone_geo.translate(0, 0.5, 0);
-    this.geometries_ = [joint_geo, head_geo, bone_geo];
+    // A hand of a points-only figure: a controller-sized block, long along its -Z (pointing).
+    const hand_geo = new THREE.BoxGeometry(kHandMarker_m[0], kHandMarker_m[1], kHandMarker_m[2]);
+    this.geometries_ = [joint_geo, head_geo, bone_geo, hand_geo];
 
+    const hands = [this.roles.left_wrist, this.roles.right_wrist];
+    // Which joints are drawn at all: every one, or for a points-only figure the head and hands.
+    this.shown_ = this.joints.map((_, i) => !this.pointsOnly || i === this.roles.head || hands.includes(i));
     this.jointMeshes = this.joints.map((_, i) => {
-      const mesh = new THREE.Mesh(i === this.roles.head ? head_geo : joint_geo, this.material);
+      let geo = joint_geo;
+      if (i === this.roles.head) geo = head_geo;
+      else if (this.pointsOnly && hands.includes(i)) geo = hand_geo;
+      const mesh = new THREE.Mesh(geo, this.material);
       mesh.visible = false; // until the first frame places it
       this.group.add(mesh);
       return mesh;
     });
     this.boneMeshes = this.joints.map((j) => {
-      if (j.parent < 0 || j.parent >= this.joints.length) return null;
+      if (this.pointsOnly || j.parent < 0 || j.parent >= this.joints.length) return null;
       const mesh = new THREE.Mesh(bone_geo, this.material);
       mesh.visible = false;
       this.group.add(mesh);
@@ -111,7 +131,7 @@ export class StickFigure {
       const joint = this.jointMeshes[i];
       joint.position.copy(this.positions_ws[i]);
       joint.quaternion.copy(this.rotations_ws[i]);
-      joint.visible = !(this.headHidden_ && i === this.roles.head);
+      joint.visible = this.shown_[i] && !(this.headHidden_ && i === this.roles.head);
       const bone = this.boneMeshes[i];
       if (!bone) continue;
       const from = this.positions_ws[this.joints[i].parent];
@@ -144,9 +164,17 @@ export class StickFigure {
 
   /**
    * Horizontal unit vector the dancer faces: up x (right - left) over hips and shoulders,
-   * falling back to the head joint's +Z when the skeleton has no named sides.
+   * falling back to the head joint's +Z when the skeleton has no named sides; a points-only
+   * figure faces where its headset looks.
    */
   facing(out = new THREE.Vector3()) {
+    if (this.pointsOnly) {
+      // A headset's orientation looks along its -Z (WebXR's convention, docs/protocol.md).
+      out.set(0, 0, -1).applyQuaternion(this.rotations_ws[this.roles.head]);
+      out.y = 0;
+      if (out.lengthSq() < 1e-8) out.set(0, 0, -1);
+      return out.normalize();
+    }
     const side = new THREE.Vector3();
     const r = this.roles;
     for (const [left, right] of [

@@ -9,6 +9,7 @@ import { Connection, defaultSocketUrl } from './connection.js';
 import { StickFigure, kRoleColors } from './dancers.js';
 import { Timeline } from './timeline.js';
 import { VRSession, installXREmulator, placeRigAtHead } from './xr.js';
+import { XRPoseSender } from './xr_pose.js';
 
 const kCorrections = ['align', 'contact', 'smooth', 'footlock', 'blend'];
 const kPendingToggle_s = 1.5; // how long a clicked switch waits for the server to confirm it
@@ -302,6 +303,10 @@ async function main() {
     },
     onBadMessage: (_text, reason) => showError(`bad message: ${reason}`),
   });
+  // In VR on a headset-source server, the headset and controllers are the user's input.
+  const xr_sender = new XRPoseSender(connection);
+  let xr_frame_hook = null; // test hook: (time_ms, message sent or null) after each XR frame
+  const headsetIsSource = () => state.hello?.source_kind === 'xr';
 
   // --- Controls ----------------------------------------------------------------------------
   for (const name of kCorrections) {
@@ -392,6 +397,7 @@ async function main() {
   let mode_before_vr = 'orbit';
   const vr = new VRSession(renderer, ui.vr, {
     onStart: () => {
+      xr_sender.reset();
       mode_before_vr = state.cameraMode;
       setCameraMode('vr');
     },
@@ -472,7 +478,14 @@ async function main() {
   function updateCamera(dt_s) {
     const user = state.user;
     if (state.cameraMode === 'vr') {
-      if (user?.posed) placeRigAtHead(rig, user.headPosition(tmp.head), user.facing(tmp.facing));
+      if (headsetIsSource()) {
+        // The room is the world: the server places the partner in the headset's own
+        // 'local-floor' space, in metres, so the rig stays at the origin.
+        rig.position.set(0, 0, 0);
+        rig.quaternion.identity();
+      } else if (user?.posed) {
+        placeRigAtHead(rig, user.headPosition(tmp.head), user.facing(tmp.facing));
+      }
       return;
     }
     if (state.cameraMode === 'first-person') {
@@ -514,7 +527,11 @@ async function main() {
   }
 
   let last_ms = performance.now();
-  renderer.setAnimationLoop(() => {
+  renderer.setAnimationLoop((time_ms, xr_frame) => {
+    if (xr_frame && headsetIsSource() && renderer.xr.isPresenting) {
+      const sent = xr_sender.send(time_ms, xr_frame, renderer.xr.getReferenceSpace());
+      xr_frame_hook?.(time_ms, sent);
+    }
     const now = performance.now();
     const dt_s = Math.min(0.1, (now - last_ms) / 1000);
     last_ms = now;
@@ -563,6 +580,39 @@ async function main() {
     get seqGaps() { return state.seqGaps; },
     get cameraMode() { return state.cameraMode; },
     get xrEmulated() { return xr_device !== null; },
+    /** The emulated headset (iwer's XRDevice) with `?xr-emulate=1`, else null. */
+    get xrDevice() { return xr_device; },
+    /** xr_pose messages sent and skipped (socket behind) in VR on a headset source. */
+    get xrPoses() { return { sent: xr_sender.sent, skipped: xr_sender.skipped }; },
+    /** Calls `fn(time_ms, sent)` after each XR frame on a headset source (null: stop). */
+    setXRFrameHook(fn) { xr_frame_hook = typeof fn === 'function' ? fn : null; },
+    /** In VR, the partner as the headset's left eye sees it: its hips in normalized device
+     *  coordinates, the hips' floor distance from the eye, the partner's head height, how
+     *  squarely it faces the eye (cosine), and which of the user's points are drawn. Null outside VR or before a frame. */
+    xrView() {
+      if (!renderer.xr.isPresenting || !state.partner?.posed) return null;
+      const eye = renderer.xr.getCamera().cameras[0];
+      if (!eye) return null;
+      const hips = state.partner.positions_ws[Math.max(0, state.partner.roles.hips)].clone();
+      const eye_ws = eye.getWorldPosition(new THREE.Vector3());
+      const distance = Math.hypot(hips.x - eye_ws.x, hips.z - eye_ws.z);
+      // Cosine between where the partner faces and the way to the eye, on the floor.
+      const to_eye = new THREE.Vector3(eye_ws.x - hips.x, 0, eye_ws.z - hips.z).normalize();
+      const faces = state.partner.facing(new THREE.Vector3()).dot(to_eye);
+      const ndc = hips.project(eye);
+      const head = state.user?.roles.head ?? -1;
+      const drawn = (joint) => joint >= 0 && !!state.user?.jointMeshes[joint].visible;
+      return {
+        hips_ndc: ndc.toArray(),
+        hips_distance_m: distance,
+        partner_head_height_m: state.partner.headPosition().y,
+        partner_faces_eye_cos: faces,
+        eye_ws: eye_ws.toArray(),
+        user_head_drawn: drawn(head),
+        user_hands_drawn: drawn(state.user?.roles.left_wrist ?? -1) && drawn(state.user?.roles.right_wrist ?? -1),
+        user_points_only: !!state.user?.pointsOnly,
+      };
+    },
     /** CSS colours of the figures now: {user, partner}. */
     get colors() {
       return { user: '#' + state.user?.material.color.getHexString(), partner: '#' + state.partner?.material.color.getHexString() };

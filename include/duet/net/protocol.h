@@ -29,8 +29,10 @@ constexpr int kMaxJsonDepth = 16;
 constexpr std::size_t kMaxJsonValues = 16384;
 
 // `hello`: skeletons (joints, parents, offsets, roles), takes with their contact intervals, the
-// role, the template frame rate and the corrections.
-std::string make_hello(const LiveLoop& loop, const std::string& source_description);
+// role, the template frame rate, the corrections, and the source: its description for people and
+// its kind ("replay", "ws", "xr", ...) for clients (the viewer sends headset poses for "xr").
+std::string make_hello(const LiveLoop& loop, const std::string& source_description,
+                       std::string_view source_kind);
 
 // `frame`: appends to `text` after clearing it. `seq` >= 0 replaces output.seq (the server counts
 // frames across role switches, which change the loop).
