@@ -87,17 +87,10 @@ Result<LiveLoop> LiveLoop::create(std::shared_ptr<const DuetLibrary> library,
   }
   LiveLoop loop(std::move(library), user, std::move(session).value(), std::move(models), params);
   loop.head_hands_bodies_ = std::move(head_hands_bodies);
-  loop.head_correction_ = head_hands_device_correction();
-  loop.set_params(params);
+  loop.device_correction_ = head_hands_device_correction();
   return loop;
 }
 
-void LiveLoop::set_params(const PartnerParams& params) noexcept {
-  params_ = params;
-  // A controller's orientation says nothing of how the captured grip was turned: the partner's
-  // wrist goes to the controller itself.
-  if (!head_hands_bodies_.empty()) params_.ik_target = IkTarget::kUserWrist;
-}
 
 void LiveLoop::place_head_hands_user(int take, int frame) noexcept {
   const auto head = static_cast<std::size_t>(user_.roles[Role::kHead]);
@@ -110,11 +103,20 @@ void LiveLoop::place_head_hands_user(int take, int frame) noexcept {
                                 ? head_height_max_m_ / body.template_head_height_m()
                                 : 1.0;
   const Transform head_frame =
-      head_heading_frame(head_position, out_.user_rotations_ws[head] * head_correction_);
+      head_heading_frame(head_position, out_.user_rotations_ws[head] * device_correction_);
   user_pose_.body_heading = body.body_heading(head_frame, frame, size_ratio);
   user_pose_.body_heading_valid = user_pose_.body_heading.translation.allFinite() &&
                                   user_pose_.body_heading.rotation.coeffs().allFinite();
   user_pose_.height_m = model.template_height_m() * size_ratio;
+  // The controllers' orientations as the template's wrists would be turned, so the contact IK
+  // carries the captured grip offset (IkTarget::kCapturedOffset) in the right frame.
+  for (const Side side : {Side::kLeft, Side::kRight}) {
+    const auto s = static_cast<std::size_t>(side);
+    const auto joint = static_cast<std::size_t>(
+        user_.roles[side == Side::kLeft ? Role::kLeftWrist : Role::kRightWrist]);
+    user_pose_.wrist_rotations_ws[s] =
+        body.template_rotation(out_.user_rotations_ws[joint] * device_correction_);
+  }
 }
 
 LiveLoop::LiveLoop(std::shared_ptr<const DuetLibrary> library, const SourceSkeleton& user,

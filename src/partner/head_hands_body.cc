@@ -26,6 +26,7 @@ Result<HeadHandsBody> HeadHandsBody::build(const Clip& template_clip,
   Result<Quat> correction = rest_pose_correction(template_clip.skeleton(), template_roles);
   if (!correction) return Error{"the template: " + correction.error().message};
   HeadHandsBody body;
+  body.template_correction_ = correction.value();
   body.head_in_body_.resize(static_cast<std::size_t>(template_clip.frame_count()));
   const auto n = static_cast<std::size_t>(template_clip.joint_count());
   std::vector<Vec3> positions(n);

@@ -71,7 +71,7 @@ class LiveLoop {
   void reset() noexcept;
   // Switch a correction (protocol name); false for an unknown name.
   bool set_correction(std::string_view name, bool enabled) noexcept;
-  void set_params(const PartnerParams& params) noexcept;
+  void set_params(const PartnerParams& params) noexcept { params_ = params; }
   const PartnerParams& params() const noexcept { return params_; }
 
   const DuetLibrary& library() const noexcept { return *library_; }
@@ -102,7 +102,7 @@ class LiveLoop {
   double user_height_m_ = 0.0;  // measure_body of the user's skeleton: fits the partner's spacing
   // Three-point users (head and hands only): one HeadHandsBody per take; empty for a full body.
   std::vector<HeadHandsBody> head_hands_bodies_;
-  Quat head_correction_ = Quat::Identity();  // the head's device rotation -> canonical
+  Quat device_correction_ = Quat::Identity();  // a point's device rotation -> canonical
   double head_height_max_m_ = 0.0;           // the highest the user's head has been
   ResponsePlayhead playhead_;
   Pose shown_pose_;  // the response sampled at the playhead

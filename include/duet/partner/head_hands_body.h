@@ -28,6 +28,12 @@ class HeadHandsBody {
   int frame_count() const noexcept { return static_cast<int>(head_in_body_.size()); }
   // The highest the template's head was (metres): the size the user's head height is compared to.
   double template_head_height_m() const noexcept { return template_head_height_m_; }
+  // A point's world rotation on the template's rig from its canonical rotation: what the
+  // template's wrist would have been turned to (R_world = R_canonical * correction^-1), so the
+  // captured grip offset, carried in the template wrist's frame, can be carried by a controller.
+  Quat template_rotation(const Quat& canonical_ws) const noexcept {
+    return (canonical_ws * template_correction_.conjugate()).normalized();
+  }
 
   // The user's body heading frame from their head's heading frame at template frame `frame`
   // (clamped to the take), for a user `size_ratio` times the template's size.
@@ -37,6 +43,7 @@ class HeadHandsBody {
  private:
   std::vector<Transform> head_in_body_;
   double template_head_height_m_ = 0.0;
+  Quat template_correction_ = Quat::Identity();  // rest_pose_correction of the template's rig
 };
 
 }  // namespace duet
