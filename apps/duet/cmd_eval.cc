@@ -42,7 +42,7 @@ struct EvalArgs {
   std::optional<int> jump_tolerance;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
       pause_distance, lost_distance, velocity_cap, pause_noise_factor, lost_residual,
-      lost_noise_factor;
+      lost_noise_factor, lost_residual_factor;
   std::optional<double> tempo_time_constant;
   bool fixed_band = false;
   std::optional<int> dtw_back, dtw_ahead;
@@ -192,6 +192,7 @@ int run_eval(EvalArgs& args) {
   if (args.pause_noise_factor) hmm.pause_noise_factor = *args.pause_noise_factor;
   if (args.lost_residual) hmm.lost_residual_per_dim = *args.lost_residual;
   if (args.lost_noise_factor) hmm.lost_noise_factor = *args.lost_noise_factor;
+  if (args.lost_residual_factor) hmm.lost_residual_factor = *args.lost_residual_factor;
   if (args.tempo_time_constant) hmm.tempo_time_constant_s = *args.tempo_time_constant;
   if (args.fixed_band) hmm.tempo_adaptive = false;
   if (args.jump_hold) hmm.jump_hold_s = *args.jump_hold;
@@ -274,14 +275,15 @@ int run_eval(EvalArgs& args) {
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
       "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {}\n"
-      "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {}\n\n",
+      "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
+      "lost_residual_factor {}\n\n",
       library->takes().size(), library->model().num_states(), library->frame_rate(),
       args.library.role, takes, options.seed, hmm.self_prob, hmm.next_prob, hmm.skip_prob,
       hmm.leave_prob, hmm.pause_stay_prob, hmm.emission_sigma, hmm.pause_distance_per_dim,
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
       hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.pause_noise_factor,
-      hmm.lost_residual_per_dim, hmm.lost_noise_factor);
+      hmm.lost_residual_per_dim, hmm.lost_noise_factor, hmm.lost_residual_factor);
   fmt::print("{}", format_eval_table(report.value()));
   std::fflush(stdout);
 
@@ -400,6 +402,11 @@ Command register_eval(CLI::App& app) {
       ->add_option("--lost-noise-factor", args->lost_noise_factor,
                    "lost_noise_factor: what the estimated sensor noise adds to the HMM's lost "
                    "distance, per unit of noise (all HMM variants)")
+      ->check(non_negative_check());
+  tuning
+      ->add_option("--lost-residual-factor", args->lost_residual_factor,
+                   "lost_residual_factor: the HMM's lost distance is at least this times the "
+                   "average best distance of the frames it plainly follows (all HMM variants)")
       ->check(non_negative_check());
   tuning
       ->add_option("--pause-noise-factor", args->pause_noise_factor,

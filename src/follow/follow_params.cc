@@ -76,7 +76,8 @@ Status FollowParams::validate(int num_states) const {
     const char* name;
     float value;
   } noise_levels[] = {{"pause_noise_factor", pause_noise_factor},
-                      {"lost_noise_factor", lost_noise_factor}};
+                      {"lost_noise_factor", lost_noise_factor},
+                      {"lost_residual_factor", lost_residual_factor}};
   for (const auto& level : noise_levels) {
     if (!(level.value >= 0.0f && std::isfinite(level.value))) {
       return params_error(std::string(level.name) + " must be finite and >= 0, got " +

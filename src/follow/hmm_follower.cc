@@ -35,6 +35,7 @@ void ForwardContext::reset() noexcept {
   tempo_.reset();
   jump_gate_.reset();
   sensor_noise_.reset();
+  explained_residual_.reset();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -211,7 +212,8 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
     // the fixed ceiling: taught only by frames within the noise-scaled level, the tempo lagged
     // on clean input at 1.4x (100% -> 98.8% within 100 ms).
     result.lost = best > noise_levels_.lost_ceiling_sq();
-    unexplained = best > noise_levels_.lost_distance_sq(noise);
+    unexplained =
+        best > noise_levels_.lost_distance_sq(noise, context.explained_residual_.level());
   } else {
     // No evidence: the transitions conserve mass; renormalise only to stop float drift.
     follow_detail::normalise(context.alpha_.data(), num_states + 1, num_states);
@@ -238,6 +240,8 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   ++context.frames_;
   context.previous_state_ = result.state;
   context.previous_lost_ = result.lost;
+  context.explained_residual_.update(result.best_distance_per_dim,
+                                     !result.missing && !result.in_pause && !result.jumped, dt_s);
   result.lost = result.lost || unexplained;
   return result;
 }

@@ -16,7 +16,8 @@ NoiseScaledLevels::NoiseScaledLevels(const FollowParams& params, int num_dims,
       pause_noise_factor_(params.pause_noise_factor),
       lost_ceiling_per_dim_(params.lost_distance_per_dim),
       lost_residual_per_dim_(params.lost_residual_per_dim),
-      lost_noise_factor_(params.lost_noise_factor) {}
+      lost_noise_factor_(params.lost_noise_factor),
+      lost_residual_factor_(params.lost_residual_factor) {}
 
 float NoiseScaledLevels::log_pause_emission(float noise) const noexcept {
   const double n = std::isfinite(noise) ? std::max(0.0, double{noise}) : 0.0;
@@ -25,11 +26,13 @@ float NoiseScaledLevels::log_pause_emission(float noise) const noexcept {
       std::max(-per_dim * dims_ * inv_two_sigma_sq_, double{follow_detail::kMinLogEmission}));
 }
 
-float NoiseScaledLevels::lost_distance_sq(float noise) const noexcept {
+float NoiseScaledLevels::lost_distance_sq(float noise, float residual) const noexcept {
   const double n = std::isfinite(noise) ? std::max(0.0, double{noise}) : 0.0;
+  const double r = std::isfinite(residual) ? std::max(0.0, double{residual}) : 0.0;
   // +inf residual (the paper's preset) leaves the fixed ceiling alone.
   const double per_dim =
-      std::min(lost_ceiling_per_dim_, lost_residual_per_dim_ + lost_noise_factor_ * n);
+      std::min(lost_ceiling_per_dim_, std::max(lost_residual_per_dim_ + lost_noise_factor_ * n,
+                                               lost_residual_factor_ * r));
   return static_cast<float>(std::min(per_dim * dims_, double{FLT_MAX}));
 }
 

@@ -85,11 +85,15 @@ struct FollowParams {
   //    (0.0011 at most on the 14 cases) plus what the sensor's noise adds (the best distance is
   //    about 0.8 x the noise estimate, 2.8 x at its 99.5th percentile). A clean walk, a wave or
   //    another dance stays far above it. Measured in docs/follower.md.
+  //  - takes the larger of that and lost_residual_factor times the average best distance of the
+  //    frames it plainly follows (explained_residual.h): another rig leaves a residual of its own
+  //    (on the CMU handshake rig up to 4% of the followed frames were lost without it).
   // lost_residual_per_dim = +inf and pause_noise_factor = 0 give the fixed levels (paper).
   double sensor_noise_time_constant_s = 1.0;
   float pause_noise_factor = 3.0f;
   float lost_residual_per_dim = 0.0015f;
   float lost_noise_factor = 3.5f;
+  float lost_residual_factor = 5.0f;
 
   // Confidence: posterior mass within +/- this many template frames of the estimate (same take),
   // mapped to the probability of being within 100 ms (confidence_calibration.h) when

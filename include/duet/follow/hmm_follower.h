@@ -16,6 +16,7 @@
 
 #include "duet/base/result.h"
 #include "duet/follow/follow_params.h"
+#include "duet/follow/explained_residual.h"
 #include "duet/follow/jump_gate.h"
 #include "duet/follow/noise_scaled_levels.h"
 #include "duet/follow/sensor_noise.h"
@@ -65,6 +66,7 @@ class ForwardContext {
   TempoEstimator tempo_;
   JumpGate jump_gate_;
   SensorNoiseEstimator sensor_noise_;
+  ExplainedResidual explained_residual_;
 };
 
 class HmmForward {

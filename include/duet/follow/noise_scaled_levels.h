@@ -15,8 +15,10 @@ class NoiseScaledLevels {
   // log b_N: the flat emission of a frame at pause_distance_per_dim + pause_noise_factor * noise
   // per dimension. noise: SensorNoiseEstimator::variance_per_dim().
   float log_pause_emission(float noise) const noexcept;
-  // Squared distance (over all D dimensions) beyond which no template frame explains the input.
-  float lost_distance_sq(float noise) const noexcept;
+  // Squared distance (over all D dimensions) beyond which no template frame explains the input:
+  // the larger of lost_residual_per_dim + lost_noise_factor * noise and lost_residual_factor *
+  // residual (ExplainedResidual::level()), at most lost_distance_per_dim.
+  float lost_distance_sq(float noise, float residual = 0.0f) const noexcept;
   // lost_distance_per_dim over all D dimensions: the fixed ceiling.
   float lost_ceiling_sq() const noexcept;
 
@@ -28,6 +30,7 @@ class NoiseScaledLevels {
   double lost_ceiling_per_dim_ = 0.0;
   double lost_residual_per_dim_ = 0.0;
   double lost_noise_factor_ = 0.0;
+  double lost_residual_factor_ = 0.0;
 };
 
 }  // namespace duet
