@@ -76,6 +76,7 @@ Status FollowParams::validate(int num_states) const {
     const char* name;
     float value;
   } noise_levels[] = {{"pause_noise_factor", pause_noise_factor},
+                      {"pause_noise_allowance", pause_noise_allowance},
                       {"lost_noise_factor", lost_noise_factor},
                       {"lost_residual_factor", lost_residual_factor}};
   for (const auto& level : noise_levels) {

@@ -14,6 +14,7 @@ NoiseScaledLevels::NoiseScaledLevels(const FollowParams& params, int num_dims,
       inv_two_sigma_sq_(inv_two_sigma_sq),
       pause_distance_per_dim_(params.pause_distance_per_dim),
       pause_noise_factor_(params.pause_noise_factor),
+      pause_noise_allowance_(params.pause_noise_allowance),
       lost_ceiling_per_dim_(params.lost_distance_per_dim),
       lost_residual_per_dim_(params.lost_residual_per_dim),
       lost_noise_factor_(params.lost_noise_factor),
@@ -21,7 +22,8 @@ NoiseScaledLevels::NoiseScaledLevels(const FollowParams& params, int num_dims,
 
 float NoiseScaledLevels::log_pause_emission(float noise) const noexcept {
   const double n = std::isfinite(noise) ? std::max(0.0, double{noise}) : 0.0;
-  const double per_dim = pause_distance_per_dim_ + pause_noise_factor_ * n;
+  const double per_dim =
+      pause_distance_per_dim_ + pause_noise_factor_ * std::max(0.0, n - pause_noise_allowance_);
   return static_cast<float>(
       std::max(-per_dim * dims_ * inv_two_sigma_sq_, double{follow_detail::kMinLogEmission}));
 }

@@ -85,6 +85,7 @@ TEST(NoiseScaledLevels, PauseAndLostLevelsRiseWithTheNoiseUpToTheCeiling) {
   FollowParams params;
   params.pause_distance_per_dim = 0.01f;
   params.pause_noise_factor = 2.0f;
+  params.pause_noise_allowance = 0.001f;
   params.lost_residual_per_dim = 0.002f;
   params.lost_noise_factor = 3.0f;
   params.lost_distance_per_dim = 0.05f;
@@ -92,7 +93,8 @@ TEST(NoiseScaledLevels, PauseAndLostLevelsRiseWithTheNoiseUpToTheCeiling) {
   const double inv = 1.0 / (2.0 * 0.1 * 0.1);
   const NoiseScaledLevels levels(params, dims, inv);
   EXPECT_NEAR(levels.log_pause_emission(0.0f), -0.01 * dims * inv, 1e-4);
-  EXPECT_NEAR(levels.log_pause_emission(0.005f), -(0.01 + 0.01) * dims * inv, 1e-4);
+  EXPECT_NEAR(levels.log_pause_emission(0.0008f), -0.01 * dims * inv, 1e-4);  // allowed for
+  EXPECT_NEAR(levels.log_pause_emission(0.006f), -(0.01 + 0.01) * dims * inv, 1e-4);
   EXPECT_NEAR(levels.lost_distance_sq(0.0f), 0.002 * dims, 1e-6);
   EXPECT_NEAR(levels.lost_distance_sq(0.004f), (0.002 + 0.012) * dims, 1e-6);
   EXPECT_NEAR(levels.lost_distance_sq(1.0f), 0.05 * dims, 1e-6);  // the ceiling

@@ -76,7 +76,9 @@ struct FollowParams {
 
   // Scaled to the sensor's noise (issue 11). The follower estimates the input's white-noise
   // variance per posture dimension online (sensor_noise.h, over this time constant) and
-  //  - raises the pause state's level by pause_noise_factor times it: noise adds to every
+  //  - raises the pause state's level by pause_noise_factor times what of it exceeds
+  //    pause_noise_allowance (the fixed level was chosen at 3 degrees RMS, noise 0.0015, and
+  //    allows for about that: raised from 0 on, noise@asf lost 0.3 points): noise adds to every
   //    template distance alike, so without it a sensor with 4 degrees per axis put every frame
   //    past the pause level (the pause state won: 30% of the followed frames lost, 887 false
   //    jumps a minute);
@@ -91,6 +93,7 @@ struct FollowParams {
   // lost_residual_per_dim = +inf and pause_noise_factor = 0 give the fixed levels (paper).
   double sensor_noise_time_constant_s = 1.0;
   float pause_noise_factor = 3.0f;
+  float pause_noise_allowance = 0.001f;
   float lost_residual_per_dim = 0.0015f;
   float lost_noise_factor = 3.5f;
   float lost_residual_factor = 5.0f;
