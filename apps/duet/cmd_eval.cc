@@ -30,6 +30,7 @@ struct EvalArgs {
   std::vector<std::string> rigs = {"native"};
   std::uint64_t seed = 1;
   std::string csv_path;
+  std::string frames_csv_path;
   std::string plots_dir;
   std::string trace_case = "improv-pause";
   bool no_partner_metrics = false;
@@ -43,7 +44,8 @@ struct EvalArgs {
   std::optional<float> jump_hold;
   std::optional<int> jump_tolerance;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
-      pause_distance, lost_distance, velocity_cap;
+      pause_distance, lost_distance, velocity_cap, pause_noise_factor, lost_residual,
+      lost_noise_factor, lost_residual_factor;
   std::optional<double> tempo_time_constant;
   bool fixed_band = false;
   std::optional<int> dtw_back, dtw_ahead;
@@ -178,6 +180,7 @@ int run_eval(EvalArgs& args) {
   options.takes = args.takes;
   options.seed = args.seed;
   options.trace_case = args.plots_dir.empty() ? "" : args.trace_case;
+  options.keep_frames = !args.frames_csv_path.empty();
 
   FollowParams& hmm = options.hmm;
   if (args.sigma) hmm.emission_sigma = *args.sigma;
@@ -189,6 +192,10 @@ int run_eval(EvalArgs& args) {
   if (args.pause_distance) hmm.pause_distance_per_dim = *args.pause_distance;
   if (args.lost_distance) hmm.lost_distance_per_dim = *args.lost_distance;
   if (args.velocity_cap) hmm.velocity_distance_cap = *args.velocity_cap;
+  if (args.pause_noise_factor) hmm.pause_noise_factor = *args.pause_noise_factor;
+  if (args.lost_residual) hmm.lost_residual_per_dim = *args.lost_residual;
+  if (args.lost_noise_factor) hmm.lost_noise_factor = *args.lost_noise_factor;
+  if (args.lost_residual_factor) hmm.lost_residual_factor = *args.lost_residual_factor;
   if (args.tempo_time_constant) hmm.tempo_time_constant_s = *args.tempo_time_constant;
   if (args.fixed_band) hmm.tempo_adaptive = false;
   if (args.jump_hold) hmm.jump_hold_s = *args.jump_hold;
@@ -285,18 +292,28 @@ int run_eval(EvalArgs& args) {
   fmt::print(
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
-      "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {}\n\n",
+      "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {}\n"
+      "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
+      "lost_residual_factor {}\n\n",
       library->takes().size(), library->model().num_states(), library->frame_rate(),
       args.library.role, takes, options.seed, hmm.self_prob, hmm.next_prob, hmm.skip_prob,
       hmm.leave_prob, hmm.pause_stay_prob, hmm.emission_sigma, hmm.pause_distance_per_dim,
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
-      hmm.jump_hold_s, hmm.jump_tolerance_frames);
+      hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.pause_noise_factor,
+      hmm.lost_residual_per_dim, hmm.lost_noise_factor, hmm.lost_residual_factor);
   fmt::print("{}", format_eval_table(report.value()));
   std::fflush(stdout);
 
   if (!args.csv_path.empty()) {
     if (Status s = write_file_atomically(args.csv_path, format_eval_csv(report.value())); !s) {
+      fmt::print(stderr, "duet eval: {}\n", s.error().message);
+      return kExitFailure;
+    }
+  }
+  if (!args.frames_csv_path.empty()) {
+    if (Status s = write_file_atomically(args.frames_csv_path, format_frames_csv(report.value()));
+        !s) {
       fmt::print(stderr, "duet eval: {}\n", s.error().message);
       return kExitFailure;
     }
@@ -351,8 +368,13 @@ Command register_eval(CLI::App& app) {
       ->check(number_between(0.0, 45.0, "point noise"));
   app.add_option("--seed", args->seed, "Seed of every random choice (same seed, same numbers)");
   app.add_option("--csv", args->csv_path, "Write the metrics per case, tracker and take as CSV");
+  app.add_option("--frames-csv", args->frames_csv_path,
+                 "Write every scored frame (case, tracker, take, error, confidence, window mass, "
+                 "best distance, sensor noise, lost) as CSV, e.g. for "
+                 "scripts/fit_confidence_calibration.py");
   app.add_option("--plots", args->plots_dir,
-                 "Write PNG plots (needs gnuplot) into this directory: accuracy.png, trace.png");
+                 "Write PNG plots (needs gnuplot) into this directory: accuracy.png, trace.png, "
+                 "reliability.png (confidence against the share within 100 ms, per case)");
   app.add_flag("--no-partner-metrics", args->no_partner_metrics,
                "Skip the partner metrics (by default every case x take also runs the live loop "
                "with the hmm tracker per configuration of the corrections and scores the "
@@ -397,7 +419,29 @@ Command register_eval(CLI::App& app) {
       ->add_option("--pause-distance", args->pause_distance,
                    "pause_distance_per_dim (all HMM variants)")
       ->check(non_negative_check());
-  tuning->add_option("--lost-distance", args->lost_distance, "lost_distance_per_dim (all trackers)")
+  tuning
+      ->add_option("--lost-distance", args->lost_distance,
+                   "lost_distance_per_dim (all trackers; the HMM's ceiling)")
+      ->check(non_negative_check());
+  tuning
+      ->add_option("--lost-residual", args->lost_residual,
+                   "lost_residual_per_dim: the HMM's lost distance on a noiseless sensor (all HMM "
+                   "variants; above --lost-distance, that fixed ceiling alone)")
+      ->check(non_negative_check());
+  tuning
+      ->add_option("--lost-noise-factor", args->lost_noise_factor,
+                   "lost_noise_factor: what the estimated sensor noise adds to the HMM's lost "
+                   "distance, per unit of noise (all HMM variants)")
+      ->check(non_negative_check());
+  tuning
+      ->add_option("--lost-residual-factor", args->lost_residual_factor,
+                   "lost_residual_factor: the HMM's lost distance is at least this times the "
+                   "average best distance of the frames it plainly follows (all HMM variants)")
+      ->check(non_negative_check());
+  tuning
+      ->add_option("--pause-noise-factor", args->pause_noise_factor,
+                   "pause_noise_factor: what the estimated sensor noise adds to the pause "
+                   "state's level, per unit of noise (all HMM variants)")
       ->check(non_negative_check());
   tuning
       ->add_option("--velocity-cap", args->velocity_cap,

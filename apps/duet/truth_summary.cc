@@ -87,7 +87,7 @@ void print_accuracy_summary(const GroundTruth& truth, std::span<const FollowResu
   std::vector<FrameEstimate> estimates;
   estimates.reserve(results.size());
   for (const FollowResult& r : results) {
-    estimates.push_back(FrameEstimate{r.take, r.frame_in_take, r.lost, r.jumped, 0.0});
+    estimates.push_back(frame_estimate(r));
   }
   MetricsAccumulator accumulator;
   accumulator.add(truth.rows, truth.times_s, estimates, template_rate_hz);

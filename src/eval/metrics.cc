@@ -25,6 +25,21 @@ double median(std::vector<double> values) {
 
 }  // namespace
 
+FrameEstimate frame_estimate(const FollowResult& r, double step_us) {
+  FrameEstimate e;
+  e.take = r.take;
+  e.frame_in_take = r.frame_in_take;
+  e.lost = r.lost;
+  e.jumped = r.jumped;
+  e.confidence = r.confidence;
+  e.window_mass = r.window_mass;
+  e.best_distance_per_dim = r.best_distance_per_dim;
+  e.sensor_noise_per_dim = r.sensor_noise_per_dim;
+  e.in_pause = r.in_pause;
+  e.step_us = step_us;
+  return e;
+}
+
 double frame_error_ms(const TruthFrame& truth, const FrameEstimate& estimate,
                       double template_rate_hz, const MetricsOptions& options) {
   if (estimate.take < 0 || estimate.take != truth.take) return options.miss_error_ms;
@@ -49,6 +64,7 @@ void MetricsAccumulator::add(std::span<const TruthFrame> truth, std::span<const 
     errors_ms_.push_back(errors[i]);
     if (estimates[i].take < 0 || estimates[i].take != truth[i].take) ++misses_;
     if (estimates[i].lost) ++lost_;
+    calibration_.add(estimates[i].confidence, errors[i] <= 100.0);
     if (errors[i] <= 100.0) {
       ++tracked_;
       if (estimates[i].lost) ++lost_on_tracked_;
@@ -107,6 +123,7 @@ void MetricsAccumulator::add(std::span<const TruthFrame> truth, std::span<const 
 void MetricsAccumulator::merge(const MetricsAccumulator& other) {
   errors_ms_.insert(errors_ms_.end(), other.errors_ms_.begin(), other.errors_ms_.end());
   recovery_s_.insert(recovery_s_.end(), other.recovery_s_.begin(), other.recovery_s_.end());
+  calibration_.merge(other.calibration_);
   frames_ += other.frames_;
   pause_frames_ += other.pause_frames_;
   lost_ += other.lost_;
@@ -159,6 +176,8 @@ Metrics MetricsAccumulator::summary() const {
   m.mean_recovery_s =
       m.recovered_jumps > 0 ? recovered_sum / static_cast<double>(m.recovered_jumps) : 0.0;
   m.mean_step_us = frames_ > 0 ? step_us_sum_ / static_cast<double>(frames_) : 0.0;
+  m.confidence_ece = calibration_.expected_calibration_error();
+  m.reliability = calibration_.diagram();
   return m;
 }
 

@@ -29,13 +29,13 @@ void append_csv_row(std::string& out, const std::string& case_name, const std::s
   fmt::format_to(
       std::back_inserter(out),
       "{},{},{},{},{},{},{},{:.5f},{:.5f},{:.5f},{:.5f},{:.2f},{:.2f},{},{},{},{},{:.5f},"
-      "{:.2f},{},{},{:.3f},{:.5f}\n",
+      "{:.2f},{},{},{:.3f},{:.5f},{:.5f}\n",
       case_name, tracker, take, take_name, m.frames, m.scored_frames, m.pause_frames, m.within_50ms,
       m.within_100ms, m.within_300ms, m.miss_fraction, m.mean_error_ms, m.median_error_ms, m.jumps,
       m.recovered_jumps, m.jumps ? number_or_empty(m.median_recovery_s, 4) : "",
       m.recovered_jumps ? number_or_empty(m.mean_recovery_s, 4) : "", m.lost_fraction,
       m.mean_step_us, m.reported_jumps, m.false_jumps, m.false_jumps_per_minute,
-      m.lost_on_tracked_fraction);
+      m.lost_on_tracked_fraction, m.confidence_ece);
 }
 
 std::string take_name(const EvalReport& report, int take) {
@@ -172,6 +172,53 @@ void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::
                  m.mean_jerk_mps3, m.true_mean_jerk_mps3);
 }
 
+// reliability.dat and its plot: per case, the 10 confidence bins of the first tracker (hmm when
+// it ran) as (mean confidence, accuracy), one gnuplot data block per case; empty bins left out.
+void append_reliability_plot(const EvalReport& report, const std::vector<std::string>& trackers,
+                             const std::string& terminal, std::vector<PlotFile>& files,
+                             std::string& script) {
+  if (trackers.empty()) return;
+  const std::string tracker =
+      std::ranges::find(trackers, "hmm") != trackers.end() ? "hmm" : trackers.front();
+  std::string data = "# per case (one block each): bin mean_confidence accuracy frames\n";
+  std::vector<std::string> titles;
+  for (const EvalRow& row : report.rows) {
+    if (row.tracker != tracker) continue;
+    fmt::format_to(std::back_inserter(data), "# {} (ECE {:.2f}%)\n", row.case_name,
+                   100.0 * row.metrics.confidence_ece);
+    for (std::size_t b = 0; b < row.metrics.reliability.size(); ++b) {
+      const ReliabilityBin& bin = row.metrics.reliability[b];
+      if (bin.frames == 0) continue;
+      fmt::format_to(std::back_inserter(data), "{} {:.5f} {:.5f} {}\n", b, bin.mean_confidence,
+                     bin.accuracy, bin.frames);
+    }
+    data += "\n\n";
+    titles.push_back(fmt::format("{} (ECE {:.1f}%)", row.case_name,
+                                 100.0 * row.metrics.confidence_ece));
+  }
+  files.push_back({"reliability.dat", data});
+  script += fmt::format(
+      "\nreset\n"
+      "set terminal {} size 1000,800 font ',11' noenhanced\n"
+      "set output 'reliability.png'\n"
+      "set title 'Reliability of the {} confidence: share within 100 ms per confidence bin'\n"
+      "set xlabel 'mean confidence in bin'\n"
+      "set ylabel 'frames within 100 ms'\n"
+      "set xrange [0:1]\n"
+      "set yrange [0:1]\n"
+      "set size square\n"
+      "set key outside right top\n"
+      "set grid\n"
+      "plot x with lines dt 2 lc rgb 'black' title 'calibrated'",
+      terminal, tracker);
+  for (std::size_t k = 0; k < titles.size(); ++k) {
+    script += fmt::format(
+        ", \\\n     'reliability.dat' index {} using 2:3 with linespoints pt 7 ps 0.8 title '{}'",
+        k, titles[k]);
+  }
+  script += "\n";
+}
+
 }  // namespace
 
 std::string format_partner_csv(const EvalReport& report) {
@@ -197,10 +244,11 @@ std::string format_partner_csv(const EvalReport& report) {
 std::string format_eval_table(const EvalReport& report) {
   std::string out;
   constexpr const char* kHeader =
-      "{:<18} {:<14} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>7} {:>7} {:>6} {:>6} {:>8} {:>8}\n";
+      "{:<18} {:<14} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>7} {:>7} {:>6} {:>6} {:>8} {:>6} "
+      "{:>8}\n";
   fmt::format_to(std::back_inserter(out), kHeader, "case", "tracker", "frames", "acc@50", "acc@100",
                  "acc@300", "mean ms", "med ms", "jumps", "recov s", "fj/min", "lost", "lost trk",
-                 "us/frame");
+                 "ECE", "us/frame");
   std::string previous_case;
   for (const EvalRow& row : report.rows) {
     if (!previous_case.empty() && row.case_name != previous_case) out += "\n";
@@ -213,7 +261,7 @@ std::string format_eval_table(const EvalReport& report) {
                    fmt::format("{:.1f}", m.mean_error_ms), fmt::format("{:.1f}", m.median_error_ms),
                    jumps, recovery_text(m), fmt::format("{:.1f}", m.false_jumps_per_minute),
                    percent(m.lost_fraction), percent(m.lost_on_tracked_fraction),
-                   fmt::format("{:.0f}", m.mean_step_us));
+                   percent(m.confidence_ece), fmt::format("{:.0f}", m.mean_step_us));
   }
   const NaiveCheck& n = report.naive;
   if (n.ran) {
@@ -236,7 +284,7 @@ std::string format_eval_csv(const EvalReport& report) {
       "case,tracker,take,take_name,frames,scored_frames,pause_frames,acc_50ms,acc_100ms,acc_300ms,"
       "miss_fraction,mean_error_ms,median_error_ms,jumps,recovered_jumps,median_recovery_s,"
       "mean_recovery_s,lost_fraction,mean_step_us,reported_jumps,false_jumps,"
-      "false_jumps_per_minute,lost_on_tracked_fraction\n";
+      "false_jumps_per_minute,lost_on_tracked_fraction,confidence_ece\n";
   for (const EvalRow& row : report.rows) {
     for (const auto& [take, metrics] : row.per_take) {
       append_csv_row(out, row.case_name, row.tracker, std::to_string(take), take_name(report, take),
@@ -248,6 +296,22 @@ std::string format_eval_csv(const EvalReport& report) {
   if (n.ran) {
     append_csv_row(out, n.case_name, "naive-hmm", std::to_string(n.take), n.take_name, n.naive);
     append_csv_row(out, n.case_name, "hmm-one-take", std::to_string(n.take), n.take_name, n.fast);
+  }
+  return out;
+}
+
+std::string format_frames_csv(const EvalReport& report) {
+  std::string out =
+      "case,tracker,take,error_ms,confidence,window_mass,best_distance_per_dim,"
+      "sensor_noise_per_dim,lost,in_pause\n";
+  for (const EvalRow& row : report.rows) {
+    for (const ScoredFrame& f : row.frames) {
+      const FrameEstimate& e = f.estimate;
+      fmt::format_to(std::back_inserter(out), "{},{},{},{:.1f},{:.5f},{:.5f},{:.6f},{:.7f},{},{}\n",
+                     row.case_name, row.tracker, f.take, f.error_ms, e.confidence, e.window_mass,
+                     e.best_distance_per_dim, e.sensor_noise_per_dim, e.lost ? 1 : 0,
+                     e.in_pause ? 1 : 0);
+    }
   }
   return out;
 }
@@ -350,6 +414,7 @@ std::vector<PlotFile> make_eval_plots(const EvalReport& report, const std::strin
     }
     script += "\n";
   }
+  append_reliability_plot(report, trackers, terminal, files, script);
   files.push_back({"plots.gp", script});
   return files;
 }

@@ -161,9 +161,7 @@ Timed timed(F&& f) {
   return {r, std::chrono::duration<double, std::micro>(stop - start).count()};
 }
 
-FrameEstimate to_estimate(const FollowResult& r, double us) {
-  return {r.take, r.frame_in_take, r.lost, r.jumped, us};
-}
+FrameEstimate to_estimate(const FollowResult& r, double us) { return frame_estimate(r, us); }
 
 std::vector<SourceTake> sources_for(const DuetLibrary& library, int take, bool across_takes) {
   std::vector<SourceTake> sources;
@@ -277,6 +275,12 @@ Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const Templ
       params.emission_sigma = options.hmm.emission_sigma;
       params.pause_distance_per_dim = options.hmm.pause_distance_per_dim;
       params.lost_distance_per_dim = options.hmm.lost_distance_per_dim;
+      params.sensor_noise_time_constant_s = options.hmm.sensor_noise_time_constant_s;
+      params.pause_noise_factor = options.hmm.pause_noise_factor;
+      params.pause_noise_allowance = options.hmm.pause_noise_allowance;
+      params.lost_residual_per_dim = options.hmm.lost_residual_per_dim;
+      params.lost_noise_factor = options.hmm.lost_noise_factor;
+      params.lost_residual_factor = options.hmm.lost_residual_factor;
       params.confidence_window_frames = options.hmm.confidence_window_frames;
       params.max_steps_per_frame = options.hmm.max_steps_per_frame;
       return boxed(HmmFollower::create(model, params));
@@ -369,6 +373,7 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
     const DuetLibrary& lib = eval_case.partner_role ? *partner_library : library;
     std::vector<MetricsAccumulator> pooled(trackers.size(), MetricsAccumulator(options.metrics));
     std::vector<std::vector<std::pair<int, Metrics>>> per_take(trackers.size());
+    std::vector<std::vector<ScoredFrame>> kept(trackers.size());
     const std::size_t configs = options.partner_metrics ? options.partner_configs.size() : 0;
     std::vector<PartnerMetricsAccumulator> partner_pooled(
         configs, PartnerMetricsAccumulator(options.partner));
@@ -396,6 +401,16 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
         if (!estimates) return Error{label + ": " + estimates.error().message};
         MetricsAccumulator one(options.metrics);
         one.add(performance, estimates.value());
+        if (options.keep_frames) {
+          for (std::size_t f = 0; f < estimates.value().size(); ++f) {
+            const TruthFrame& truth = performance.truth[f];
+            if (truth.in_pause) continue;
+            kept[k].push_back({take,
+                               frame_error_ms(truth, estimates.value()[f],
+                                              performance.template_rate_hz, options.metrics),
+                               estimates.value()[f]});
+          }
+        }
         per_take[k].emplace_back(take, one.summary());
         pooled[k].merge(one);
         if (eval_case.name == options.trace_case && ti == 0) {
@@ -428,7 +443,7 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
     }
     for (std::size_t k = 0; k < trackers.size(); ++k) {
       report.rows.push_back({eval_case.name, std::string(tracker_kind_name(trackers[k])),
-                             pooled[k].summary(), std::move(per_take[k])});
+                             pooled[k].summary(), std::move(per_take[k]), std::move(kept[k])});
     }
     for (std::size_t c = 0; c < configs; ++c) {
       const PartnerConfig& config = options.partner_configs[c];

@@ -1,6 +1,7 @@
 #include "duet/follow/follow_params.h"
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace duet {
@@ -22,6 +23,9 @@ FollowParams FollowParams::paper() {
   params.tempo_adaptive = false;
   params.jump_hold_s = 0.0f;
   params.jump_tolerance_frames = 0;
+  params.pause_noise_factor = 0.0f;
+  params.calibrate_confidence = false;
+  params.lost_residual_per_dim = std::numeric_limits<float>::infinity();
   return params;
 }
 
@@ -63,6 +67,27 @@ Status FollowParams::validate(int num_states) const {
   if (!(lost_distance_per_dim >= 0.0f)) {  // +inf allowed: never lost by distance
     return params_error("lost_distance_per_dim must be >= 0, got " +
                         std::to_string(lost_distance_per_dim));
+  }
+  if (!(sensor_noise_time_constant_s > 0.0 && std::isfinite(sensor_noise_time_constant_s))) {
+    return params_error("sensor_noise_time_constant_s must be finite and > 0, got " +
+                        std::to_string(sensor_noise_time_constant_s));
+  }
+  const struct {
+    const char* name;
+    float value;
+  } noise_levels[] = {{"pause_noise_factor", pause_noise_factor},
+                      {"pause_noise_allowance", pause_noise_allowance},
+                      {"lost_noise_factor", lost_noise_factor},
+                      {"lost_residual_factor", lost_residual_factor}};
+  for (const auto& level : noise_levels) {
+    if (!(level.value >= 0.0f && std::isfinite(level.value))) {
+      return params_error(std::string(level.name) + " must be finite and >= 0, got " +
+                          std::to_string(level.value));
+    }
+  }
+  if (!(lost_residual_per_dim >= 0.0f)) {  // +inf allowed: the fixed lost_distance_per_dim
+    return params_error("lost_residual_per_dim must be >= 0, got " +
+                        std::to_string(lost_residual_per_dim));
   }
   if (confidence_window_frames < 0) {
     return params_error("confidence_window_frames must be >= 0, got " +

@@ -177,6 +177,7 @@ void describe_state(const TemplateModel& model, const float* posterior, float to
   result.take = take;
   result.frame_in_take = state - model.take_begin(take);
   result.confidence = total > 0.0f ? std::clamp(mass / total, 0.0f, 1.0f) : 0.0f;
+  result.window_mass = result.confidence;
 }
 
 void decide(const TemplateModel& model, const float* posterior, float total, float pause_mass,

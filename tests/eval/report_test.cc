@@ -46,6 +46,7 @@ std::vector<std::string> trace_plot_order(const std::string& script) {
   std::vector<std::string> order;
   std::istringstream lines(script.substr(plot + 1));
   for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("set ", 0) == 0 || line == "reset") break;  // the next plot's settings
     const std::size_t title = line.find(" title '");
     if (title == std::string::npos) continue;  // notitle: a tracker's other-take markers
     const std::size_t start = title + 8;
@@ -140,6 +141,49 @@ TEST(EvalReportTable, PartnerColumnsHaveUnitsAndALegend) {
 TEST(EvalReportTable, NoPartnerRowsNoLegend) {
   const std::string table = format_eval_table(small_report());
   EXPECT_EQ(table.find("columns ("), std::string::npos) << table;
+}
+
+}  // namespace
+}  // namespace duet
+
+namespace duet {
+namespace {
+
+TEST(EvalReportPlots, ReliabilityDiagramOfTheHmmPerCase) {
+  EvalReport report = small_report();
+  CalibrationAccumulator calibration;
+  for (int k = 0; k < 10; ++k) calibration.add(0.95, k < 8);  // claims 0.95, right 80%
+  report.rows[0].metrics.reliability = calibration.diagram();
+  report.rows[0].metrics.confidence_ece = calibration.expected_calibration_error();
+  const std::vector<PlotFile> files = make_eval_plots(report, "png");
+  const PlotFile* data = find_file(files, "reliability.dat");
+  const PlotFile* script = find_file(files, "plots.gp");
+  ASSERT_NE(data, nullptr);
+  ASSERT_NE(script, nullptr);
+  // The hmm row's one filled bin (bin 9: mean confidence 0.95, 80% right, 10 frames); the
+  // nearest row is not drawn.
+  EXPECT_NE(data->content.find("# clean (ECE 15.00%)\n9 0.95000 0.80000 10\n"), std::string::npos)
+      << data->content;
+  EXPECT_NE(script->content.find("set output 'reliability.png'"), std::string::npos);
+  EXPECT_NE(script->content.find("'reliability.dat' index 0 using 2:3"), std::string::npos);
+  EXPECT_EQ(script->content.find("'reliability.dat' index 1"), std::string::npos);
+}
+
+TEST(EvalReportCsv, HasTheCalibrationErrorAndTheFramesCsvItsRows) {
+  EvalReport report = small_report();
+  report.rows[0].metrics.confidence_ece = 0.0123;
+  FrameEstimate e{0, 5, true, false, 0.0};
+  e.confidence = 0.5f;
+  e.window_mass = 0.75f;
+  e.sensor_noise_per_dim = 0.002f;
+  report.rows[0].frames.push_back({0, 33.3, e});
+  const std::string csv = format_eval_csv(report);
+  EXPECT_NE(csv.find(",confidence_ece\n"), std::string::npos);
+  EXPECT_NE(csv.find(",0.01230\n"), std::string::npos) << csv;
+  EXPECT_EQ(format_frames_csv(report),
+            "case,tracker,take,error_ms,confidence,window_mass,best_distance_per_dim,"
+            "sensor_noise_per_dim,lost,in_pause\n"
+            "clean,hmm,0,33.3,0.50000,0.75000,0.000000,0.0020000,1,0\n");
 }
 
 }  // namespace

@@ -34,11 +34,13 @@ TEST(CrossRigFollow, TakeOneFromTheCmuAsfAmcIsFollowedAgainstTheSalsaLibrary) {
   EXPECT_GE(share, 0.99);
 }
 
-TEST(CrossRigFollow, AWalkAndADanceOnAThirdPartyRigAreLost) {
+TEST(CrossRigFollow, AWalkADanceAndAWaveOnAThirdPartyRigAreLost) {
   // Bandai clips: another studio's rig (roles from its joint names, centimetres guessed) and
   // motions that are no part of the salsa. The follower must not claim to follow them, and the
-  // rig's posture offset must not learn to make them look like salsa.
-  for (const char* clip : {"walk", "dance-short"}) {
+  // rig's posture offset must not learn to make them look like salsa. The wave (standing, one
+  // arm waving) comes closest to salsa postures: with the fixed lost distance it was 47.9% lost;
+  // the noise-scaled one, on this clean capture, holds it to what a clean dance reaches.
+  for (const char* clip : {"walk", "dance-short", "byebye"}) {
     Result<LoadedMotion> input =
         load_motion({kData + "/bandai/dataset-1_" + std::string(clip) + "_normal_001.bvh"});
     ASSERT_TRUE(input) << input.error().message;

@@ -73,14 +73,14 @@ std::vector<TraceRow> read_trace(const std::string& path) {
   std::ifstream in(path);
   if (!in) fail(path + ": cannot open");
   std::string line;
-  std::getline(in, line);  // header: frame,time_s,take,template_frame,confidence,jumped,lost
+  std::getline(in, line);  // header: frame,time_s,take,template_frame,confidence,jumped,lost,...
   std::vector<TraceRow> rows;
   while (std::getline(in, line)) {
     if (line.empty()) continue;
     std::vector<std::string> cells;
     std::stringstream ss(line);
     for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
-    if (cells.size() != 7) fail(path + ": expected 7 columns in '" + line + "'");
+    if (cells.size() < 7) fail(path + ": expected at least 7 columns in '" + line + "'");
     TraceRow row;
     row.take = std::stoi(cells[2]);
     row.template_frame = std::stoi(cells[3]);

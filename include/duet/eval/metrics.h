@@ -10,7 +10,9 @@
 #include <span>
 #include <vector>
 
+#include "duet/eval/calibration.h"
 #include "duet/eval/performance.h"
+#include "duet/follow/tracker.h"
 
 namespace duet {
 
@@ -21,7 +23,16 @@ struct FrameEstimate {
   bool lost = false;
   bool jumped = false;
   double step_us = 0.0;  // wall-clock time of the session step for this frame, microseconds
+  float confidence = 0.0f;  // FollowResult::confidence: P(within 100 ms) as the tracker claims it
+  // What the confidence and lost decisions were made from (FollowResult), for fitting them.
+  float window_mass = 0.0f;
+  float best_distance_per_dim = 0.0f;
+  float sensor_noise_per_dim = 0.0f;
+  bool in_pause = false;
 };
+
+// A follower's result as scored; step_us its measured wall-clock time.
+FrameEstimate frame_estimate(const FollowResult& result, double step_us = 0.0);
 
 struct MetricsOptions {
   double miss_error_ms = 1000.0;         // error of a miss, and cap of every error
@@ -68,6 +79,9 @@ struct Metrics {
   long long false_jumps = 0;
   double false_jumps_per_minute = 0.0;
   double mean_step_us = 0.0;  // mean wall-clock time per session step (measured)
+  // Calibration of the confidence against "within 100 ms" over the scored frames (calibration.h).
+  double confidence_ece = 0.0;
+  ReliabilityDiagram reliability{};
 };
 
 // Collects per-frame errors of several performances and summarises them (pooled over frames and
@@ -91,6 +105,7 @@ class MetricsAccumulator {
   MetricsOptions options_;
   std::vector<double> errors_ms_;   // scored frames
   std::vector<double> recovery_s_;  // one per jump, +inf when unrecovered
+  CalibrationAccumulator calibration_;
   long long frames_ = 0, pause_frames_ = 0, lost_ = 0, misses_ = 0;
   long long tracked_ = 0, lost_on_tracked_ = 0, reported_jumps_ = 0, false_jumps_ = 0;
   double duration_s_ = 0.0;

@@ -22,6 +22,11 @@ std::string format_eval_csv(const EvalReport& report);
 // take and one pooled row (take "all") per case x configuration. Columns in docs/evaluation.md.
 std::string format_partner_csv(const EvalReport& report);
 
+// Every kept frame (EvalOptions::keep_frames): case, tracker, take, error, and what the tracker
+// said (confidence, window mass, best distance, sensor noise, lost, pause). Columns in
+// docs/evaluation.md.
+std::string format_frames_csv(const EvalReport& report);
+
 struct PlotFile {
   std::string name;  // file name inside the plot directory
   std::string content;

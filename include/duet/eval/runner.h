@@ -90,6 +90,16 @@ struct EvalOptions {
   bool partner_metrics = false;
   std::vector<PartnerConfig> partner_configs = standard_partner_configs();
   PartnerMetricsOptions partner;
+  // Keep every scored frame's estimate and error in EvalRow::frames (for --frames-csv: fitting
+  // and checking the confidence calibration and the lost decision offline).
+  bool keep_frames = false;
+};
+
+// One scored (not pause) frame of a performance, when EvalOptions::keep_frames.
+struct ScoredFrame {
+  int take = 0;
+  double error_ms = 0.0;  // frame_error_ms
+  FrameEstimate estimate;
 };
 
 // A case x tracker, pooled over the performed takes, and per take.
@@ -98,6 +108,7 @@ struct EvalRow {
   std::string tracker;
   Metrics metrics;
   std::vector<std::pair<int, Metrics>> per_take;  // (take index, metrics)
+  std::vector<ScoredFrame> frames;                // when EvalOptions::keep_frames
 };
 
 // A case x configuration of the corrections, pooled over the performed takes, and per take.

@@ -16,7 +16,10 @@
 
 #include "duet/base/result.h"
 #include "duet/follow/follow_params.h"
+#include "duet/follow/explained_residual.h"
 #include "duet/follow/jump_gate.h"
+#include "duet/follow/noise_scaled_levels.h"
+#include "duet/follow/sensor_noise.h"
 #include "duet/follow/tempo_band.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tracker.h"
@@ -45,6 +48,9 @@ class ForwardContext {
   // The tempo the band is centred on (1 until the dancer has shown another one).
   float tempo() const { return tempo_.tempo(); }
   long long frames() const { return frames_; }
+  // The input's noise level (sized by HmmFollower::create; a context without it reports 0).
+  SensorNoiseEstimator& sensor_noise() { return sensor_noise_; }
+  const SensorNoiseEstimator& sensor_noise() const { return sensor_noise_; }
 
  private:
   friend class HmmForward;
@@ -59,6 +65,8 @@ class ForwardContext {
   bool previous_lost_ = false;
   TempoEstimator tempo_;
   JumpGate jump_gate_;
+  SensorNoiseEstimator sensor_noise_;
+  ExplainedResidual explained_residual_;
 };
 
 class HmmForward {
@@ -106,8 +114,7 @@ class HmmForward {
   float pause_stay_ = 0.0f;
   std::vector<float> resume_;  // R_i, normalised; empty = uniform 1/M
   float inv_two_sigma_sq_ = 0.0f;
-  float log_pause_emission_ = 0.0f;
-  float lost_distance_sq_ = 0.0f;
+  NoiseScaledLevels noise_levels_;
 };
 
 // HmmForward + ForwardContext behind the Tracker interface. FollowParams::left_to_right() gives

@@ -12,7 +12,11 @@ struct FollowResult {
   int state = -1;           // estimated template state (global index in [0, M)); eq. 8-9
   int take = -1;            // the take that contains state
   int frame_in_take = -1;   // state - first state of that take
-  float confidence = 0.0f;  // posterior mass within the confidence window around state, [0, 1]
+  // The probability that state is within 100 ms of the dancer's true place, [0, 1]: the
+  // posterior mass within the confidence window around state, mapped through a calibration
+  // fitted on `duet eval` performances (confidence_calibration.h; raw where a tracker has none).
+  float confidence = 0.0f;
+  float window_mass = 0.0f;  // that posterior mass before calibration
   // The estimate moved by something other than 0..2n frames forward within its take (n = steps),
   // or changed take. False on the first frame after reset().
   bool jumped = false;
@@ -25,6 +29,9 @@ struct FollowResult {
   double log_likelihood = 0.0;
   // min_i ||phi - phi_i||^2 / D over all states (online DTW: over its window); -1 if missing.
   float best_distance_per_dim = 0.0f;
+  // The input sensor's white-noise variance per posture dimension as the tracker estimates it
+  // online (sensor_noise.h); 0 for trackers that do not.
+  float sensor_noise_per_dim = 0.0f;
   // The dancer's tempo as the tracker sees it (template frames per template frame of input time,
   // 1 = the template's tempo); 1 for trackers that do not estimate one.
   float tempo = 1.0f;

@@ -1,0 +1,45 @@
+#include "duet/follow/noise_scaled_levels.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+
+#include "forward_common.h"
+
+namespace duet {
+
+NoiseScaledLevels::NoiseScaledLevels(const FollowParams& params, int num_dims,
+                                     double inv_two_sigma_sq)
+    : dims_(num_dims),
+      inv_two_sigma_sq_(inv_two_sigma_sq),
+      pause_distance_per_dim_(params.pause_distance_per_dim),
+      pause_noise_factor_(params.pause_noise_factor),
+      pause_noise_allowance_(params.pause_noise_allowance),
+      lost_ceiling_per_dim_(params.lost_distance_per_dim),
+      lost_residual_per_dim_(params.lost_residual_per_dim),
+      lost_noise_factor_(params.lost_noise_factor),
+      lost_residual_factor_(params.lost_residual_factor) {}
+
+float NoiseScaledLevels::log_pause_emission(float noise) const noexcept {
+  const double n = std::isfinite(noise) ? std::max(0.0, double{noise}) : 0.0;
+  const double per_dim =
+      pause_distance_per_dim_ + pause_noise_factor_ * std::max(0.0, n - pause_noise_allowance_);
+  return static_cast<float>(
+      std::max(-per_dim * dims_ * inv_two_sigma_sq_, double{follow_detail::kMinLogEmission}));
+}
+
+float NoiseScaledLevels::lost_distance_sq(float noise, float residual) const noexcept {
+  const double n = std::isfinite(noise) ? std::max(0.0, double{noise}) : 0.0;
+  const double r = std::isfinite(residual) ? std::max(0.0, double{residual}) : 0.0;
+  // +inf residual (the paper's preset) leaves the fixed ceiling alone.
+  const double per_dim =
+      std::min(lost_ceiling_per_dim_, std::max(lost_residual_per_dim_ + lost_noise_factor_ * n,
+                                               lost_residual_factor_ * r));
+  return static_cast<float>(std::min(per_dim * dims_, double{FLT_MAX}));
+}
+
+float NoiseScaledLevels::lost_ceiling_sq() const noexcept {
+  return static_cast<float>(std::min(lost_ceiling_per_dim_ * dims_, double{FLT_MAX}));
+}
+
+}  // namespace duet
