@@ -1,0 +1,104 @@
+#include "duet/follow/jump_candidates.h"
+
+#include <nanoflann.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <string>
+#include <vector>
+
+namespace duet {
+
+namespace {
+
+constexpr int kDims = JumpCandidateIndex::kProjectedDims;
+
+// nanoflann's view of the projected points: M rows of kDims floats.
+struct ProjectedPoints {
+  std::vector<float> values;
+  std::size_t kdtree_get_point_count() const { return values.size() / kDims; }
+  float kdtree_get_pt(std::uint32_t i, std::size_t d) const {
+    return values[static_cast<std::size_t>(i) * kDims + d];
+  }
+  template <class Box>
+  bool kdtree_get_bbox(Box& /*unused*/) const {
+    return false;
+  }
+};
+
+using Tree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, ProjectedPoints>,
+                                        ProjectedPoints, kDims, std::uint32_t>;
+
+}  // namespace
+
+struct JumpCandidateIndex::Impl {
+  int posture_dims = 0;
+  Eigen::VectorXf mean;                                             // posture_dims
+  Eigen::Matrix<float, kDims, Eigen::Dynamic, Eigen::RowMajor> axes;  // kDims x posture_dims
+  ProjectedPoints points;
+  std::unique_ptr<Tree> tree;  // refers to points: Impl never moves (held by pointer)
+};
+
+JumpCandidateIndex::JumpCandidateIndex(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+JumpCandidateIndex::JumpCandidateIndex(JumpCandidateIndex&&) noexcept = default;
+JumpCandidateIndex& JumpCandidateIndex::operator=(JumpCandidateIndex&&) noexcept = default;
+JumpCandidateIndex::~JumpCandidateIndex() = default;
+
+Result<JumpCandidateIndex> JumpCandidateIndex::build(const TemplateModel& model) {
+  const int posture = model.num_dims() - model.velocity_dims();
+  if (posture <= 0) {
+    return make_error("jump candidate index", 0,
+                      "the model has no posture dimensions (all " +
+                          std::to_string(model.num_dims()) + " are velocities)");
+  }
+  auto impl = std::make_unique<Impl>();
+  impl->posture_dims = posture;
+  const auto features = model.features().leftCols(posture);
+  impl->mean = features.colwise().mean().transpose();
+  // Principal axes of the posture features (double for the covariance of up to 1M rows).
+  const Eigen::MatrixXd centred =
+      (features.rowwise() - impl->mean.transpose()).cast<double>();
+  const Eigen::MatrixXd covariance =
+      (centred.adjoint() * centred) / static_cast<double>(std::max<Eigen::Index>(1, features.rows()));
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(covariance);
+  impl->axes.setZero(kDims, posture);
+  for (int k = 0; k < std::min(kDims, posture); ++k) {
+    // Eigenvalues ascend: the largest variance last.
+    impl->axes.row(k) = solver.eigenvectors().col(posture - 1 - k).transpose().cast<float>();
+  }
+  const int rows = model.num_states();
+  impl->points.values.resize(static_cast<std::size_t>(rows) * kDims);
+  Eigen::Map<Eigen::Matrix<float, Eigen::Dynamic, kDims, Eigen::RowMajor>> projected(
+      impl->points.values.data(), rows, kDims);
+  projected.noalias() =
+      (features.rowwise() - impl->mean.transpose()) * impl->axes.transpose();
+  impl->tree = std::make_unique<Tree>(kDims, impl->points,
+                                      nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  return JumpCandidateIndex(std::move(impl));
+}
+
+int JumpCandidateIndex::nearest(const float* phi, int k, std::uint32_t* states,
+                                float* projected_d2, float& bound) const noexcept {
+  const Impl& impl = *impl_;
+  // Plain loops: an Eigen product of a dynamic difference would allocate its temporary.
+  float query[kDims] = {};
+  for (int p = 0; p < impl.posture_dims; ++p) {
+    const float centred = phi[p] - impl.mean[p];
+    for (int d = 0; d < kDims; ++d) query[d] += impl.axes(d, p) * centred;
+  }
+  nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> result(static_cast<std::size_t>(k));
+  result.init(states, projected_d2);
+  impl.tree->findNeighbors(result, query, nanoflann::SearchParams());
+  const int found = static_cast<int>(result.size());
+  bound = found == k ? result.worstDist() : 0.0f;
+  return found;
+}
+
+std::size_t JumpCandidateIndex::memory_bytes() const noexcept {
+  // The projected points and the tree's permutation; the tree's nodes are a few per leaf.
+  return impl_->points.values.size() * sizeof(float) +
+         impl_->points.kdtree_get_point_count() * (sizeof(std::uint32_t) + 16);
+}
+
+}  // namespace duet
