@@ -36,6 +36,9 @@ float emission_distance(const TemplateModel& model, const float* phi, int i,
 Status BeamParams::validate() const {
   auto fail = [](const std::string& what) { return make_error("beam parameters", 0, what); };
   if (jump_candidates < 1) return fail("jump_candidates must be >= 1");
+  if (wide_jump_candidates < jump_candidates) {
+    return fail("wide_jump_candidates must be >= jump_candidates");
+  }
   if (!(prune_ratio >= 0.0f && prune_ratio < 1.0f)) return fail("prune_ratio must be in [0, 1)");
   if (max_states < 1) return fail("max_states must be >= 1");
   if (!(outside_mass_tolerance >= 0.0f && std::isfinite(outside_mass_tolerance))) {
@@ -58,12 +61,12 @@ BeamContext::BeamContext(int num_states, const BeamParams& beam, int max_steps_p
   const std::size_t list = std::min(
       size, static_cast<std::size_t>(beam.max_states) *
                     (1 + 2 * static_cast<std::size_t>(std::max(1, max_steps_per_frame))) +
-                static_cast<std::size_t>(beam.jump_candidates));
+                static_cast<std::size_t>(beam.wide_jump_candidates));
   beam_.reserve(list);
   next_.reserve(list);
   weighted_.assign(list, 0.0f);
-  candidates_.assign(static_cast<std::size_t>(beam.jump_candidates), 0);
-  candidate_d2_.assign(static_cast<std::size_t>(beam.jump_candidates), 0.0f);
+  candidates_.assign(static_cast<std::size_t>(beam.wide_jump_candidates), 0);
+  candidate_d2_.assign(static_cast<std::size_t>(beam.wide_jump_candidates), 0.0f);
   reset();
 }
 
@@ -146,7 +149,7 @@ void BeamForward::sparse_transition(const BandProbabilities& band,
   context.beam_.swap(context.next_);
 }
 
-bool BeamForward::sparse_emission(const float* phi, BeamContext& context,
+bool BeamForward::sparse_emission(const float* phi, int wanted, BeamContext& context,
                                   FollowResult& result) const noexcept {
   const TemplateModel& model = *exact_.model_;
   const int num_states = model.num_states();
@@ -156,7 +159,7 @@ bool BeamForward::sparse_emission(const float* phi, BeamContext& context,
 
   // The jump candidates, merged into the beam (both sorted) in next_.
   float bound = 0.0f;
-  const int found = index_.nearest(phi, beam_.jump_candidates, context.candidates_.data(),
+  const int found = index_.nearest(phi, wanted, context.candidates_.data(),
                                    context.candidate_d2_.data(), bound);
   std::uint32_t* candidates = context.candidates_.data();
   std::sort(candidates, candidates + found);
@@ -184,7 +187,7 @@ bool BeamForward::sparse_emission(const float* phi, BeamContext& context,
   }
   // Lost is decided on the best distance of the whole library; states left out are >= bound.
   const float lost_sq = exact_.lost_distance_sq_;
-  if (found == beam_.jump_candidates && best > lost_sq && bound <= lost_sq) return false;
+  if (found == wanted && best > lost_sq && bound <= lost_sq) return false;
 
   const float log_pause = exact_.log_pause_emission_;
   const bool jump = params.jump_enabled;
@@ -204,7 +207,7 @@ bool BeamForward::sparse_emission(const float* phi, BeamContext& context,
   // Mass the states left out may carry: their prediction is the background, their emission at
   // most the bound's.
   const double outside =
-      found == beam_.jump_candidates
+      found == wanted
           ? static_cast<double>(background) *
                 std::exp(static_cast<double>(log_emission(bound, inv_two_sigma_sq) - shift))
           : 0.0;
@@ -336,8 +339,10 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   }
 
   if (!result.missing) {
-    if (!dense && !sparse_emission(features.data(), context, result)) {
-      // The beam may have lost the dancer: finish the frame with the full step.
+    // Uncertain with the usual candidates: widen the search; still uncertain, the beam may have
+    // lost the dancer: finish the frame with the full step.
+    if (!dense && !sparse_emission(features.data(), beam_.jump_candidates, context, result) &&
+        !sparse_emission(features.data(), beam_.wide_jump_candidates, context, result)) {
       materialise(context);
       dense = true;
     }

@@ -55,24 +55,34 @@ Result<JumpCandidateIndex> JumpCandidateIndex::build(const TemplateModel& model)
   auto impl = std::make_unique<Impl>();
   impl->posture_dims = posture;
   const auto features = model.features().leftCols(posture);
+  const Eigen::Index rows = features.rows();
   impl->mean = features.colwise().mean().transpose();
-  // Principal axes of the posture features (double for the covariance of up to 1M rows).
-  const Eigen::MatrixXd centred =
-      (features.rowwise() - impl->mean.transpose()).cast<double>();
-  const Eigen::MatrixXd covariance =
-      (centred.adjoint() * centred) / static_cast<double>(std::max<Eigen::Index>(1, features.rows()));
+  // Principal axes of the posture features. The covariance is summed in double over chunks of
+  // rows, so that a library of 1M states needs no centred copy of its features.
+  constexpr Eigen::Index kChunk = 4096;
+  Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(posture, posture);
+  Eigen::MatrixXd chunk;
+  for (Eigen::Index begin = 0; begin < rows; begin += kChunk) {
+    const Eigen::Index n = std::min(kChunk, rows - begin);
+    chunk = (features.middleRows(begin, n).rowwise() - impl->mean.transpose()).cast<double>();
+    covariance.noalias() += chunk.adjoint() * chunk;
+  }
+  covariance /= static_cast<double>(rows);
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(covariance);
   impl->axes.setZero(kDims, posture);
   for (int k = 0; k < std::min(kDims, posture); ++k) {
     // Eigenvalues ascend: the largest variance last.
     impl->axes.row(k) = solver.eigenvectors().col(posture - 1 - k).transpose().cast<float>();
   }
-  const int rows = model.num_states();
   impl->points.values.resize(static_cast<std::size_t>(rows) * kDims);
   Eigen::Map<Eigen::Matrix<float, Eigen::Dynamic, kDims, Eigen::RowMajor>> projected(
       impl->points.values.data(), rows, kDims);
-  projected.noalias() =
-      (features.rowwise() - impl->mean.transpose()) * impl->axes.transpose();
+  for (Eigen::Index begin = 0; begin < rows; begin += kChunk) {
+    const Eigen::Index n = std::min(kChunk, rows - begin);
+    projected.middleRows(begin, n).noalias() =
+        (features.middleRows(begin, n).rowwise() - impl->mean.transpose()) *
+        impl->axes.transpose();
+  }
   impl->tree = std::make_unique<Tree>(kDims, impl->points,
                                       nanoflann::KDTreeSingleIndexAdaptorParams(16));
   return JumpCandidateIndex(std::move(impl));

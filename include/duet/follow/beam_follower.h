@@ -34,8 +34,11 @@
 namespace duet {
 
 struct BeamParams {
-  // Jump candidates per frame: the states nearest the input in the index's projection.
-  int jump_candidates = 64;
+  // Jump candidates per frame: the states nearest the input in the index's projection. When
+  // they leave the frame uncertain (see above), the search is widened to wide_jump_candidates
+  // before the full step is taken.
+  int jump_candidates = 16;
+  int wide_jump_candidates = 256;
   // A state leaves the beam when its posterior is below this times the largest one.
   float prune_ratio = 1e-8f;
   // Above this many states the next frame is a full step (a beam this wide saves nothing).
@@ -114,7 +117,8 @@ class BeamForward {
   void sparse_transition(const BandProbabilities& band, BeamContext& context) const noexcept;
   // Emission over the beam and the jump candidates; false (context unchanged but for next_)
   // when the full step must finish the frame.
-  bool sparse_emission(const float* phi, BeamContext& context, FollowResult& result) const noexcept;
+  bool sparse_emission(const float* phi, int candidates, BeamContext& context,
+                       FollowResult& result) const noexcept;
   // Adds the background to every state (the dense prediction of the full step).
   void materialise(BeamContext& context) const noexcept;
   void full_emission(const float* phi, BeamContext& context, FollowResult& result) const noexcept;
