@@ -98,7 +98,12 @@ Result<BeamForward> BeamForward::create(const TemplateModel& model, const Follow
   if (!exact) return exact.error();
   Result<JumpCandidateIndex> index = JumpCandidateIndex::build(model);
   if (!index) return index.error();
-  return BeamForward(std::move(exact).value(), std::move(index).value(), beam);
+  BeamForward forward(std::move(exact).value(), std::move(index).value(), beam);
+  forward.max_resume_share_ = 1.0f / static_cast<float>(model.num_states());
+  for (const float r : forward.exact_.resume_) {
+    forward.max_resume_share_ = std::max(forward.max_resume_share_, r);
+  }
+  return forward;
 }
 
 float BeamForward::resume_share(int i) const noexcept {
@@ -204,19 +209,28 @@ bool BeamForward::sparse_emission(const float* phi, int wanted, BeamContext& con
   }
   const float pause = jump ? alpha[num_states] * std::exp(log_pause - shift) : 0.0f;
   sum += pause;
-  // Mass the states left out may carry: their prediction is the background, their emission at
-  // most the bound's.
-  const double outside =
-      found == wanted
-          ? static_cast<double>(background) *
-                std::exp(static_cast<double>(log_emission(bound, inv_two_sigma_sq) - shift))
-          : 0.0;
-  if (!(sum >= kMinNormaliser) || outside > beam_.outside_mass_tolerance * sum) return false;
+  // The states left out: their prediction is the background, their emission at most the
+  // bound's. Their total is spread over up to M states, so it only matters where it could change
+  // a decision: the maximum, the confidence window, the pause state's majority.
+  float largest = 0.0f;
+  for (std::size_t k = 0; k < count; ++k) largest = std::max(largest, weighted[k]);
+  if (found == wanted) {
+    const double emitted =
+        std::exp(static_cast<double>(log_emission(bound, inv_two_sigma_sq) - shift));
+    const double outside_total = static_cast<double>(background) * emitted;
+    const double outside_state = static_cast<double>(background) * max_resume_share_ * emitted;
+    const double window = 2.0 * params.confidence_window_frames + 1.0;
+    const bool in_pause = pause > 0.5 * sum;
+    if (outside_state >= static_cast<double>(largest) ||
+        outside_state * window > beam_.outside_mass_tolerance * sum ||
+        in_pause != (pause > 0.5 * (sum + outside_total))) {
+      return false;
+    }
+  }
+  if (!(sum >= kMinNormaliser)) return false;
 
   // Accepted: the posterior over the merged states; those below the threshold leave the beam.
   const float scale = static_cast<float>(1.0 / sum);
-  float largest = 0.0f;
-  for (std::size_t k = 0; k < count; ++k) largest = std::max(largest, weighted[k]);
   const float threshold = largest * beam_.prune_ratio;
   context.beam_.clear();
   for (std::size_t k = 0; k < count; ++k) {

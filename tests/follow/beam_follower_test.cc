@@ -89,14 +89,14 @@ TEST_F(BeamTest, MissingAndSlowFramesAsTheExactStep) {
   }
 }
 
-TEST_F(BeamTest, AFarDancerIsLostWithoutTheFullStep) {
+TEST_F(BeamTest, AFarDancerTakesTheFullStepAndIsFoundAgain) {
   BeamFollower beam = BeamFollower::create(model_, {}).value();
   HmmFollower exact = HmmFollower::create(model_, {}).value();
   for (int t = 0; t < 60; ++t) {
     beam.step(inputs_[static_cast<std::size_t>(t)], 1.0 / 60);
     exact.step(inputs_[static_cast<std::size_t>(t)], 1.0 / 60);
   }
-  // Every state is beyond the index's bound, so the lost decision needs no other emission.
+  // Every state is about as far: any of those the index left out could hold the maximum.
   const long long full_before = beam.context().full_steps();
   const std::vector<float> far(kDims, 50.0f);
   for (int t = 0; t < 5; ++t) {
@@ -106,7 +106,7 @@ TEST_F(BeamTest, AFarDancerIsLostWithoutTheFullStep) {
     EXPECT_EQ(b.state, e.state);
     EXPECT_TRUE(std::isfinite(b.log_likelihood));
   }
-  EXPECT_EQ(beam.context().full_steps(), full_before);
+  EXPECT_GT(beam.context().full_steps(), full_before);
   // Back on the template: the jump candidates find the dancer again, as the exact step does.
   for (int t = 60; t < 120; ++t) {
     const FollowResult b = beam.step(inputs_[static_cast<std::size_t>(t)], 1.0 / 60);

@@ -8,10 +8,14 @@
 //     (1 - A_NN) * alpha(N) * R_i. That share is kept as one number (the background), so the
 //     pause state's mass is accounted exactly; the background reaches the emission only at the
 //     beam and the jump candidates.
-//   - Every state left out is at least the index's bound away from the input, so the mass it would
-//     have carried is bounded. When that bound is not negligible against the kept mass, or the
-//     lost decision depends on states left out, or the beam grows past BeamParams::max_states,
+//   - Every state left out is at least the index's bound away from the input, so the mass each
+//     would have carried is bounded (the background's share times the bound's emission). When
+//     that could change a decision (the maximum, the confidence, the pause state's majority, or
+//     lost: the best distance of the library), or the beam grows past BeamParams::max_states,
 //     the frame is finished by the full (exact) step, and the beam is rebuilt from its posterior.
+//     Otherwise the posterior is normalised over the states kept: the left-out mass (spread over
+//     the far states, where the exact step keeps it below a per-state bound) is dropped, and the
+//     frame's log-likelihood misses it.
 //   - States whose posterior falls below prune_ratio times the maximum leave the beam.
 // The first frame after reset() is a full step (the initial distribution is uniform).
 #pragma once
@@ -38,14 +42,15 @@ struct BeamParams {
   // they leave the frame uncertain (see above), the search is widened to wide_jump_candidates
   // before the full step is taken.
   int jump_candidates = 16;
-  int wide_jump_candidates = 256;
+  int wide_jump_candidates = 128;
   // A state leaves the beam when its posterior is below this times the largest one.
   float prune_ratio = 1e-8f;
   // Above this many states the next frame is a full step (a beam this wide saves nothing).
   int max_states = 4096;
-  // A full step finishes the frame when the mass the left-out states may carry exceeds this
-  // fraction of the kept mass.
-  float outside_mass_tolerance = 1e-4f;
+  // A full step finishes the frame when the mass the left-out states may carry within one
+  // confidence window exceeds this fraction of the kept mass (or could be the maximum, or could
+  // turn the pause state's majority).
+  float outside_mass_tolerance = 1e-3f;
 
   Status validate() const;
 };
@@ -129,6 +134,7 @@ class BeamForward {
   HmmForward exact_;
   JumpCandidateIndex index_;
   BeamParams beam_;
+  float max_resume_share_ = 0.0f;  // max_i R_i
 };
 
 // BeamForward + BeamContext behind the Tracker interface.
