@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -23,6 +24,7 @@
 
 #include "duet/follow/beam_follower.h"
 #include "duet/follow/hmm_follower.h"
+#include "duet/follow/model_cache.h"
 #include "duet/follow/synthetic_library.h"
 #include "duet/live/duet_library.h"
 
@@ -189,6 +191,39 @@ BENCHMARK(BM_BeamStepAtScale)
     ->Arg(1000000)
     ->Iterations(6000)
     ->Unit(benchmark::kMicrosecond);
+
+// Start-up from the model cache file: map it, check it, copy the features into the model (which
+// blocks them for the AVX2 kernel), load the jump candidate index and create the beam follower.
+// The cache is written once beforehand (in the temporary directory, removed afterwards).
+void BM_StartUpFromCache(benchmark::State& state) {
+  const TemplateModel* model = library_of(static_cast<int>(state.range(0)));
+  if (model == nullptr) {
+    state.SkipWithError("salsa data not found");
+    return;
+  }
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "duet_beam_bench.model").string();
+  {
+    const JumpCandidateIndex index = JumpCandidateIndex::build(*model).value();
+    if (!write_model_cache(path, *model, index, 1).ok()) {
+      state.SkipWithError("cannot write the cache");
+      return;
+    }
+  }
+  for (auto _ : state) {
+    Result<CachedModel> cached = read_model_cache(path, 1);
+    if (!cached) {
+      state.SkipWithError(cached.error().message.c_str());
+      break;
+    }
+    CachedModel& c = cached.value();
+    Result<BeamFollower> beam = BeamFollower::create(c.model, {}, {}, std::move(c.index));
+    benchmark::DoNotOptimize(beam.ok());
+  }
+  state.counters["cache_mb"] = static_cast<double>(std::filesystem::file_size(path)) / 1e6;
+  std::filesystem::remove(path);
+}
+BENCHMARK(BM_StartUpFromCache)->Arg(1000000)->Iterations(3)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace duet

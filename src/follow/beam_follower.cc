@@ -94,11 +94,22 @@ void BeamContext::reset() noexcept {
 Result<BeamForward> BeamForward::create(const TemplateModel& model, const FollowParams& params,
                                         const BeamParams& beam) {
   if (Status status = beam.validate(); !status.ok()) return status.error();
-  Result<HmmForward> exact = HmmForward::create(model, params);
-  if (!exact) return exact.error();
   Result<JumpCandidateIndex> index = JumpCandidateIndex::build(model);
   if (!index) return index.error();
-  BeamForward forward(std::move(exact).value(), std::move(index).value(), beam);
+  return create(model, params, beam, std::move(index).value());
+}
+
+Result<BeamForward> BeamForward::create(const TemplateModel& model, const FollowParams& params,
+                                        const BeamParams& beam, JumpCandidateIndex index) {
+  if (Status status = beam.validate(); !status.ok()) return status.error();
+  if (index.num_states() != model.num_states()) {
+    return make_error("beam follower", 0,
+                      "jump candidate index of " + std::to_string(index.num_states()) +
+                          " states for a model of " + std::to_string(model.num_states()));
+  }
+  Result<HmmForward> exact = HmmForward::create(model, params);
+  if (!exact) return exact.error();
+  BeamForward forward(std::move(exact).value(), std::move(index), beam);
   forward.max_resume_share_ = 1.0f / static_cast<float>(model.num_states());
   for (const float r : forward.exact_.resume_) {
     forward.max_resume_share_ = std::max(forward.max_resume_share_, r);
@@ -414,6 +425,14 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
 Result<BeamFollower> BeamFollower::create(const TemplateModel& model, const FollowParams& params,
                                           const BeamParams& beam) {
   Result<BeamForward> forward = BeamForward::create(model, params, beam);
+  if (!forward.ok()) return forward.error();
+  return BeamFollower(std::move(forward).value(),
+                      BeamContext(model.num_states(), beam, params.max_steps_per_frame));
+}
+
+Result<BeamFollower> BeamFollower::create(const TemplateModel& model, const FollowParams& params,
+                                          const BeamParams& beam, JumpCandidateIndex index) {
+  Result<BeamForward> forward = BeamForward::create(model, params, beam, std::move(index));
   if (!forward.ok()) return forward.error();
   return BeamFollower(std::move(forward).value(),
                       BeamContext(model.num_states(), beam, params.max_steps_per_frame));

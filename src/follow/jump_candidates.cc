@@ -4,6 +4,8 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <istream>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -103,6 +105,69 @@ int JumpCandidateIndex::nearest(const float* phi, int k, std::uint32_t* states,
   const int found = static_cast<int>(result.size());
   bound = found == k ? result.worstDist() : 0.0f;
   return found;
+}
+
+namespace {
+
+template <class T>
+void write_array(std::ostream& out, const T* data, std::size_t count) {
+  out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(count * sizeof(T)));
+}
+
+template <class T>
+bool read_array(std::istream& in, T* data, std::size_t count) {
+  in.read(reinterpret_cast<char*>(data), static_cast<std::streamsize>(count * sizeof(T)));
+  return static_cast<bool>(in);
+}
+
+}  // namespace
+
+void JumpCandidateIndex::save(std::ostream& out) const {
+  const Impl& impl = *impl_;
+  const std::int32_t header[2] = {impl.posture_dims,
+                                  static_cast<std::int32_t>(impl.points.kdtree_get_point_count())};
+  write_array(out, header, 2);
+  write_array(out, impl.mean.data(), static_cast<std::size_t>(impl.mean.size()));
+  write_array(out, impl.axes.data(), static_cast<std::size_t>(impl.axes.size()));
+  write_array(out, impl.points.values.data(), impl.points.values.size());
+  impl.tree->saveIndex(out);
+}
+
+Result<JumpCandidateIndex> JumpCandidateIndex::load(std::istream& in, int num_states,
+                                                    int posture_dims) {
+  auto fail = [](const std::string& what) {
+    return make_error("jump candidate index", 0, what);
+  };
+  std::int32_t header[2] = {0, 0};
+  if (!read_array(in, header, 2)) return fail("truncated before its sizes");
+  if (header[0] != posture_dims || header[1] != num_states) {
+    return fail("built for " + std::to_string(header[1]) + " states x " +
+                std::to_string(header[0]) + " posture dimensions, the model has " +
+                std::to_string(num_states) + " x " + std::to_string(posture_dims));
+  }
+  auto impl = std::make_unique<Impl>();
+  impl->posture_dims = posture_dims;
+  impl->mean.resize(posture_dims);
+  impl->axes.resize(kDims, posture_dims);
+  impl->points.values.resize(static_cast<std::size_t>(num_states) * kDims);
+  if (!read_array(in, impl->mean.data(), static_cast<std::size_t>(posture_dims)) ||
+      !read_array(in, impl->axes.data(), static_cast<std::size_t>(impl->axes.size())) ||
+      !read_array(in, impl->points.values.data(), impl->points.values.size())) {
+    return fail("truncated in its projection");
+  }
+  impl->tree = std::make_unique<Tree>(
+      kDims, impl->points,
+      nanoflann::KDTreeSingleIndexAdaptorParams(
+          16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex));
+  impl->tree->loadIndex(in);
+  if (!in || impl->tree->vAcc.size() != static_cast<std::size_t>(num_states)) {
+    return fail("truncated or damaged in its tree");
+  }
+  return JumpCandidateIndex(std::move(impl));
+}
+
+int JumpCandidateIndex::num_states() const noexcept {
+  return static_cast<int>(impl_->points.kdtree_get_point_count());
 }
 
 std::size_t JumpCandidateIndex::memory_bytes() const noexcept {

@@ -105,6 +105,9 @@ class BeamForward {
   // Validates the parameters and builds the jump candidate index (allocates, O(M log M)).
   static Result<BeamForward> create(const TemplateModel& model, const FollowParams& params,
                                     const BeamParams& beam = {});
+  // The same with an index already built for this model (e.g. read from the model cache).
+  static Result<BeamForward> create(const TemplateModel& model, const FollowParams& params,
+                                    const BeamParams& beam, JumpCandidateIndex index);
 
   // One input frame, as HmmForward::step. Allocates nothing, throws nothing.
   FollowResult step(std::span<const float> features, double dt_s,
@@ -142,6 +145,8 @@ class BeamFollower final : public Tracker {
  public:
   static Result<BeamFollower> create(const TemplateModel& model, const FollowParams& params,
                                      const BeamParams& beam = {});
+  static Result<BeamFollower> create(const TemplateModel& model, const FollowParams& params,
+                                     const BeamParams& beam, JumpCandidateIndex index);
 
   void reset() noexcept override { context_.reset(); }
   FollowResult step(std::span<const float> features, double dt_s) noexcept override {

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <iosfwd>
 #include <memory>
 
 #include "duet/base/result.h"
@@ -36,6 +37,14 @@ class JumpCandidateIndex {
               float& bound) const noexcept;
 
   std::size_t memory_bytes() const noexcept;
+  int num_states() const noexcept;
+
+  // The index as bytes (projection, projected points and tree), for the model cache
+  // (model_cache.h). The stream is native-endian and only for this build's readers.
+  void save(std::ostream& out) const;
+  // An index saved by save() for a model of num_states states with posture_dims posture
+  // dimensions; an error when the bytes do not describe one.
+  static Result<JumpCandidateIndex> load(std::istream& in, int num_states, int posture_dims);
 
  private:
   struct Impl;
