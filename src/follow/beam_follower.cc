@@ -386,6 +386,9 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
       alpha[num_states] *= scale;
       context.background_ *= scale;
     }
+    // Unpruned, the beam spreads along the band while frames are missing; too wide, the next
+    // frame is a full step (which also keeps the buffers within their reserved size).
+    if (static_cast<int>(context.beam_.size()) > beam_.max_states) context.full_next_ = true;
     result.best_distance_per_dim = -1.0f;
   }
 

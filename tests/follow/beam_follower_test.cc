@@ -128,6 +128,31 @@ TEST_F(BeamTest, ABeamTooWideFallsBackToTheFullStepWithTheSameStates) {
   EXPECT_GT(beam.context().full_steps() * 2, beam.context().frames());
 }
 
+TEST_F(BeamTest, ALongGapWidensTheBeamIntoAFullStepAndTheEstimatesAreTheSameAfterIt) {
+  HmmFollower exact = HmmFollower::create(model_, {}).value();
+  BeamParams small;
+  small.max_states = 32;
+  BeamFollower beam = BeamFollower::create(model_, {}, small).value();
+  const std::vector<float> missing(kDims, std::numeric_limits<float>::quiet_NaN());
+  for (std::size_t t = 0; t < 60; ++t) {
+    ASSERT_EQ(exact.step(inputs_[t], 1.0 / 60).state, beam.step(inputs_[t], 1.0 / 60).state);
+  }
+  const long long full_before = beam.context().full_steps();
+  for (int t = 0; t < 40; ++t) {  // 40 frames of 8 template steps with no evidence
+    // The mass spreads until the posterior is nearly flat (its maximum then is float noise, in
+    // the exact step as in the beam): only the flags are compared.
+    const FollowResult e = exact.step(missing, 8.0 / 60);
+    const FollowResult b = beam.step(missing, 8.0 / 60);
+    EXPECT_TRUE(e.missing && b.missing);
+    EXPECT_EQ(e.lost, b.lost);
+  }
+  EXPECT_GT(beam.context().full_steps(), full_before);
+  for (std::size_t t = 60; t < 200; ++t) {
+    ASSERT_EQ(exact.step(inputs_[t], 1.0 / 60).state, beam.step(inputs_[t], 1.0 / 60).state)
+        << "frame " << t;
+  }
+}
+
 TEST_F(BeamTest, LeftToRightAsTheExactStep) {
   HmmFollower exact = HmmFollower::create(model_, FollowParams::left_to_right()).value();
   BeamFollower beam = BeamFollower::create(model_, FollowParams::left_to_right()).value();
