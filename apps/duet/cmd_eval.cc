@@ -322,7 +322,7 @@ Command register_eval(CLI::App& app) {
                  "nearest, online-dtw, naive-hmm (O(M^2), run on the first take alone)")
       ->delimiter(',');
   app.add_flag("--beam", args->beam,
-               "Run the hmm, hmm-paper and left-to-right trackers in beam mode (docs/follower.md "
+               "Run the hmm and hmm-paper trackers in beam mode (docs/follower.md "
                "\"Beam mode\"; the partner metrics keep the exact step)");
   app.add_option("--seed", args->seed, "Seed of every random choice (same seed, same numbers)");
   app.add_option("--csv", args->csv_path, "Write the metrics per case, tracker and take as CSV");

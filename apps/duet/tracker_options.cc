@@ -34,7 +34,7 @@ void add_tracker_options(CLI::App& app, TrackerArgs& args) {
                "Keep the HMM's band at the template's tempo instead of centring it on the "
                "dancer's tempo (the paper preset always keeps it fixed)");
   app.add_flag("--beam", args.beam,
-               "Beam mode of the hmm and left-to-right trackers: emissions only for the states "
+               "Beam mode of the hmm tracker: emissions only for the states "
                "that carry mass and the jump candidates nearest the input, with a full step when "
                "the beam may have lost the dancer (docs/follower.md \"Beam mode\")");
 }
@@ -44,15 +44,14 @@ Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args,
   FollowParams params = args.preset == "paper" ? FollowParams::paper() : FollowParams{};
   if (args.sigma) params.emission_sigma = *args.sigma;
   if (args.fixed_band) params.tempo_adaptive = false;
-  if (args.beam && args.kind != "hmm" && args.kind != "left-to-right") {
-    return make_error("--beam", 0, "beam mode is for the hmm and left-to-right trackers, not '" +
-                                       args.kind + "'");
+  if (args.beam && args.kind != "hmm") {
+    return make_error("--beam", 0, "beam mode is for the hmm tracker, not '" + args.kind + "'");
   }
   if (args.kind == "nearest") return boxed(NearestNeighbourTracker::create(model, params));
   if (args.kind == "dtw") return boxed(OnlineDtwTracker::create(model, OnlineDtwParams{}));
   if (args.kind == "naive") return boxed(NaiveHmmFollower::create(model, params));
   if (args.kind == "left-to-right") params.jump_enabled = false;
-  if (args.beam) return boxed(BeamFollower::create(model, params));
+  if (args.beam) return boxed(BeamFollower::create(model, params, BeamParams::suited_to(params)));
   return boxed(HmmFollower::create(model, params));
 }
 

@@ -269,10 +269,12 @@ std::vector<TrackerKind> all_tracker_kinds() {
 
 namespace {
 
-// The HMM follower, in beam mode when EvalOptions::beam asks for it.
+// The jump HMM, in beam mode when EvalOptions::beam asks for it.
 Result<std::unique_ptr<Tracker>> hmm_tracker(const TemplateModel& model, const FollowParams& params,
                                              const EvalOptions& options) {
-  if (options.beam) return boxed(BeamFollower::create(model, params));
+  if (options.beam) {
+    return boxed(BeamFollower::create(model, params, BeamParams::suited_to(params)));
+  }
   return boxed(HmmFollower::create(model, params));
 }
 
@@ -297,7 +299,7 @@ Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const Templ
       FollowParams params = options.hmm;
       params.jump_enabled = false;
       params.resume_weights.clear();
-      return hmm_tracker(model, params, options);
+      return boxed(HmmFollower::create(model, params));  // no beam mode without the pause state
     }
     case TrackerKind::kNearestNeighbour:
       return boxed(NearestNeighbourTracker::create(model, options.hmm));

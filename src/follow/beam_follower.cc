@@ -31,6 +31,12 @@ float emission_distance(const TemplateModel& model, const float* phi, int i,
   return std::min(posture_d2 + std::min(velocity_d2, velocity_cap), FLT_MAX);
 }
 
+Error left_to_right_error() {
+  return make_error("beam follower", 0,
+                    "beam mode needs the jump HMM's pause state; the left-to-right HMM runs "
+                    "only with the exact step");
+}
+
 }  // namespace
 
 Status BeamParams::validate() const {
@@ -45,6 +51,12 @@ Status BeamParams::validate() const {
     return fail("outside_mass_tolerance must be finite and >= 0");
   }
   return Ok{};
+}
+
+BeamParams BeamParams::suited_to(const FollowParams& params) {
+  BeamParams beam;
+  if (!params.tempo_adaptive || params.skip_prob == 0.0f) beam.prune_ratio = 1e-20f;
+  return beam;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -94,6 +106,7 @@ void BeamContext::reset() noexcept {
 Result<BeamForward> BeamForward::create(const TemplateModel& model, const FollowParams& params,
                                         const BeamParams& beam) {
   if (Status status = beam.validate(); !status.ok()) return status.error();
+  if (!params.jump_enabled) return left_to_right_error();
   Result<JumpCandidateIndex> index = JumpCandidateIndex::build(model);
   if (!index) return index.error();
   return create(model, params, beam, std::move(index).value());
@@ -102,6 +115,7 @@ Result<BeamForward> BeamForward::create(const TemplateModel& model, const Follow
 Result<BeamForward> BeamForward::create(const TemplateModel& model, const FollowParams& params,
                                         const BeamParams& beam, JumpCandidateIndex index) {
   if (Status status = beam.validate(); !status.ok()) return status.error();
+  if (!params.jump_enabled) return left_to_right_error();
   if (index.num_states() != model.num_states()) {
     return make_error("beam follower", 0,
                       "jump candidate index of " + std::to_string(index.num_states()) +

@@ -153,13 +153,21 @@ TEST_F(BeamTest, ALongGapWidensTheBeamIntoAFullStepAndTheEstimatesAreTheSameAfte
   }
 }
 
-TEST_F(BeamTest, LeftToRightAsTheExactStep) {
-  HmmFollower exact = HmmFollower::create(model_, FollowParams::left_to_right()).value();
-  BeamFollower beam = BeamFollower::create(model_, FollowParams::left_to_right()).value();
-  for (std::size_t t = 0; t < 120; ++t) {
+TEST_F(BeamTest, PaperPresetAsTheExactStep) {
+  const FollowParams paper = FollowParams::paper();
+  HmmFollower exact = HmmFollower::create(model_, paper).value();
+  BeamFollower beam = BeamFollower::create(model_, paper, BeamParams::suited_to(paper)).value();
+  EXPECT_EQ(BeamParams::suited_to(paper).prune_ratio, 1e-20f);
+  for (std::size_t t = 0; t < inputs_.size(); ++t) {
     ASSERT_EQ(exact.step(inputs_[t], 1.0 / 60).state, beam.step(inputs_[t], 1.0 / 60).state)
         << "frame " << t;
   }
+}
+
+TEST_F(BeamTest, RejectsTheLeftToRightHmm) {
+  Result<BeamFollower> beam = BeamFollower::create(model_, FollowParams::left_to_right());
+  ASSERT_FALSE(beam);
+  EXPECT_NE(beam.error().message.find("pause state"), std::string::npos);
 }
 
 TEST(BeamParamsTest, RejectsBadParameters) {

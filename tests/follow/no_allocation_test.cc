@@ -81,8 +81,11 @@ TEST(NoAllocation, StepsAllocateNothing) {
   NearestNeighbourTracker nn = NearestNeighbourTracker::create(model, {}).value();
   OnlineDtwTracker dtw = OnlineDtwTracker::create(model, {}).value();
   BeamFollower beam = BeamFollower::create(model, {}).value();
-  BeamFollower beam_l2r = BeamFollower::create(model, FollowParams::left_to_right()).value();
-  Tracker* trackers[] = {&hmm, &l2r, &hmm_sharp, &naive, &nn, &dtw, &beam, &beam_l2r};
+  BeamFollower beam_paper =
+      BeamFollower::create(model, FollowParams::paper(),
+                           BeamParams::suited_to(FollowParams::paper()))
+          .value();
+  Tracker* trackers[] = {&hmm, &l2r, &hmm_sharp, &naive, &nn, &dtw, &beam, &beam_paper};
 
   // Inputs made beforehand: exact, noisy, missing, far, at 30 Hz and late.
   std::vector<std::vector<float> > inputs;

@@ -18,6 +18,9 @@
 //     frame's log-likelihood misses it.
 //   - States whose posterior falls below prune_ratio times the maximum leave the beam.
 // The first frame after reset() is a full step (the initial distribution is uniform).
+// Only for the jump HMM: a left-to-right HMM (no pause state) recovers from a wrong place only
+// through the little mass it keeps everywhere, which a beam drops (measured: up to 2.4 points of
+// accuracy apart even at a prune ratio of 1e-20), so create() rejects it.
 #pragma once
 
 #include <cstdint>
@@ -53,6 +56,12 @@ struct BeamParams {
   float outside_mass_tolerance = 1e-3f;
 
   Status validate() const;
+
+  // The defaults, with the pruning deepened to 1e-20 for a fixed band or a band without skip
+  // (the paper preset): such a band lags behind a faster dancer and its estimate rides on mass
+  // far below the maximum. Measured with `duet eval --trackers hmm-paper --beam`: up to 11 points
+  // of accuracy lost at 1e-8, 0.8 at 1e-14, at most 0.13 at 1e-20 (docs/follower.md).
+  static BeamParams suited_to(const FollowParams& params);
 };
 
 // State between frames: the dense forward variable (zero outside the beam), the beam's states
@@ -152,9 +161,7 @@ class BeamFollower final : public Tracker {
   FollowResult step(std::span<const float> features, double dt_s) noexcept override {
     return forward_.step(features, dt_s, context_);
   }
-  std::string_view name() const noexcept override {
-    return forward_.exact().params().jump_enabled ? "hmm" : "left_to_right_hmm";
-  }
+  std::string_view name() const noexcept override { return "hmm"; }
 
   const BeamForward& forward() const { return forward_; }
   const BeamContext& context() const { return context_; }
