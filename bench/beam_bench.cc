@@ -8,6 +8,7 @@
 // alone, --benchmark_filter='/1000000', for the memory of that size: rss_mb is the process's
 // resident memory while it runs; the real library's motion is not kept).
 #include <benchmark/benchmark.h>
+#include <immintrin.h>
 #include <malloc.h>
 
 #include <algorithm>
@@ -191,6 +192,35 @@ BENCHMARK(BM_BeamStepAtScale)
     ->Arg(1000000)
     ->Iterations(6000)
     ->Unit(benchmark::kMicrosecond);
+
+// The memory floor of the exact step: reading the features once per frame. An AVX2 sum (four
+// accumulators) over a buffer the size of the features at 27,495 states (5.5 MB, in L3) and at 1M
+// states (200 MB, from DRAM); bytes_per_second gives the floor in ns per state (200 bytes at
+// D = 50). Skipped on a CPU without AVX2.
+__attribute__((target("avx2"))) float sum_avx2(const float* data, std::size_t floats) {
+  __m256 a = _mm256_setzero_ps(), b = a, c = a, d = a;
+  for (std::size_t i = 0; i + 32 <= floats; i += 32) {
+    a = _mm256_add_ps(a, _mm256_loadu_ps(data + i));
+    b = _mm256_add_ps(b, _mm256_loadu_ps(data + i + 8));
+    c = _mm256_add_ps(c, _mm256_loadu_ps(data + i + 16));
+    d = _mm256_add_ps(d, _mm256_loadu_ps(data + i + 24));
+  }
+  alignas(32) float out[8];
+  _mm256_store_ps(out, _mm256_add_ps(_mm256_add_ps(a, b), _mm256_add_ps(c, d)));
+  return out[0] + out[1] + out[2] + out[3] + out[4] + out[5] + out[6] + out[7];
+}
+
+void BM_ReadBandwidth(benchmark::State& state) {
+  if (!__builtin_cpu_supports("avx2")) {
+    state.SkipWithError("no AVX2 on this CPU");
+    return;
+  }
+  const auto floats = static_cast<std::size_t>(state.range(0)) / sizeof(float);
+  std::vector<float> buffer(floats, 1.0f);
+  for (auto _ : state) benchmark::DoNotOptimize(sum_avx2(buffer.data(), floats));
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * state.range(0));
+}
+BENCHMARK(BM_ReadBandwidth)->Arg(27495 * 200)->Arg(1000000 * 200)->Unit(benchmark::kMicrosecond);
 
 // Start-up from the model cache file: map it, check it, copy the features into the model (which
 // blocks them for the AVX2 kernel), load the jump candidate index and create the beam follower.
