@@ -34,6 +34,7 @@ struct EvalArgs {
   std::string plots_dir;
   std::string trace_case = "improv-pause";
   bool no_partner_metrics = false;
+  bool beam = false;
   std::string partner_csv_path;
   CaseSettings settings;
   double noise_cm = 1.0;
@@ -177,6 +178,7 @@ int run_eval(EvalArgs& args) {
     return usage_error("--partner-csv needs the partner metrics (leave out --no-partner-metrics)");
   }
   options.partner_metrics = !args.no_partner_metrics;
+  options.beam = args.beam;
   options.takes = args.takes;
   options.seed = args.seed;
   options.trace_case = args.plots_dir.empty() ? "" : args.trace_case;
@@ -366,6 +368,9 @@ Command register_eval(CLI::App& app) {
   app.add_option("--point-noise-deg", args->point_noise_deg,
                  "Three points: orientation noise of each point, RMS degrees (default 1)")
       ->check(number_between(0.0, 45.0, "point noise"));
+  app.add_flag("--beam", args->beam,
+               "Run the hmm and hmm-paper trackers in beam mode (docs/follower.md "
+               "\"Beam mode\"; the partner metrics keep the exact step)");
   app.add_option("--seed", args->seed, "Seed of every random choice (same seed, same numbers)");
   app.add_option("--csv", args->csv_path, "Write the metrics per case, tracker and take as CSV");
   app.add_option("--frames-csv", args->frames_csv_path,

@@ -1,5 +1,6 @@
 #include "tracker_options.h"
 
+#include "duet/follow/beam_follower.h"
 #include "duet/follow/hmm_follower.h"
 #include "duet/follow/naive_hmm.h"
 #include "duet/follow/nearest_neighbour.h"
@@ -32,6 +33,10 @@ void add_tracker_options(CLI::App& app, TrackerArgs& args) {
   app.add_flag("--fixed-band", args.fixed_band,
                "Keep the HMM's band at the template's tempo instead of centring it on the "
                "dancer's tempo (the paper preset always keeps it fixed)");
+  app.add_flag("--beam", args.beam,
+               "Beam mode of the hmm tracker: emissions only for the states "
+               "that carry mass and the jump candidates nearest the input, with a full step when "
+               "the beam may have lost the dancer (docs/follower.md \"Beam mode\")");
 }
 
 Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args,
@@ -39,10 +44,14 @@ Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args,
   FollowParams params = args.preset == "paper" ? FollowParams::paper() : FollowParams{};
   if (args.sigma) params.emission_sigma = *args.sigma;
   if (args.fixed_band) params.tempo_adaptive = false;
+  if (args.beam && args.kind != "hmm") {
+    return make_error("--beam", 0, "beam mode is for the hmm tracker, not '" + args.kind + "'");
+  }
   if (args.kind == "nearest") return boxed(NearestNeighbourTracker::create(model, params));
   if (args.kind == "dtw") return boxed(OnlineDtwTracker::create(model, OnlineDtwParams{}));
   if (args.kind == "naive") return boxed(NaiveHmmFollower::create(model, params));
   if (args.kind == "left-to-right") params.jump_enabled = false;
+  if (args.beam) return boxed(BeamFollower::create(model, params, BeamParams::suited_to(params)));
   return boxed(HmmFollower::create(model, params));
 }
 

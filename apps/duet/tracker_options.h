@@ -17,6 +17,7 @@ struct TrackerArgs {
   std::string preset = "default";  // default | paper
   std::optional<float> sigma;      // emission sigma override
   bool fixed_band = false;         // tempo_adaptive = false
+  bool beam = false;               // beam mode of the HMM (beam_follower.h)
 };
 
 void add_tracker_options(CLI::App& app, TrackerArgs& args);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 
+#include "duet/follow/beam_follower.h"
 #include "duet/follow/hmm_follower.h"
 #include "duet/follow/naive_hmm.h"
 #include "duet/follow/nearest_neighbour.h"
@@ -264,11 +265,24 @@ std::vector<TrackerKind> all_tracker_kinds() {
   return kinds;
 }
 
+namespace {
+
+// The jump HMM, in beam mode when EvalOptions::beam asks for it.
+Result<std::unique_ptr<Tracker>> hmm_tracker(const TemplateModel& model, const FollowParams& params,
+                                             const EvalOptions& options) {
+  if (options.beam) {
+    return boxed(BeamFollower::create(model, params, BeamParams::suited_to(params)));
+  }
+  return boxed(HmmFollower::create(model, params));
+}
+
+}  // namespace
+
 Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const TemplateModel& model,
                                                    const EvalOptions& options) {
   switch (kind) {
     case TrackerKind::kHmm:
-      return boxed(HmmFollower::create(model, options.hmm));
+      return hmm_tracker(model, options.hmm, options);
     case TrackerKind::kHmmPaper: {
       // The paper's transitions [4.2]; the emission and decision settings are ours.
       FollowParams params = FollowParams::paper();
@@ -283,13 +297,13 @@ Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const Templ
       params.lost_residual_factor = options.hmm.lost_residual_factor;
       params.confidence_window_frames = options.hmm.confidence_window_frames;
       params.max_steps_per_frame = options.hmm.max_steps_per_frame;
-      return boxed(HmmFollower::create(model, params));
+      return hmm_tracker(model, params, options);
     }
     case TrackerKind::kLeftToRight: {
       FollowParams params = options.hmm;
       params.jump_enabled = false;
       params.resume_weights.clear();
-      return boxed(HmmFollower::create(model, params));
+      return boxed(HmmFollower::create(model, params));  // no beam mode without the pause state
     }
     case TrackerKind::kNearestNeighbour:
       return boxed(NearestNeighbourTracker::create(model, options.hmm));

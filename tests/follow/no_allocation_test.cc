@@ -7,6 +7,7 @@
 #include <limits>
 #include <vector>
 
+#include "duet/follow/beam_follower.h"
 #include "duet/follow/hmm_follower.h"
 #include "duet/follow/naive_hmm.h"
 #include "duet/follow/nearest_neighbour.h"
@@ -79,7 +80,12 @@ TEST(NoAllocation, StepsAllocateNothing) {
   NaiveHmmFollower naive = NaiveHmmFollower::create(model, {}).value();
   NearestNeighbourTracker nn = NearestNeighbourTracker::create(model, {}).value();
   OnlineDtwTracker dtw = OnlineDtwTracker::create(model, {}).value();
-  Tracker* trackers[] = {&hmm, &l2r, &hmm_sharp, &naive, &nn, &dtw};
+  BeamFollower beam = BeamFollower::create(model, {}).value();
+  BeamFollower beam_paper =
+      BeamFollower::create(model, FollowParams::paper(),
+                           BeamParams::suited_to(FollowParams::paper()))
+          .value();
+  Tracker* trackers[] = {&hmm, &l2r, &hmm_sharp, &naive, &nn, &dtw, &beam, &beam_paper};
 
   // Inputs made beforehand: exact, noisy, missing, far, at 30 Hz and late.
   std::vector<std::vector<float> > inputs;

@@ -35,13 +35,11 @@ inline const DuetLibrary& salsa_library() {
   return loaded;
 }
 
-// Every frame of `input` through a FollowSession with the default HMM, one result per frame.
-inline std::vector<FollowResult> follow_clip(const LoadedMotion& input) {
-  Result<HmmFollower> follower = HmmFollower::create(salsa_library().model(), FollowParams{});
-  EXPECT_TRUE(follower) << follower.error().message;
-  Result<FollowSession> session =
-      FollowSession::create(salsa_library(), input.clip.skeleton_ptr(), input.roles,
-                            std::make_unique<HmmFollower>(std::move(follower).value()));
+// Every frame of `input` through a FollowSession with `tracker`, one result per frame.
+inline std::vector<FollowResult> follow_clip(const LoadedMotion& input,
+                                             std::unique_ptr<Tracker> tracker) {
+  Result<FollowSession> session = FollowSession::create(salsa_library(), input.clip.skeleton_ptr(),
+                                                        input.roles, std::move(tracker));
   EXPECT_TRUE(session) << session.error().message;
   std::vector<FollowResult> results;
   for (int f = 0; f < input.clip.frame_count(); ++f) {
@@ -49,6 +47,13 @@ inline std::vector<FollowResult> follow_clip(const LoadedMotion& input) {
         input.clip.translations_ls(f), input.clip.rotations_ls(f), f / input.clip.frame_rate()));
   }
   return results;
+}
+
+// The same with the default HMM.
+inline std::vector<FollowResult> follow_clip(const LoadedMotion& input) {
+  Result<HmmFollower> follower = HmmFollower::create(salsa_library().model(), FollowParams{});
+  EXPECT_TRUE(follower) << follower.error().message;
+  return follow_clip(input, std::make_unique<HmmFollower>(std::move(follower).value()));
 }
 
 }  // namespace duet::test

@@ -78,6 +78,7 @@ struct EvalOptions {
   std::vector<TrackerKind> trackers;
   std::uint64_t seed = 1;
   FollowParams hmm;     // parameters of the "hmm" tracker (defaults + tuning)
+  bool beam = false;    // the hmm and hmm-paper trackers in beam mode (BeamFollower)
   OnlineDtwParams dtw;  // its emission sigma and lost threshold are taken from hmm
   MetricsOptions metrics;
   // Keep per-frame traces of this case on the first performed take (for plots); empty = none.

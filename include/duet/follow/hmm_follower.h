@@ -102,6 +102,7 @@ class HmmForward {
   float resume(int i) const noexcept;
 
  private:
+  friend class BeamForward;  // beam mode (beam_follower.h) reuses the constants and transition
   HmmForward() = default;
   // alpha_{t-1} -> sum_j alpha_{t-1}(j) A(j -> i) for every i, in O(M) (the bracket of eq. 11).
   void transition(const float* alpha, const BandProbabilities& band, float* next) const noexcept;

@@ -1,0 +1,182 @@
+// Beam mode of the HMM follower (issue 13): per frame, emissions only for the states that carry
+// forward mass (and the band successors they reach), plus the jump candidates nearest the input
+// (JumpCandidateIndex). The cost per frame depends on the beam, not on the library.
+//
+// The model is the one of hmm_follower.h, with the same transitions, emission and decisions.
+// What makes the beam exact enough:
+//   - The jump term factorises through the pause state (method.md 4): every state receives
+//     (1 - A_NN) * alpha(N) * R_i. That share is kept as one number (the background), so the
+//     pause state's mass is accounted exactly; the background reaches the emission only at the
+//     beam and the jump candidates.
+//   - Every state left out is at least the index's bound away from the input, so the mass each
+//     would have carried is bounded (the background's share times the bound's emission). When
+//     that could change a decision (the maximum, the confidence, the pause state's majority, or
+//     lost: the best distance of the library), or the beam grows past BeamParams::max_states,
+//     the frame is finished by the full (exact) step, and the beam is rebuilt from its posterior.
+//     Otherwise the posterior is normalised over the states kept: the left-out mass (spread over
+//     the far states, where the exact step keeps it below a per-state bound) is dropped, and the
+//     frame's log-likelihood misses it.
+//   - States whose posterior falls below prune_ratio times the maximum leave the beam.
+// The first frame after reset() is a full step (the initial distribution is uniform).
+// Only for the jump HMM: a left-to-right HMM (no pause state) recovers from a wrong place only
+// through the little mass it keeps everywhere, which a beam drops (measured: up to 2.4 points of
+// accuracy apart even at a prune ratio of 1e-20), so create() rejects it.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "duet/base/result.h"
+#include "duet/follow/follow_params.h"
+#include "duet/follow/hmm_follower.h"
+#include "duet/follow/jump_candidates.h"
+#include "duet/follow/jump_gate.h"
+#include "duet/follow/tempo_band.h"
+#include "duet/follow/template_model.h"
+#include "duet/follow/tracker.h"
+
+namespace duet {
+
+struct BeamParams {
+  // Jump candidates per frame: the states nearest the input in the index's projection. When
+  // they leave the frame uncertain (see above), the search is widened to wide_jump_candidates
+  // before the full step is taken.
+  int jump_candidates = 16;
+  int wide_jump_candidates = 128;
+  // A state leaves the beam when its posterior is below this times the largest one.
+  float prune_ratio = 1e-8f;
+  // Above this many states the next frame is a full step (a beam this wide saves nothing).
+  int max_states = 4096;
+  // A full step finishes the frame when the mass the left-out states may carry within one
+  // confidence window exceeds this fraction of the kept mass (or could be the maximum, or could
+  // turn the pause state's majority).
+  float outside_mass_tolerance = 1e-3f;
+
+  Status validate() const;
+
+  // The defaults, with the pruning deepened to 1e-20 for a fixed band or a band without skip
+  // (the paper preset): such a band lags behind a faster dancer and its estimate rides on mass
+  // far below the maximum. Measured with `duet eval --trackers hmm-paper --beam`: up to 11 points
+  // of accuracy lost at 1e-8, 0.8 at 1e-14, at most 0.13 at 1e-20 (docs/follower.md).
+  static BeamParams suited_to(const FollowParams& params);
+};
+
+// State between frames: the dense forward variable (zero outside the beam), the beam's states
+// and the buffers of one frame, sized once.
+class BeamContext {
+ public:
+  BeamContext() = default;
+  // Sizes the buffers for num_states states, beam params and max_steps_per_frame. Allocates.
+  BeamContext(int num_states, const BeamParams& beam, int max_steps_per_frame);
+
+  // Uniform over the template states; the next step is a full one.
+  void reset() noexcept;
+
+  int num_states() const { return num_states_; }
+  // The posterior over M + 1 states after the last step (the states outside the beam hold 0).
+  std::span<const float> alpha() const { return alpha_; }
+  // States in the beam after the last step (0 when that step left the full distribution).
+  int beam_size() const { return full_next_ ? 0 : static_cast<int>(beam_.size()); }
+  // Frames that took the full step (the first one, and every fallback).
+  long long full_steps() const { return full_steps_; }
+  SensorNoiseEstimator& sensor_noise() { return sensor_noise_; }
+  long long frames() const { return frames_; }
+  double total_log_likelihood() const { return total_log_likelihood_; }
+  float tempo() const { return tempo_.tempo(); }
+
+ private:
+  friend class BeamForward;
+
+  int num_states_ = 0;
+  std::vector<float> alpha_;        // M + 1, dense; outside beam_ zero unless full_next_
+  std::vector<float> scratch_;      // M + 1, dense; zero outside next_ between frames
+  std::vector<float> distance_sq_;  // M for the full step; the beam's distances otherwise
+  std::vector<int> beam_;           // sorted states of the beam
+  std::vector<int> next_;           // sorted states being built (transition, merge)
+  std::vector<float> weighted_;     // per state of next_: predicted * emission
+  std::vector<std::uint32_t> candidates_;
+  std::vector<float> candidate_d2_;
+  float background_ = 0.0f;  // resumed mass per unit of R_i, not yet in alpha_
+  bool full_next_ = true;
+  double total_log_likelihood_ = 0.0;
+  long long frames_ = 0;
+  long long full_steps_ = 0;
+  int previous_state_ = -1;
+  bool previous_lost_ = false;
+  TempoEstimator tempo_;
+  JumpGate jump_gate_;
+  // The noise-scaled pause level and lost distance, as HmmForward's (noise_scaled_levels.h).
+  SensorNoiseEstimator sensor_noise_;
+  ExplainedResidual explained_residual_;
+  float frame_noise_ = 0.0f;  // the sensor noise estimated at the current frame
+};
+
+class BeamForward {
+ public:
+  // Validates the parameters and builds the jump candidate index (allocates, O(M log M)).
+  static Result<BeamForward> create(const TemplateModel& model, const FollowParams& params,
+                                    const BeamParams& beam = {});
+  // The same with an index already built for this model (e.g. read from the model cache).
+  static Result<BeamForward> create(const TemplateModel& model, const FollowParams& params,
+                                    const BeamParams& beam, JumpCandidateIndex index);
+
+  // One input frame, as HmmForward::step. Allocates nothing, throws nothing.
+  FollowResult step(std::span<const float> features, double dt_s,
+                    BeamContext& context) const noexcept;
+
+  const HmmForward& exact() const { return exact_; }
+  const BeamParams& beam_params() const { return beam_; }
+  const JumpCandidateIndex& index() const { return index_; }
+
+ private:
+  BeamForward(HmmForward exact, JumpCandidateIndex index, const BeamParams& beam)
+      : exact_(std::move(exact)), index_(std::move(index)), beam_(beam) {}
+
+  float resume_share(int i) const noexcept;  // R_i
+  void sparse_transition(const BandProbabilities& band, BeamContext& context) const noexcept;
+  // Emission over the beam and the jump candidates; false (context unchanged but for next_)
+  // when the full step must finish the frame.
+  bool sparse_emission(const float* phi, int candidates, BeamContext& context,
+                       FollowResult& result) const noexcept;
+  // Adds the background to every state (the dense prediction of the full step).
+  void materialise(BeamContext& context) const noexcept;
+  void full_emission(const float* phi, BeamContext& context, FollowResult& result) const noexcept;
+  // After a full step: the states above the prune threshold become the beam, unless too many.
+  void rebuild_beam(BeamContext& context) const noexcept;
+  int sparse_argmax(const BeamContext& context) const noexcept;
+
+  HmmForward exact_;
+  JumpCandidateIndex index_;
+  BeamParams beam_;
+  float max_resume_share_ = 0.0f;  // max_i R_i
+};
+
+// BeamForward + BeamContext behind the Tracker interface.
+class BeamFollower final : public Tracker {
+ public:
+  static Result<BeamFollower> create(const TemplateModel& model, const FollowParams& params,
+                                     const BeamParams& beam = {});
+  static Result<BeamFollower> create(const TemplateModel& model, const FollowParams& params,
+                                     const BeamParams& beam, JumpCandidateIndex index);
+
+  void reset() noexcept override { context_.reset(); }
+  FollowResult step(std::span<const float> features, double dt_s) noexcept override {
+    return forward_.step(features, dt_s, context_);
+  }
+  std::string_view name() const noexcept override { return "hmm"; }
+
+  const BeamForward& forward() const { return forward_; }
+  const BeamContext& context() const { return context_; }
+
+ private:
+  BeamFollower(BeamForward forward, BeamContext context)
+      : forward_(std::move(forward)), context_(std::move(context)) {}
+
+  BeamForward forward_;
+  BeamContext context_;
+};
+
+}  // namespace duet

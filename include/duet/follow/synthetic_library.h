@@ -1,0 +1,28 @@
+// A large template library made from a real one, for scale tests and benchmarks (issue 13): the
+// real takes replicated with time warps and noise until the library has the asked number of
+// states. Each copy plays one real take at a random speed (linear interpolation between its
+// frames; the velocity dimensions scale with the speed, as a faster dancer's would) with Gaussian
+// noise on every feature, so no two copies are alike and the follower's beam meets as many
+// look-alike places as in a big real library. Mirroring is left out: the follow module sees
+// feature vectors, not the joints that a mirror would swap.
+#pragma once
+
+#include "duet/base/result.h"
+#include "duet/follow/template_model.h"
+
+namespace duet {
+
+struct SyntheticLibraryOptions {
+  int num_states = 100000;
+  float min_speed = 0.8f;  // each copy plays at a speed in [min_speed, max_speed]
+  float max_speed = 1.25f;
+  float noise = 0.02f;  // standard deviation of the noise added to every feature
+  unsigned seed = 1;
+};
+
+// Copies of real's takes, in turn, until num_states states (the last copy cut short, but kept at
+// least 3 frames long). Same dimensions, velocity dimensions and frame rate as real. Allocates.
+Result<TemplateModel> synthesize_library(const TemplateModel& real,
+                                         const SyntheticLibraryOptions& options);
+
+}  // namespace duet

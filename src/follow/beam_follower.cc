@@ -1,0 +1,491 @@
+#include "duet/follow/beam_follower.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cfloat>
+#include <cmath>
+#include <string>
+
+#include "duet/follow/confidence_calibration.h"
+#include "forward_common.h"
+
+namespace duet {
+
+using follow_detail::log_emission;
+
+namespace {
+
+// Below this the kept mass has lost too many bits to be normalised (as forward_common.cc).
+constexpr double kMinNormaliser = 1e-30;
+
+// ||phi - phi_i||^2 with the velocity part capped (as follow_detail::emission_distances).
+float emission_distance(const TemplateModel& model, const float* phi, int i,
+                        float velocity_cap) noexcept {
+  const auto row = model.features().row(i);
+  const Eigen::Index dims = model.num_dims();
+  const Eigen::Index velocity = model.velocity_dims();
+  const Eigen::Index posture = dims - velocity;
+  const Eigen::Map<const Eigen::RowVectorXf> query(phi, dims);
+  const float posture_d2 = (row.head(posture) - query.head(posture)).squaredNorm();
+  const float velocity_d2 =
+      velocity > 0 ? (row.tail(velocity) - query.tail(velocity)).squaredNorm() : 0.0f;
+  return std::min(posture_d2 + std::min(velocity_d2, velocity_cap), FLT_MAX);
+}
+
+Error left_to_right_error() {
+  return make_error("beam follower", 0,
+                    "beam mode needs the jump HMM's pause state; the left-to-right HMM runs "
+                    "only with the exact step");
+}
+
+}  // namespace
+
+Status BeamParams::validate() const {
+  auto fail = [](const std::string& what) { return make_error("beam parameters", 0, what); };
+  if (jump_candidates < 1) return fail("jump_candidates must be >= 1");
+  if (wide_jump_candidates < jump_candidates) {
+    return fail("wide_jump_candidates must be >= jump_candidates");
+  }
+  if (!(prune_ratio >= 0.0f && prune_ratio < 1.0f)) return fail("prune_ratio must be in [0, 1)");
+  if (max_states < 1) return fail("max_states must be >= 1");
+  if (!(outside_mass_tolerance >= 0.0f && std::isfinite(outside_mass_tolerance))) {
+    return fail("outside_mass_tolerance must be finite and >= 0");
+  }
+  return Ok{};
+}
+
+BeamParams BeamParams::suited_to(const FollowParams& params) {
+  BeamParams beam;
+  if (!params.tempo_adaptive || params.skip_prob == 0.0f) beam.prune_ratio = 1e-20f;
+  return beam;
+}
+
+// ---------------------------------------------------------------------------------------------
+// BeamContext
+
+BeamContext::BeamContext(int num_states, const BeamParams& beam, int max_steps_per_frame) {
+  assert(num_states > 0);
+  num_states_ = num_states;
+  const auto size = static_cast<std::size_t>(num_states);
+  alpha_.assign(size + 1, 0.0f);
+  scratch_.assign(size + 1, 0.0f);
+  distance_sq_.assign(size, 0.0f);
+  // Each transition grows a run of the beam by at most 2 states; then come the candidates.
+  const std::size_t list = std::min(
+      size, static_cast<std::size_t>(beam.max_states) *
+                    (1 + 2 * static_cast<std::size_t>(std::max(1, max_steps_per_frame))) +
+                static_cast<std::size_t>(beam.wide_jump_candidates));
+  beam_.reserve(list);
+  next_.reserve(list);
+  weighted_.assign(list, 0.0f);
+  candidates_.assign(static_cast<std::size_t>(beam.wide_jump_candidates), 0);
+  candidate_d2_.assign(static_cast<std::size_t>(beam.wide_jump_candidates), 0.0f);
+  reset();
+}
+
+void BeamContext::reset() noexcept {
+  if (num_states_ == 0) return;
+  std::fill(alpha_.begin(), alpha_.end() - 1, 1.0f / static_cast<float>(num_states_));
+  alpha_.back() = 0.0f;
+  std::fill(scratch_.begin(), scratch_.end(), 0.0f);
+  beam_.clear();
+  next_.clear();
+  background_ = 0.0f;
+  full_next_ = true;
+  total_log_likelihood_ = 0.0;
+  frames_ = 0;
+  full_steps_ = 0;
+  previous_state_ = -1;
+  previous_lost_ = false;
+  tempo_.reset();
+  jump_gate_.reset();
+  sensor_noise_.reset();
+  explained_residual_.reset();
+  frame_noise_ = 0.0f;
+}
+
+// ---------------------------------------------------------------------------------------------
+// BeamForward
+
+Result<BeamForward> BeamForward::create(const TemplateModel& model, const FollowParams& params,
+                                        const BeamParams& beam) {
+  if (Status status = beam.validate(); !status.ok()) return status.error();
+  if (!params.jump_enabled) return left_to_right_error();
+  Result<JumpCandidateIndex> index = JumpCandidateIndex::build(model);
+  if (!index) return index.error();
+  return create(model, params, beam, std::move(index).value());
+}
+
+Result<BeamForward> BeamForward::create(const TemplateModel& model, const FollowParams& params,
+                                        const BeamParams& beam, JumpCandidateIndex index) {
+  if (Status status = beam.validate(); !status.ok()) return status.error();
+  if (!params.jump_enabled) return left_to_right_error();
+  if (index.num_states() != model.num_states()) {
+    return make_error("beam follower", 0,
+                      "jump candidate index of " + std::to_string(index.num_states()) +
+                          " states for a model of " + std::to_string(model.num_states()));
+  }
+  Result<HmmForward> exact = HmmForward::create(model, params);
+  if (!exact) return exact.error();
+  BeamForward forward(std::move(exact).value(), std::move(index), beam);
+  forward.max_resume_share_ = 1.0f / static_cast<float>(model.num_states());
+  for (const float r : forward.exact_.resume_) {
+    forward.max_resume_share_ = std::max(forward.max_resume_share_, r);
+  }
+  return forward;
+}
+
+float BeamForward::resume_share(int i) const noexcept {
+  return exact_.resume_.empty() ? 1.0f / static_cast<float>(exact_.model_->num_states())
+                                : exact_.resume_[static_cast<std::size_t>(i)];
+}
+
+void BeamForward::sparse_transition(const BandProbabilities& band,
+                                    BeamContext& context) const noexcept {
+  const TemplateModel& model = *exact_.model_;
+  const int num_states = model.num_states();
+  const bool jump = exact_.params_.jump_enabled;
+  float* alpha = context.alpha_.data();
+  float* next = context.scratch_.data();
+  const float pause_mass = alpha[num_states];
+
+  float beam_mass = 0.0f;
+  for (const int j : context.beam_) beam_mass += alpha[j];
+  float into_pause = 0.0f;
+  if (jump) {
+    into_pause = exact_.leave_ * (beam_mass + context.background_) + exact_.pause_stay_ * pause_mass;
+  }
+  // The band moves each state's mass to j, j + 1, j + 2 of its take. The beam is sorted, so the
+  // targets come in order and a target at or below the last one added is already in next_.
+  context.next_.clear();
+  for (const int j : context.beam_) {
+    const HmmForward::Row r = exact_.row(j, band);
+    if (jump) into_pause += alpha[j] * (r.leave - exact_.leave_);  // the end of a take
+    const int last = std::min(j + 2, model.take_end(model.take_of(j)) - 1);
+    for (int t = j; t <= last; ++t) {
+      if (context.next_.empty() || t > context.next_.back()) {
+        context.next_.push_back(t);
+        next[t] = 0.0f;
+      }
+      next[t] += alpha[j] * r.band[t - j];
+    }
+  }
+  for (const int j : context.beam_) alpha[j] = 0.0f;
+  // The background moves along the band as any uniform mass (its take ends are neglected: it
+  // is spread over the whole library) and receives what resumes from the pause state.
+  if (jump) {
+    context.background_ = context.background_ * (band.self + band.next + band.skip) +
+                          (1.0f - exact_.pause_stay_) * pause_mass;
+  }
+  alpha[num_states] = 0.0f;
+  next[num_states] = into_pause;
+  context.alpha_.swap(context.scratch_);
+  context.beam_.swap(context.next_);
+}
+
+bool BeamForward::sparse_emission(const float* phi, int wanted, BeamContext& context,
+                                  FollowResult& result) const noexcept {
+  const TemplateModel& model = *exact_.model_;
+  const int num_states = model.num_states();
+  const FollowParams& params = exact_.params_;
+  const float inv_two_sigma_sq = exact_.inv_two_sigma_sq_;
+  float* alpha = context.alpha_.data();
+
+  // The jump candidates, merged into the beam (both sorted) in next_.
+  float bound = 0.0f;
+  const int found = index_.nearest(phi, wanted, context.candidates_.data(),
+                                   context.candidate_d2_.data(), bound);
+  std::uint32_t* candidates = context.candidates_.data();
+  std::sort(candidates, candidates + found);
+  context.next_.clear();
+  {
+    std::size_t b = 0;
+    int c = 0;
+    const std::size_t beam_size = context.beam_.size();
+    while (b < beam_size || c < found) {
+      const int from_beam = b < beam_size ? context.beam_[b] : num_states;
+      const int from_index = c < found ? static_cast<int>(candidates[c]) : num_states;
+      const int state = std::min(from_beam, from_index);
+      context.next_.push_back(state);
+      if (from_beam == state) ++b;
+      if (from_index == state) ++c;
+    }
+  }
+  const std::size_t count = context.next_.size();
+
+  float best = FLT_MAX;
+  float* d2 = context.distance_sq_.data();
+  for (std::size_t k = 0; k < count; ++k) {
+    d2[k] = emission_distance(model, phi, context.next_[k], params.velocity_distance_cap);
+    best = std::min(best, d2[k]);
+  }
+  // Lost is decided on the best distance of the whole library; states left out are >= bound.
+  const float lost_sq = exact_.noise_levels_.lost_ceiling_sq();
+  if (found == wanted && best > lost_sq && bound <= lost_sq) return false;
+  const float unexplained_sq = exact_.noise_levels_.lost_distance_sq(
+      context.frame_noise_, context.explained_residual_.level());
+  if (found == wanted && best > unexplained_sq && bound <= unexplained_sq) return false;
+
+  const float log_pause = exact_.noise_levels_.log_pause_emission(context.frame_noise_);
+  const bool jump = params.jump_enabled;
+  const float max_template = log_emission(best, inv_two_sigma_sq);
+  const float shift = jump ? std::max(max_template, log_pause) : max_template;
+  const float background = context.background_;
+  float* weighted = context.weighted_.data();
+  double sum = 0.0;
+  for (std::size_t k = 0; k < count; ++k) {
+    const int i = context.next_[k];
+    const float predicted = alpha[i] + background * resume_share(i);
+    weighted[k] = predicted * std::exp(log_emission(d2[k], inv_two_sigma_sq) - shift);
+    sum += weighted[k];
+  }
+  const float pause = jump ? alpha[num_states] * std::exp(log_pause - shift) : 0.0f;
+  sum += pause;
+  // The states left out: their prediction is the background, their emission at most the
+  // bound's. Their total is spread over up to M states, so it only matters where it could change
+  // a decision: the maximum, the confidence window, the pause state's majority.
+  float largest = 0.0f;
+  for (std::size_t k = 0; k < count; ++k) largest = std::max(largest, weighted[k]);
+  if (found == wanted) {
+    const double emitted =
+        std::exp(static_cast<double>(log_emission(bound, inv_two_sigma_sq) - shift));
+    const double outside_total = static_cast<double>(background) * emitted;
+    const double outside_state = static_cast<double>(background) * max_resume_share_ * emitted;
+    const double window = 2.0 * params.confidence_window_frames + 1.0;
+    const bool in_pause = pause > 0.5 * sum;
+    if (outside_state >= static_cast<double>(largest) ||
+        outside_state * window > beam_.outside_mass_tolerance * sum ||
+        in_pause != (pause > 0.5 * (sum + outside_total))) {
+      return false;
+    }
+  }
+  if (!(sum >= kMinNormaliser)) return false;
+
+  // Accepted: the posterior over the merged states; those below the threshold leave the beam.
+  const float scale = static_cast<float>(1.0 / sum);
+  const float threshold = largest * beam_.prune_ratio;
+  context.beam_.clear();
+  for (std::size_t k = 0; k < count; ++k) {
+    const int i = context.next_[k];
+    if (weighted[k] >= threshold && weighted[k] > 0.0f) {
+      alpha[i] = weighted[k] * scale;
+      context.beam_.push_back(i);
+    } else {
+      alpha[i] = 0.0f;
+    }
+  }
+  alpha[num_states] = pause * scale;
+  context.background_ = 0.0f;  // its emitted mass is left out (bounded above)
+  if (static_cast<int>(context.beam_.size()) > beam_.max_states) context.full_next_ = true;
+  result.log_likelihood = std::log(sum) + static_cast<double>(shift);
+  result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
+  result.lost = best > lost_sq;
+  return true;
+}
+
+void BeamForward::materialise(BeamContext& context) const noexcept {
+  const int num_states = exact_.model_->num_states();
+  const float background = context.background_;
+  if (background > 0.0f) {
+    float* alpha = context.alpha_.data();
+    for (int i = 0; i < num_states; ++i) alpha[i] += background * resume_share(i);
+  }
+  context.background_ = 0.0f;
+}
+
+void BeamForward::full_emission(const float* phi, BeamContext& context,
+                                FollowResult& result) const noexcept {
+  const TemplateModel& model = *exact_.model_;
+  const FollowParams& params = exact_.params_;
+  const float best = follow_detail::emission_distances(model, phi, params.velocity_distance_cap,
+                                                       context.distance_sq_.data());
+  result.log_likelihood = follow_detail::weigh_and_normalise(
+      context.alpha_.data(), context.distance_sq_.data(), best, exact_.inv_two_sigma_sq_,
+      model.num_states(), exact_.noise_levels_.log_pause_emission(context.frame_noise_),
+      params.jump_enabled, context.scratch_.data());
+  context.alpha_.swap(context.scratch_);
+  result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
+  result.lost = best > exact_.noise_levels_.lost_ceiling_sq();
+}
+
+void BeamForward::rebuild_beam(BeamContext& context) const noexcept {
+  const int num_states = exact_.model_->num_states();
+  float* alpha = context.alpha_.data();
+  float largest = 0.0f;
+  for (int i = 0; i < num_states; ++i) largest = std::max(largest, alpha[i]);
+  const float threshold = largest * beam_.prune_ratio;
+  context.beam_.clear();
+  for (int i = 0; i < num_states; ++i) {
+    if (alpha[i] >= threshold && alpha[i] > 0.0f) {
+      if (static_cast<int>(context.beam_.size()) == beam_.max_states) {
+        context.beam_.clear();
+        context.full_next_ = true;  // too wide: stay dense
+        return;
+      }
+      context.beam_.push_back(i);
+    }
+  }
+  // The states left out hold less than prune_ratio of the maximum each: dropped.
+  std::size_t k = 0;
+  float kept = alpha[num_states];
+  for (int i = 0; i < num_states; ++i) {
+    if (k < context.beam_.size() && context.beam_[k] == i) {
+      kept += alpha[i];
+      ++k;
+    } else {
+      alpha[i] = 0.0f;
+    }
+  }
+  if (kept > 0.0f) {
+    const float scale = 1.0f / kept;
+    for (const int i : context.beam_) alpha[i] *= scale;
+    alpha[num_states] *= scale;
+  }
+  std::fill(context.scratch_.begin(), context.scratch_.end(), 0.0f);
+  context.full_next_ = false;
+}
+
+int BeamForward::sparse_argmax(const BeamContext& context) const noexcept {
+  // The beam is sorted: the first of equal maxima wins, as in the full argmax.
+  int state = context.beam_.empty() ? 0 : context.beam_.front();
+  float best = -1.0f;
+  for (const int i : context.beam_) {
+    if (context.alpha_[static_cast<std::size_t>(i)] > best) {
+      best = context.alpha_[static_cast<std::size_t>(i)];
+      state = i;
+    }
+  }
+  return state;
+}
+
+FollowResult BeamForward::step(std::span<const float> features, double dt_s,
+                               BeamContext& context) const noexcept {
+  const follow_detail::ScopedFlushDenormals flush_denormals;
+  const TemplateModel& model = *exact_.model_;
+  const FollowParams& params = exact_.params_;
+  const int num_states = model.num_states();
+  FollowResult result;
+  assert(context.num_states_ == num_states && "context sized for another model");
+  if (context.num_states_ != num_states) return result;
+
+  result.missing = features.size() != static_cast<std::size_t>(model.num_dims()) ||
+                   !follow_detail::all_finite(features);
+  result.steps = exact_.steps_for(dt_s);
+  const BandProbabilities band = exact_.band_for(context.tempo_.tempo());
+
+  bool dense = context.full_next_;
+  if (dense) {
+    materialise(context);
+    for (int s = 0; s < result.steps; ++s) {
+      exact_.transition(context.alpha_.data(), band, context.scratch_.data());
+      context.alpha_.swap(context.scratch_);
+    }
+  } else {
+    for (int s = 0; s < result.steps; ++s) sparse_transition(band, context);
+  }
+
+  context.sensor_noise_.update(features, dt_s, !result.missing);
+  result.sensor_noise_per_dim = context.sensor_noise_.variance_per_dim();
+  context.frame_noise_ = result.sensor_noise_per_dim;
+  if (!result.missing) {
+    // Uncertain with the usual candidates: widen the search; still uncertain, the beam may have
+    // lost the dancer: finish the frame with the full step.
+    if (!dense && !sparse_emission(features.data(), beam_.jump_candidates, context, result) &&
+        !sparse_emission(features.data(), beam_.wide_jump_candidates, context, result)) {
+      materialise(context);
+      dense = true;
+    }
+    if (dense) full_emission(features.data(), context, result);
+  } else if (dense) {
+    follow_detail::normalise(context.alpha_.data(), num_states + 1, num_states);
+    result.best_distance_per_dim = -1.0f;
+  } else {
+    // No evidence: renormalise the beam, the background and the pause state together.
+    float* alpha = context.alpha_.data();
+    float total = alpha[num_states] + context.background_;
+    for (const int i : context.beam_) total += alpha[i];
+    if (total > 0.0f && std::isfinite(total)) {
+      const float scale = 1.0f / total;
+      for (const int i : context.beam_) alpha[i] *= scale;
+      alpha[num_states] *= scale;
+      context.background_ *= scale;
+    }
+    // Unpruned, the beam spreads along the band while frames are missing; too wide, the next
+    // frame is a full step (which also keeps the buffers within their reserved size).
+    if (static_cast<int>(context.beam_.size()) > beam_.max_states) context.full_next_ = true;
+    result.best_distance_per_dim = -1.0f;
+  }
+
+  const float* alpha = context.alpha_.data();
+  if (dense) {
+    ++context.full_steps_;
+    follow_detail::decide(model, alpha, 1.0f, alpha[num_states], context.previous_state_,
+                          result.steps, params.confidence_window_frames, result);
+  } else {
+    follow_detail::describe_state(model, alpha, 1.0f, sparse_argmax(context),
+                                  params.confidence_window_frames, result);
+    result.in_pause = alpha[num_states] > 0.5f;
+    result.jumped =
+        follow_detail::is_jump(model, context.previous_state_, result.state, result.steps);
+  }
+  context.jump_gate_.apply(model, params, alpha, 1.0f, context.previous_state_,
+                           context.previous_lost_, result);
+  if (dense && !result.missing) rebuild_beam(context);
+
+  result.lost = result.missing ? context.previous_lost_ : (result.lost || result.in_pause);
+  if (params.calibrate_confidence) {
+    result.confidence =
+        ConfidenceCalibration::apply(result.window_mass, result.sensor_noise_per_dim);
+  }
+  if (params.tempo_adaptive) {
+    const bool band_move = !result.missing && !result.lost && !result.jumped;
+    context.tempo_.update(context.previous_state_, result.state, result.steps, dt_s, band_move,
+                          exact_.tempo_limits_);
+  }
+  result.tempo = context.tempo_.tempo();
+  context.total_log_likelihood_ += result.log_likelihood;
+  ++context.frames_;
+  context.previous_state_ = result.state;
+  context.previous_lost_ = result.lost;
+  const bool unexplained =
+      !result.missing &&
+      result.best_distance_per_dim * static_cast<float>(model.num_dims()) >
+          exact_.noise_levels_.lost_distance_sq(context.frame_noise_,
+                                                context.explained_residual_.level());
+  context.explained_residual_.update(result.best_distance_per_dim,
+                                     !result.missing && !result.in_pause && !result.jumped, dt_s);
+  result.lost = result.lost || unexplained;
+  return result;
+}
+
+// ---------------------------------------------------------------------------------------------
+// BeamFollower
+
+namespace {
+
+BeamContext make_context(const TemplateModel& model, const FollowParams& params,
+                         const BeamParams& beam) {
+  BeamContext context(model.num_states(), beam, params.max_steps_per_frame);
+  context.sensor_noise() = SensorNoiseEstimator(model.num_dims() - model.velocity_dims(),
+                                                params.sensor_noise_time_constant_s,
+                                                model.frame_rate_hz());
+  return context;
+}
+
+}  // namespace
+
+Result<BeamFollower> BeamFollower::create(const TemplateModel& model, const FollowParams& params,
+                                          const BeamParams& beam) {
+  Result<BeamForward> forward = BeamForward::create(model, params, beam);
+  if (!forward.ok()) return forward.error();
+  return BeamFollower(std::move(forward).value(), make_context(model, params, beam));
+}
+
+Result<BeamFollower> BeamFollower::create(const TemplateModel& model, const FollowParams& params,
+                                          const BeamParams& beam, JumpCandidateIndex index) {
+  Result<BeamForward> forward = BeamForward::create(model, params, beam, std::move(index));
+  if (!forward.ok()) return forward.error();
+  return BeamFollower(std::move(forward).value(), make_context(model, params, beam));
+}
+
+}  // namespace duet

@@ -1,0 +1,65 @@
+// The synthetic library generator (scale tests of issue 13): the asked size, copies of the real
+// takes at the asked speeds, reproducible, bad options rejected.
+#include <gtest/gtest.h>
+
+#include "duet/follow/synthetic_library.h"
+#include "follow/synthetic.h"
+
+namespace duet {
+namespace {
+
+TEST(SyntheticLibrary, CopiesTheTakesUntilTheAskedSize) {
+  const TemplateModel real = test::make_model({200, 150}, 12, 5, 60.0, 4);
+  SyntheticLibraryOptions options;
+  options.num_states = 1000;
+  options.min_speed = options.max_speed = 1.0f;
+  options.noise = 0.0f;
+  const TemplateModel big = synthesize_library(real, options).value();
+  EXPECT_EQ(big.num_states(), 1000);
+  EXPECT_EQ(big.num_dims(), 12);
+  EXPECT_EQ(big.velocity_dims(), 4);
+  EXPECT_EQ(big.frame_rate_hz(), 60.0);
+  // At speed 1 without noise the copies are the takes, in turn.
+  EXPECT_EQ(big.take_begin(1), 200);
+  EXPECT_EQ(big.take_begin(2), 350);
+  EXPECT_TRUE(big.features().middleRows(350, 200).isApprox(real.features().topRows(200)));
+  EXPECT_TRUE(big.features().middleRows(200, 150).isApprox(real.features().middleRows(200, 150)));
+}
+
+TEST(SyntheticLibrary, WarpsTimeAndAddsNoise) {
+  const TemplateModel real = test::make_model({200, 150}, 12, 5, 60.0, 4);
+  SyntheticLibraryOptions options;
+  options.num_states = 5000;
+  const TemplateModel big = synthesize_library(real, options).value();
+  ASSERT_EQ(big.num_states(), 5000);
+  int shorter = 0, longer = 0;
+  for (int k = 0; k + 1 < big.num_takes(); ++k) {  // the last copy may be cut short
+    const int length = big.take_end(k) - big.take_begin(k);
+    const int source = real.take_end(k % 2) - real.take_begin(k % 2);
+    EXPECT_GE(length, static_cast<int>(static_cast<float>(source) / options.max_speed) - 1);
+    EXPECT_LE(length, static_cast<int>(static_cast<float>(source) / options.min_speed) + 1);
+    shorter += length < source;
+    longer += length > source;
+  }
+  EXPECT_GT(shorter, 0);
+  EXPECT_GT(longer, 0);
+  // Same seed, same library; another seed, another one.
+  EXPECT_TRUE(synthesize_library(real, options).value().features().isApprox(big.features()));
+  options.seed = 2;
+  EXPECT_FALSE(synthesize_library(real, options).value().features().isApprox(big.features()));
+}
+
+TEST(SyntheticLibrary, RejectsBadOptions) {
+  const TemplateModel real = test::make_model({50}, 4, 1);
+  SyntheticLibraryOptions options;
+  options.num_states = 2;
+  EXPECT_FALSE(synthesize_library(real, options));
+  options.num_states = 100;
+  options.min_speed = 0.0f;
+  Result<TemplateModel> bad = synthesize_library(real, options);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("speed"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace duet
