@@ -1,6 +1,7 @@
 // duet inspect FILE.bvh | SKELETON.asf MOTION.amc [--json]
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <iostream>
 #include <limits>
 #include <string>
@@ -10,6 +11,7 @@
 #include "commands.h"
 #include "duet/io/motion_file.h"
 #include "duet/motion/forward_kinematics.h"
+#include "duet/motion/head_hands.h"
 #include "motion_options.h"
 
 namespace duet::app {
@@ -100,6 +102,7 @@ int run_inspect(const InspectArgs& args) {
     doc["roles"] = roles;
     doc["roles_problem"] = motion.role_detection.problem;
     doc["can_drive_follower"] = problems.empty();
+    doc["input_points"] = is_head_hands_input(motion.roles) ? "head,hands" : "full";
     doc["follower_problems"] = problems;
     doc["bounding_box_m"] = {{"min", {low.x(), low.y(), low.z()}},
                              {"max", {high.x(), high.y(), high.z()}}};
@@ -123,6 +126,13 @@ int run_inspect(const InspectArgs& args) {
     fmt::print("height:      {:.2f} m estimated (legs {:.2f} m, arms {:.2f} m, trunk {:.2f} m)\n",
                body.standing_height_m, body.leg_length_m, body.arm_length_m,
                body.trunk_length_m);
+  } else if (is_head_hands_input(motion.roles)) {
+    double head_high = 0.0;
+    for (int f = 0; f < clip.frame_count(); ++f) {
+      head_high = std::max(head_high, clip.translations_ls(f)[kPointsHead].y());
+    }
+    fmt::print("height:      head up to {:.2f} m above the floor (three points: head and hands)\n",
+               head_high);
   } else {
     fmt::print("height:      unknown (needs the roles)\n");
   }
@@ -143,7 +153,9 @@ int run_inspect(const InspectArgs& args) {
     fmt::print("  {:<15} {:<16} {}\n", role_name(static_cast<Role>(r)),
                joint_name(skeleton, joint), motion.role_detection.notes[static_cast<std::size_t>(r)]);
   }
-  if (problems.empty()) {
+  if (problems.empty() && is_head_hands_input(motion.roles)) {
+    fmt::print("follower:    this file can drive the three-point follower (head and hands)\n");
+  } else if (problems.empty()) {
     fmt::print("follower:    this file can drive the follower\n");
   } else {
     fmt::print("follower:    this file cannot drive the follower:\n");
