@@ -33,7 +33,6 @@ Vec3 smooth_position(const Vec3& current, const Vec3& target, double half_life_s
 
 namespace {
 
-// The constants of one decay step, computed once per frame for all joints.
 // Holds a decaying offset's step since `before` to at most max_speed * dt (the spring's velocity
 // with it), so a large offset moves at that speed until the spring alone is slower.
 void limit_speed(Vec3& x, Vec3& v, const Vec3& before, double max_speed, double dt) {
@@ -46,6 +45,7 @@ void limit_speed(Vec3& x, Vec3& v, const Vec3& before, double max_speed, double 
   if (speed > max_speed) v *= max_speed / speed;
 }
 
+// The constants of one decay step, computed once per frame for all joints.
 struct DecayStep {
   bool skip = false;     // dt <= 0: nothing happens
   bool instant = false;  // no half-life: the offset vanishes at once

@@ -148,8 +148,9 @@ struct PartnerParams {
   // adds at most this to any arm joint's angular speed (infinity: no limit). Noise makes the
   // 1-euro filter's speed estimate, and so its cutoff, rise; the limit holds regardless.
   // Measured (docs/evaluation.md, "Partner steadiness"): with it the partner's p99 largest joint
-  // speed is what it is with the IK off, and the median hand error on clean input unchanged.
-  double ik_correction_max_speed_rad_s = 2.0;
+  // speed is about what it is with the IK off; 2 rad/s was as steady but slowed a persistent
+  // correction (`body-size`: median hand error 1.25 cm, 0.99 at 4 rad/s).
+  double ik_correction_max_speed_rad_s = 4.0;
   // smooth: the response is shown at a real frame that advances at the dancer's tempo
   // (response_playhead.h; used by LiveLoop, which samples the pose there and passes it as
   // PartnerSynthesisJob::frame_position).
