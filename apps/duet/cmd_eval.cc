@@ -1,12 +1,15 @@
-// duet eval --pair LEADER PARTNER [...] [--takes 0,2] [--cases ...] [--trackers ...] [--csv F]
-//           [--plots DIR] [--no-partner-metrics] [--partner-csv F] [tuning options]
+// duet eval --pair LEADER PARTNER [...] [--takes 0,2] [--cases ...] [--noise-sweep]
+//           [--trackers ...] [--csv F] [--plots DIR] [--no-partner-metrics] [--partner-csv F]
+//           [tuning options]
 // Synthetic performances with ground truth from the real takes, followed by the HMM and the
 // baselines; prints a table (docs/evaluation.md).
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <iterator>
 #include <set>
 
 #include "commands.h"
@@ -35,6 +38,7 @@ struct EvalArgs {
   std::string trace_case = "improv-pause";
   bool no_partner_metrics = false;
   bool beam = false;
+  bool noise_sweep = false;
   std::string partner_csv_path;
   CaseSettings settings;
   double noise_cm = 1.0;
@@ -144,8 +148,10 @@ int run_eval(EvalArgs& args) {
   const std::vector<EvalCase> standard = standard_cases(args.settings);
   EvalOptions options;
   std::string error;
-  if (args.cases.empty()) args.cases = {"all"};
+  // --noise-sweep alone runs the sweep only; with --cases, after them.
+  if (args.cases.empty() && !args.noise_sweep) args.cases = {"all"};
   if (!select_cases(args.cases, standard, options.cases, error)) return usage_error(error);
+  if (args.noise_sweep) std::ranges::move(noise_sweep_cases(), std::back_inserter(options.cases));
   if (args.trackers.empty()) {
     options.trackers = all_tracker_kinds();
   } else {
@@ -350,8 +356,13 @@ Command register_eval(CLI::App& app) {
   app.add_option("--cases", args->cases,
                  "Cases to run, comma-separated (default all): clean, tempo-slow, tempo-fast "
                  "(or tempo), drift, improv, improv-pause, improv-library, noise, 30hz-noisy, "
-                 "late-frames, body-size, room-place, partner-role, improv-30hz-noisy")
+                 "late-frames, body-size, room-place, partner-role, improv-30hz-noisy, harsh "
+                 "(30 Hz, 4 deg per axis + 1 cm noise, 3% repeated frames, a 1.1x body)")
       ->delimiter(',');
+  app.add_flag("--noise-sweep", args->noise_sweep,
+               "Also run noise-sweep-0 ... noise-sweep-5: improv-pause with 0 to 5 degrees of "
+               "rotation noise per axis (+1 cm root noise above 0); alone (without --cases) "
+               "only these");
   app.add_option("--trackers", args->trackers,
                  "Followers, comma-separated (default all): hmm, hmm-paper, left-to-right, "
                  "nearest, online-dtw, naive-hmm (O(M^2), run on the first take alone)")

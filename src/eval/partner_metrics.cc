@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 
 #include "duet/math/rotation.h"
 #include "duet/motion/forward_kinematics.h"
@@ -207,6 +208,7 @@ void add_captured_reference(const Clip& response, const JointRoles& roles,
       reference.angular_speeds_rad_s.push_back(speed);
       frame_max[fs] = std::max(frame_max[fs], speed);
     }
+    reference.frame_max_rad_s.push_back(frame_max[fs]);
   }
   // Non-overlapping windows of the post-jump length, from the second frame on.
   const int window = std::max(1, static_cast<int>(std::lround(options.post_jump_window_s / dt)));
@@ -247,8 +249,23 @@ void PartnerMetricsAccumulator::add(const Performance& performance,
       slip_frames_ += r.slip ? 1 : 0;
       ground_speed_sum_mps_ += r.ground_speed_sum_mps;
       ground_feet_ += r.ground_feet;
+      frame_max_rad_s_.push_back(r.max_angular_speed_rad_s);
+      max_slide_mps_ = std::max(max_slide_mps_, r.planted_slide_mps);
+      sliding_frames_ += r.planted_slide_mps > options_.slide_limit_mps ? 1 : 0;
     }
   }
+  // Rejoined at frame f: hands and spacing within the tolerance from f for rejoin_hold_s (or to
+  // the end of the performance).
+  const auto rejoined_from = [&](std::size_t f) {
+    for (std::size_t g = f; g < n && performance.times_s[g] < performance.times_s[f] +
+                                                                   options_.rejoin_hold_s;
+         ++g) {
+      if (!records[g].hands_joined || records[g].spacing_error_m > options_.rejoin_tolerance_m) {
+        return false;
+      }
+    }
+    return true;
+  };
   // Jump windows: frames from the jump frame to window seconds after it; frame 0 has no speed.
   for (std::size_t j = 0; j < n; ++j) {
     if (!performance.truth[j].jump) continue;
@@ -258,10 +275,27 @@ void PartnerMetricsAccumulator::add(const Performance& performance,
       largest = std::max(largest, records[f].max_angular_speed_rad_s);
       true_largest = std::max(true_largest, records[f].true_max_angular_speed_rad_s);
     }
-    if (largest >= 0.0) {
-      jump_max_rad_s_.push_back(largest);
-      jump_true_max_rad_s_.push_back(true_largest);
+    if (largest < 0.0) continue;
+    jump_max_rad_s_.push_back(largest);
+    jump_true_max_rad_s_.push_back(true_largest);
+
+    const double t0 = performance.times_s[j];
+    double rejoin = std::numeric_limits<double>::infinity();
+    double spacing = -1.0, slide = 0.0;
+    for (std::size_t f = j; f < n && performance.times_s[f] < t0 + options_.rejoin_search_s; ++f) {
+      const double t = performance.times_s[f] - t0;
+      if (!std::isfinite(rejoin) && rejoined_from(f)) rejoin = t;
+      if (spacing < 0.0 && t >= options_.rejoin_deadline_s - 1e-9) {
+        spacing = records[f].spacing_error_m;
+      }
+      if (f > j && t < options_.post_jump_window_s) {
+        slide = std::max(slide, records[f].planted_slide_mps);
+      }
     }
+    jump_rejoin_s_.push_back(rejoin);
+    // A performance that ends first: the last frame's spacing.
+    jump_spacing_m_.push_back(spacing >= 0.0 ? spacing : records[n - 1].spacing_error_m);
+    jump_slide_mps_.push_back(slide);
   }
 }
 
@@ -277,6 +311,9 @@ void PartnerMetricsAccumulator::add_reference(const CapturedReference& reference
   reference_.window_max_rad_s.insert(reference_.window_max_rad_s.end(),
                                      reference.window_max_rad_s.begin(),
                                      reference.window_max_rad_s.end());
+  reference_.frame_max_rad_s.insert(reference_.frame_max_rad_s.end(),
+                                    reference.frame_max_rad_s.begin(),
+                                    reference.frame_max_rad_s.end());
 }
 
 void PartnerMetricsAccumulator::merge(const PartnerMetricsAccumulator& other) {
@@ -297,6 +334,16 @@ void PartnerMetricsAccumulator::merge(const PartnerMetricsAccumulator& other) {
                          other.jump_max_rad_s_.end());
   jump_true_max_rad_s_.insert(jump_true_max_rad_s_.end(), other.jump_true_max_rad_s_.begin(),
                               other.jump_true_max_rad_s_.end());
+  frame_max_rad_s_.insert(frame_max_rad_s_.end(), other.frame_max_rad_s_.begin(),
+                          other.frame_max_rad_s_.end());
+  jump_rejoin_s_.insert(jump_rejoin_s_.end(), other.jump_rejoin_s_.begin(),
+                        other.jump_rejoin_s_.end());
+  jump_spacing_m_.insert(jump_spacing_m_.end(), other.jump_spacing_m_.begin(),
+                         other.jump_spacing_m_.end());
+  jump_slide_mps_.insert(jump_slide_mps_.end(), other.jump_slide_mps_.begin(),
+                         other.jump_slide_mps_.end());
+  max_slide_mps_ = std::max(max_slide_mps_, other.max_slide_mps_);
+  sliding_frames_ += other.sliding_frames_;
   add_reference(other.reference_);
 }
 
@@ -361,7 +408,21 @@ PartnerMetrics PartnerMetricsAccumulator::summary() const {
           jump_max_rad_s_[k] > std::max(window_reference_rad_s, jump_true_max_rad_s_[k]) ? 1 : 0;
     }
     m.median_true_jump_speed_deg_s = rad_to_deg(median(jump_true_max_rad_s_));
+    m.median_rejoin_s = median(jump_rejoin_s_);
+    m.max_rejoin_s = *std::ranges::max_element(jump_rejoin_s_);
+    m.jumps_rejoined_in_time = std::ranges::count_if(
+        jump_rejoin_s_, [&](double s) { return s <= options_.rejoin_deadline_s + 1e-9; });
+    m.median_spacing_error_cm = 100.0 * median(jump_spacing_m_);
+    m.max_spacing_error_cm = 100.0 * *std::ranges::max_element(jump_spacing_m_);
+    m.max_jump_slide_mps = *std::ranges::max_element(jump_slide_mps_);
+    m.jumps_sliding = std::ranges::count_if(
+        jump_slide_mps_, [&](double s) { return s > options_.slide_limit_mps; });
   }
+  m.frame_speed_deg_s = rad_to_deg(quantile(frame_max_rad_s_, options_.reference_percentile));
+  m.captured_frame_speed_deg_s =
+      rad_to_deg(quantile(reference_.frame_max_rad_s, options_.reference_percentile));
+  m.max_slide_mps = max_slide_mps_;
+  m.sliding_frames = sliding_frames_;
   return m;
 }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cassert>
 #include <chrono>
+#include <cmath>
 #include <map>
 
 #include "duet/live/live_loop.h"
@@ -56,6 +57,10 @@ void load_frame(const Performance& performance, int f, SourceFrame& frame) {
   frame.arrival = SteadyClock::now();
   std::ranges::copy(performance.motion.translations_ls(f), frame.translations_ls.begin());
   std::ranges::copy(performance.motion.rotations_ls(f), frame.rotations_ls.begin());
+}
+
+double horizontal_distance_m(const Vec3& a, const Vec3& b) {
+  return std::hypot(a.x() - b.x(), a.z() - b.z());
 }
 
 }  // namespace
@@ -145,6 +150,9 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
   std::vector<PartnerFrameRecord> records(static_cast<std::size_t>(frames));
   JerkMeter jerk(partner_joints), true_jerk(partner_joints);
   const double nominal_period = 1.0 / performance.motion.frame_rate();
+  FootLockParams planted;  // what a planted foot is for the slide metric (not the lock's own)
+  planted.height_margin_m = options.slip.height_margin_m;
+  planted.speed_threshold_mps = options.planted_speed_mps;
   for (const PartnerConfig& config : configs) {
     loop.set_params(config.params);
     loop.reset();  // rewinds the replay too
@@ -163,12 +171,19 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
       r.step_us = elapsed_us(start, stop);
       const TruthFrame& truth = performance.truth[fs];
       CapturedDuetSampler& sampler = samplers.at(truth.take);
-      sampler.compute(truth.template_frame,
-                      body_heading_frame(out.user_positions_ws, performance.roles));
+      const Transform user_heading = body_heading_frame(out.user_positions_ws, performance.roles);
+      sampler.compute(truth.template_frame, user_heading);
+      r.spacing_error_m =
+          std::abs(horizontal_distance_m(out.partner_positions_ws[0], user_heading.translation) -
+                   horizontal_distance_m(sampler.placed_positions_ws()[0],
+                                         user_heading.translation));
       r.joint_error_m =
           mean_joint_distance_m(out.partner_positions_ws, sampler.placed_positions_ws());
 
       const PartnerModel& model = loop.partner_model(out.partner_take);
+      const PartnerModel& true_model = loop.partner_model(truth.take);
+      const int true_frame = std::clamp(static_cast<int>(std::lround(truth.template_frame)), 0,
+                                        true_model.frame_count() - 1);
       const JointRoles& partner_roles = model.response_roles();
       for (int pair = 0; pair < kHandPairCount; ++pair) {
         if ((sampler.contact_mask() & (1u << pair)) == 0) continue;
@@ -181,6 +196,8 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
         r.hand_error_m[static_cast<std::size_t>(pair)] =
             std::abs(output - sampler.captured_wrist_distance_m(pair));
         r.hand_pairs |= static_cast<std::uint8_t>(1u << pair);
+        r.hands_joined = r.hands_joined && r.hand_error_m[static_cast<std::size_t>(pair)] <=
+                                               options.rejoin_tolerance_m;
       }
 
       std::array<Vec3, 2> toes;
@@ -200,8 +217,12 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
           const double ground = model.foot_ground_height(static_cast<Side>(side));
           r.slip = r.slip || foot_slips(previous_toes[side], toes[side], ground, dt, options.slip);
           if (foot_near_ground(previous_toes[side], toes[side], ground, options.slip)) {
-            r.ground_speed_sum_mps += horizontal_speed_mps(previous_toes[side], toes[side], dt);
+            const double speed = horizontal_speed_mps(previous_toes[side], toes[side], dt);
+            r.ground_speed_sum_mps += speed;
             ++r.ground_feet;
+            if (true_model.foot_planted(true_frame, static_cast<Side>(side), planted)) {
+              r.planted_slide_mps = std::max(r.planted_slide_mps, speed);
+            }
           }
         }
         r.max_angular_speed_rad_s = max_joint_angular_speed_rad_s(

@@ -425,12 +425,24 @@ Performance with_frame_loss(Performance performance, const FrameLossOptions& opt
       continue;
     }
     const int o = static_cast<int>(next_kept++);
-    std::ranges::copy(motion.translations_ls(k), out.motion.translations_ls(o).begin());
-    std::ranges::copy(motion.rotations_ls(k), out.motion.rotations_ls(o).begin());
-    TruthFrame truth = performance.truth[ks];
-    truth.jump = truth.jump || carry_jump;
-    carry_jump = false;
-    out.truth.push_back(truth);
+    // Drawn only when asked for: performances without repeats stay what they were.
+    const bool repeat =
+        options.repeat_fraction > 0.0 && o > 0 && uniform(rng, 0.0, 1.0) < options.repeat_fraction;
+    if (repeat) {
+      std::ranges::copy(out.motion.translations_ls(o - 1), out.motion.translations_ls(o).begin());
+      std::ranges::copy(out.motion.rotations_ls(o - 1), out.motion.rotations_ls(o).begin());
+      TruthFrame truth = out.truth.back();
+      carry_jump = carry_jump || performance.truth[ks].jump;
+      truth.jump = false;
+      out.truth.push_back(truth);
+    } else {
+      std::ranges::copy(motion.translations_ls(k), out.motion.translations_ls(o).begin());
+      std::ranges::copy(motion.rotations_ls(k), out.motion.rotations_ls(o).begin());
+      TruthFrame truth = performance.truth[ks];
+      truth.jump = truth.jump || carry_jump;
+      carry_jump = false;
+      out.truth.push_back(truth);
+    }
     double time = performance.times_s[ks];
     if (options.jitter_s > 0.0) time += uniform(rng, 0.0, options.jitter_s);
     if (uniform(rng, 0.0, 1.0) < options.late_fraction) {

@@ -92,6 +92,70 @@ void append_partner_legend(std::string& out, const PartnerMetricsOptions& option
        "user)");
 }
 
+std::string seconds_cell(double s) {
+  return std::isfinite(s) ? fmt::format("{:.2f}", s) : std::string("never");
+}
+
+// Issue 11's partner targets, one line per case x configuration: is the partner as steady as the
+// captured one, and how fast is it back after a jump.
+void append_steadiness_table(std::string& out, const EvalReport& report) {
+  const PartnerMetricsOptions& o = report.partner_options;
+  out += "\npartner steadiness and transitions after jumps (issue 11; docs/evaluation.md):\n";
+  constexpr const char* kHeader =
+      "{:<18} {:<12} {:>8} {:>8} {:>6} {:>8} {:>7} {:>8} {:>8} {:>7} {:>8} {:>8} {:>8} {:>6} "
+      "{:>8} {:>7}\n";
+  fmt::format_to(std::back_inserter(out), kHeader, "case", "corrections", "speed", "captured",
+                 "ratio", "hand med", ">win99", "rejoin", "rejoin", "in time", "spacing",
+                 "spacing", "slide", ">limit", "slide", ">limit");
+  fmt::format_to(std::back_inserter(out), kHeader, "", "",
+                 fmt::format("p{:g}", 100.0 * o.reference_percentile), "deg/s", "", "cm", "jumps",
+                 "med s", "max s", "jumps", "med cm", "max cm", "jump m/s", "jumps", "all m/s",
+                 "frames");
+  for (const PartnerRow& row : report.partner_rows) {
+    const PartnerMetrics& m = row.metrics;
+    const bool hands = row.aligned && m.hand_samples > 0;
+    const bool jumps = m.jumps > 0;
+    const bool placed = row.aligned && jumps;
+    fmt::format_to(
+        std::back_inserter(out), kHeader, row.case_name, row.config,
+        fmt::format("{:.0f}", m.frame_speed_deg_s),
+        fmt::format("{:.0f}", m.captured_frame_speed_deg_s),
+        partner_cell(m.captured_frame_speed_deg_s > 0.0,
+                     m.frame_speed_deg_s / std::max(m.captured_frame_speed_deg_s, 1e-9), 2),
+        partner_cell(hands, m.median_hand_error_cm, 2),
+        jumps ? fmt::format("{}/{}", m.jumps_over_window_reference, m.jumps) : "-",
+        placed ? seconds_cell(m.median_rejoin_s) : "-",
+        placed ? seconds_cell(m.max_rejoin_s) : "-",
+        placed ? fmt::format("{}/{}", m.jumps_rejoined_in_time, m.jumps) : "-",
+        partner_cell(placed, m.median_spacing_error_cm, 1),
+        partner_cell(placed, m.max_spacing_error_cm, 1), partner_cell(jumps, m.max_jump_slide_mps, 2),
+        jumps ? fmt::format("{}/{}", m.jumps_sliding, m.jumps) : "-",
+        fmt::format("{:.2f}", m.max_slide_mps), m.sliding_frames);
+  }
+  out += "\ncolumns:\n";
+  const auto line = [&out](std::string_view name, const std::string& text) {
+    fmt::format_to(std::back_inserter(out), "  {:<18} {}\n", name, text);
+  };
+  line("speed, captured",
+       fmt::format("p{:g} of the per-frame largest joint angular speed: the partner's, the "
+                   "captured partner's over the same takes; ratio = speed / captured",
+                   100.0 * o.reference_percentile));
+  line("rejoin s", fmt::format("after each true jump, until the held hands are within {:g} cm of "
+                               "the captured grip and the spacing within {:g} cm of the true "
+                               "response's, for {:g} s (never: not within {:g} s)",
+                               100.0 * o.rejoin_tolerance_m, 100.0 * o.rejoin_tolerance_m,
+                               o.rejoin_hold_s, o.rejoin_search_s));
+  line("in time jumps", fmt::format("jumps rejoined within {:g} s", o.rejoin_deadline_s));
+  line("spacing cm", fmt::format("|partner-to-user - true response-to-user pelvis distance| {:g} s "
+                                 "after each jump",
+                                 o.rejoin_deadline_s));
+  line("slide m/s",
+       fmt::format("largest speed of a toe on the floor whose true foot is planted: in the {:g} s "
+                   "after a jump (largest over jumps; >limit: jumps above {:g} m/s), and over "
+                   "every frame (>limit: frames above it)",
+                   o.post_jump_window_s, o.slide_limit_mps));
+}
+
 // The partner section of the table: one line per case x configuration, then per case the captured
 // partner's own numbers and the loop's cost with the tracker.
 void append_partner_table(std::string& out, const EvalReport& report) {
@@ -153,6 +217,7 @@ void append_partner_table(std::string& out, const EvalReport& report) {
   }
   case_footer(report.partner_rows.back());
   append_partner_legend(out, report.partner_options);
+  append_steadiness_table(out, report);
 }
 
 void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::string& take,
@@ -160,7 +225,8 @@ void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::
   fmt::format_to(std::back_inserter(out),
                  "{},{},{},{},{},{},{:.4f},{},{:.4f},{:.4f},{:.5f},{:.5f},{:.3f},{:.3f},{},{:.2f},"
                  "{:.2f},{},"
-                 "{:.2f},{},{:.2f},{:.5f},{:.3f},{:.2f},{:.2f},{},{},{:.2f},{:.2f}\n",
+                 "{:.2f},{},{:.2f},{:.5f},{:.3f},{:.2f},{:.2f},{},{},{:.2f},{:.2f},{:.2f},{:.2f},"
+                 "{:.3f},{:.3f},{},{:.2f},{:.2f},{:.3f},{},{:.3f},{}\n",
                  row.case_name, row.config, take, take_name, row.aligned ? 1 : 0, m.frames,
                  m.mean_joint_error_cm, m.hand_samples, m.median_hand_error_cm,
                  m.mean_hand_error_cm, m.slip_rate, m.captured_slip_rate, m.ground_speed_cm_s,
@@ -169,7 +235,10 @@ void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::
                  m.jumps_over_truth, m.reference_speed_deg_s, m.captured_windows_over_reference,
                  m.mean_step_us, row.loop_step_us, m.window_reference_speed_deg_s,
                  m.jumps_over_window_reference, m.jumps_over_window_reference_and_truth,
-                 m.mean_jerk_mps3, m.true_mean_jerk_mps3);
+                 m.mean_jerk_mps3, m.true_mean_jerk_mps3, m.frame_speed_deg_s,
+                 m.captured_frame_speed_deg_s, m.median_rejoin_s, m.max_rejoin_s,
+                 m.jumps_rejoined_in_time, m.median_spacing_error_cm, m.max_spacing_error_cm,
+                 m.max_jump_slide_mps, m.jumps_sliding, m.max_slide_mps, m.sliding_frames);
 }
 
 // reliability.dat and its plot: per case, the 10 confidence bins of the first tracker (hmm when
@@ -231,7 +300,9 @@ std::string format_partner_csv(const EvalReport& report) {
       "jumps_over_truth,reference_speed_deg_s,"
       "captured_windows_over_reference,mean_step_us,loop_step_us,window_reference_speed_deg_s,"
       "jumps_over_window_reference,jumps_over_window_reference_and_truth,mean_jerk_mps3,"
-      "true_mean_jerk_mps3\n";
+      "true_mean_jerk_mps3,frame_speed_deg_s,captured_frame_speed_deg_s,median_rejoin_s,"
+      "max_rejoin_s,jumps_rejoined_in_time,median_spacing_error_cm,max_spacing_error_cm,"
+      "max_jump_slide_mps,jumps_sliding,max_slide_mps,sliding_frames\n";
   for (const PartnerRow& row : report.partner_rows) {
     for (const auto& [take, metrics] : row.per_take) {
       append_partner_csv_row(out, row, std::to_string(take), take_name(report, take), metrics);

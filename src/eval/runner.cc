@@ -81,12 +81,42 @@ std::vector<EvalCase> standard_cases(const CaseSettings& settings) {
     c.recipe.noise = noise;
     c.recipe.loss = loss;
   }
+  {
+    // Issue 11's harsher sensor, fixed (not scaled by the settings): per-axis noise is
+    // rotation_deg / sqrt(3) (with_sensor_noise takes the RMS angle).
+    EvalCase& c = add("harsh",
+                      "improv-pause at 30 Hz, 4 deg per axis + 1 cm root noise, 3% repeated "
+                      "frames, a 1.1x body");
+    c.recipe.improvise = true;
+    c.recipe.improvise_options.pause_prob = 1.0;
+    c.recipe.improvise_options.rate_hz = 30.0;
+    c.recipe.noise = {4.0 * std::sqrt(3.0), 0.01, 0};
+    c.recipe.loss.repeat_fraction = 0.03;
+    c.recipe.body_scale = 1.1;
+  }
   // Describe the magnitudes actually used.
   for (EvalCase& c : cases) {
+    if (c.name == "harsh") continue;
     if (c.recipe.noise.active()) {
       c.description += fmt::format(" (noise {:g} deg, {:g} cm)", settings.noise_rotation_deg,
                                    settings.noise_position_m * 100.0);
     }
+  }
+  return cases;
+}
+
+std::vector<EvalCase> noise_sweep_cases() {
+  std::vector<EvalCase> cases;
+  for (int deg = 0; deg <= 5; ++deg) {
+    EvalCase c;
+    c.name = fmt::format("noise-sweep-{}", deg);
+    c.description = fmt::format("improv-pause with {} deg per axis{} of sensor noise", deg,
+                                deg > 0 ? " + 1 cm root" : "");
+    c.recipe.improvise = true;
+    c.recipe.improvise_options.pause_prob = 1.0;
+    // with_sensor_noise takes the RMS angle: sqrt(3) times the per-axis deviation.
+    c.recipe.noise = {deg * std::sqrt(3.0), deg > 0 ? 0.01 : 0.0, 0};
+    cases.push_back(std::move(c));
   }
   return cases;
 }

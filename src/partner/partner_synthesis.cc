@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
+#include "duet/math/rotation.h"
 #include "duet/motion/forward_kinematics.h"
 #include "duet/partner/ik_two_bone_job.h"
 
@@ -84,6 +86,22 @@ double capped_half_life(double minimum, double x0, double max_speed) {
   constexpr double kPeak = 2.0 * 0.69314718055994531 / 2.71828182845904524;
   if (!(max_speed > 0.0) || !std::isfinite(x0)) return minimum;
   return std::max(minimum, kPeak * x0 / max_speed);
+}
+
+// Where the end (wrist) of an arm lands when the local rotations of its start (shoulder) and
+// mid (elbow) joints change from `*_before` to `*_after`; start/mid/end: world transforms before.
+// Joints between them keep their local rotations, so each segment turns with its upper joint.
+Vec3 arm_end_position(const Transform& start, const Transform& mid, const Transform& end,
+                      const Quat& start_before, const Quat& mid_before, const Quat& start_after,
+                      const Quat& mid_after) {
+  // World rotation of the start after: its parent's (unchanged) times the new local rotation.
+  const Quat start_turn = start.rotation * start_before.conjugate() * start_after *
+                          start.rotation.conjugate();  // world-frame turn about the start
+  const Vec3 mid_position = start.translation + start_turn * (mid.translation - start.translation);
+  const Quat mid_rotation = start_turn * mid.rotation;  // the mid as moved with its parent chain
+  const Quat mid_turn =
+      mid_rotation * mid_before.conjugate() * mid_after * mid_rotation.conjugate();
+  return mid_position + mid_turn * (start_turn * (end.translation - mid.translation));
 }
 
 bool finite_pose(const UserPose& user, Side side) {
@@ -200,11 +218,15 @@ std::string PartnerParams::validate() const {
       return std::string(name) + " must be finite and >= 0 (got " + std::to_string(value) + ")";
     }
   }
+  if (!(ik_correction_max_speed_rad_s > 0.0)) {
+    return "ik_correction_max_speed_rad_s must be > 0 (infinity for no limit; got " +
+           std::to_string(ik_correction_max_speed_rad_s) + ")";
+  }
   if (const std::string_view problem = user_filter.validate(); !problem.empty()) {
     return "user_filter: " + std::string(problem);
   }
-  if (const std::string_view problem = ik_target_filter.validate(); !problem.empty()) {
-    return "ik_target_filter: " + std::string(problem);
+  if (const std::string_view problem = ik_correction_filter.validate(); !problem.empty()) {
+    return "ik_correction_filter: " + std::string(problem);
   }
   if (const std::string_view problem = playhead.validate(); !problem.empty()) {
     return "playhead: " + std::string(problem);
@@ -313,7 +335,9 @@ void PartnerContext::reset() noexcept {
   user_heading_ = Transform();
   user_root_filter_.reset();
   user_facing_filter_.reset();
-  for (OneEuroFilter3& filter : ik_target_filter_) filter.reset();
+  for (auto& arm : ik_correction_filter_) {
+    for (OneEuroFilter3& filter : arm) filter.reset();
+  }
   ik_ramp_ = {0.0, 0.0};
   ik_pair_ = {-1, -1};
   ik_target_valid_ = {false, false};
@@ -468,7 +492,7 @@ bool PartnerSynthesisJob::run() const noexcept {
       ctx.ik_ramp_[r] = ramp;
       const double weight = smoothstep(ctx.ik_ramp_[r]);
       if (weight <= 0.0 || ctx.ik_pair_[r] < 0) {
-        ctx.ik_target_filter_[r].reset();
+        for (OneEuroFilter3& filter : ctx.ik_correction_filter_[r]) filter.reset();
         ctx.ik_target_valid_[r] = false;
         continue;
       }
@@ -477,7 +501,7 @@ bool PartnerSynthesisJob::run() const noexcept {
       // captured path while the weight falls.
       const Side ts = template_side(ctx.ik_pair_[r]);
       if (!finite_pose(*user, ts)) {
-        ctx.ik_target_filter_[r].reset();
+        for (OneEuroFilter3& filter : ctx.ik_correction_filter_[r]) filter.reset();
         ctx.ik_target_valid_[r] = false;
         continue;
       }
@@ -511,10 +535,7 @@ bool PartnerSynthesisJob::run() const noexcept {
         ctx.ik_target_offset_[r] = Vec3::Zero();
         ctx.ik_target_offset_velocity_[r] = Vec3::Zero();
       }
-      Vec3 target = raw_target + ctx.ik_target_offset_[r];
-      // Smooth: the target through the 1-euro filter, restarted where the blend takes a jump.
-      if (!p.smooth || (p.blend && jumped)) ctx.ik_target_filter_[r].reset();
-      if (p.smooth) target = ctx.ik_target_filter_[r].filter(target, dt, p.ik_target_filter);
+      const Vec3 target = raw_target + ctx.ik_target_offset_[r];
       ctx.ik_target_valid_[r] = true;
       ctx.ik_raw_target_[r] = raw_target;
       ctx.ik_shown_target_[r] = target;
@@ -525,19 +546,50 @@ bool PartnerSynthesisJob::run() const noexcept {
       const Transform start{ctx.rotations_ws_[js], ctx.positions_ws_[js]};
       const Transform mid{ctx.rotations_ws_[jm], ctx.positions_ws_[jm]};
       const Transform end{ctx.rotations_ws_[je], ctx.positions_ws_[je]};
+      const Quat captured_start = out_r[js], captured_mid = out_r[jm];
+      Quat ik_start = captured_start, ik_mid = captured_mid;
       Vec3 reached_at = Vec3::Zero();
       IkTwoBoneJob ik;
       ik.start_joint_ws = &start;
       ik.mid_joint_ws = &mid;
       ik.end_joint_ws = &end;
-      ik.start_rotation_ls = &out_r[js];
-      ik.mid_rotation_ls = &out_r[jm];
+      ik.start_rotation_ls = &captured_start;
+      ik.mid_rotation_ls = &captured_mid;
       ik.target_ws = target;
       ik.weight = weight;
-      ik.start_rotation_ls_out = &out_r[js];
-      ik.mid_rotation_ls_out = &out_r[jm];
+      ik.start_rotation_ls_out = &ik_start;
+      ik.mid_rotation_ls_out = &ik_mid;
       ik.end_position_ws = &reached_at;
       if (!ik.run()) continue;
+      std::array<OneEuroFilter3, 2>& filters = ctx.ik_correction_filter_[r];
+      if (!p.smooth || (p.blend && jumped)) {
+        for (OneEuroFilter3& filter : filters) filter.reset();
+      }
+      if (p.smooth) {
+        // The correction (captured -> IK, in the joint's own frame) through the 1-euro filter,
+        // then put back on the captured rotation; the wrist lands where that arm reaches.
+        // At most ik_correction_max_speed_rad_s: the IK adds at most that to a joint's speed.
+        std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
+        const auto correct = [&](std::size_t k, const Quat& captured, const Quat& solved) {
+          const bool primed = filters[k].primed();
+          Vec3 c = filters[k].filter(log_map(captured.conjugate() * solved), dt,
+                                     p.ik_correction_filter);
+          const double most = p.ik_correction_max_speed_rad_s * dt;
+          if (primed && (c - shown[k]).norm() > most) {
+            c = shown[k] + (c - shown[k]) * (most / (c - shown[k]).norm());
+          }
+          shown[k] = c;
+          return c;
+        };
+        const Vec3 start_correction = correct(0, captured_start, ik_start);
+        const Vec3 mid_correction = correct(1, captured_mid, ik_mid);
+        ik_start = (captured_start * exp_map(start_correction)).normalized();
+        ik_mid = (captured_mid * exp_map(mid_correction)).normalized();
+        reached_at = arm_end_position(start, mid, end, captured_start, captured_mid, ik_start,
+                                      ik_mid);
+      }
+      out_r[js] = ik_start;
+      out_r[jm] = ik_mid;
       diagnostics.ik_weight[r] = weight;
       diagnostics.ik_target_ws[r] = target;
       diagnostics.ik_error_m[r] = (reached_at - target).norm();
@@ -546,7 +598,9 @@ bool PartnerSynthesisJob::run() const noexcept {
     ctx.ik_ramp_ = {0.0, 0.0};
     ctx.ik_pair_ = {-1, -1};
     ctx.ik_target_valid_ = {false, false};
-    for (OneEuroFilter3& filter : ctx.ik_target_filter_) filter.reset();
+    for (auto& arm : ctx.ik_correction_filter_) {
+      for (OneEuroFilter3& filter : arm) filter.reset();
+    }
   }
 
   // 5. Blend (5.3): inertialization of the finished pose, so a jump's change is blended whatever
@@ -563,13 +617,20 @@ bool PartnerSynthesisJob::run() const noexcept {
     if (jumped && ctx.primed_) {
       ctx.inertializer_.transition(ctx.blend_translations_, ctx.blend_rotations_, out_t, out_r);
       ctx.blend_half_life_ =
-          std::max(capped_half_life(p.blend_half_life_s, ctx.inertializer_.max_rotation_offset(),
-                                    p.blend_max_speed_rad_s),
-                   capped_half_life(p.blend_half_life_s, ctx.inertializer_.max_translation_offset(),
-                                    p.blend_max_root_speed_mps));
+          p.blend_speed_limited
+              ? p.blend_half_life_s
+              : std::max(capped_half_life(p.blend_half_life_s,
+                                          ctx.inertializer_.max_rotation_offset(),
+                                          p.blend_max_speed_rad_s),
+                         capped_half_life(p.blend_half_life_s,
+                                          ctx.inertializer_.max_translation_offset(),
+                                          p.blend_max_root_speed_mps));
     }
+    constexpr double kNoLimit = std::numeric_limits<double>::infinity();
     ctx.inertializer_.update(out_t, out_r, std::max(ctx.blend_half_life_, p.blend_half_life_s), dt,
-                             out_t, out_r);
+                             out_t, out_r,
+                             p.blend_speed_limited ? p.blend_max_speed_rad_s : kNoLimit,
+                             p.blend_speed_limited ? p.blend_max_root_speed_mps : kNoLimit);
     diagnostics.blend_offset_rad = ctx.inertializer_.max_rotation_offset();
   } else {
     ctx.inertializer_.reset();

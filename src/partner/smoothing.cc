@@ -33,6 +33,18 @@ Vec3 smooth_position(const Vec3& current, const Vec3& target, double half_life_s
 
 namespace {
 
+// Holds a decaying offset's step since `before` to at most max_speed * dt (the spring's velocity
+// with it), so a large offset moves at that speed until the spring alone is slower.
+void limit_speed(Vec3& x, Vec3& v, const Vec3& before, double max_speed, double dt) {
+  if (!(max_speed > 0.0) || !std::isfinite(max_speed)) return;
+  const Vec3 step = x - before;
+  const double length = step.norm();
+  if (length <= max_speed * dt) return;
+  x = before + step * (max_speed * dt / length);
+  const double speed = v.norm();
+  if (speed > max_speed) v *= max_speed / speed;
+}
+
 // The constants of one decay step, computed once per frame for all joints.
 struct DecayStep {
   bool skip = false;     // dt <= 0: nothing happens
@@ -135,15 +147,23 @@ void PoseInertializer::transition(std::span<const Vec3> source_translations_ls,
 
 void PoseInertializer::update(std::span<const Vec3> translations_ls,
                               std::span<const Quat> rotations_ls, double half_life_s, double dt_s,
-                              std::span<Vec3> translations_out,
-                              std::span<Quat> rotations_out) noexcept {
+                              std::span<Vec3> translations_out, std::span<Quat> rotations_out,
+                              double max_rotation_speed_rad_s,
+                              double max_translation_speed_mps) noexcept {
   const std::size_t n = rotation_x_.size();
   assert(translations_ls.size() == n && rotations_ls.size() == n);
   assert(translations_out.size() == n && rotations_out.size() == n);
   const DecayStep decay(half_life_s, dt_s);
+  const bool timed = dt_s > 0.0 && std::isfinite(dt_s);
   for (std::size_t j = 0; j < n; ++j) {
+    const Vec3 rotation_before = rotation_x_[j], translation_before = translation_x_[j];
     decay.apply(rotation_x_[j], rotation_v_[j]);
     decay.apply(translation_x_[j], translation_v_[j]);
+    if (timed) {
+      limit_speed(rotation_x_[j], rotation_v_[j], rotation_before, max_rotation_speed_rad_s, dt_s);
+      limit_speed(translation_x_[j], translation_v_[j], translation_before,
+                  max_translation_speed_mps, dt_s);
+    }
     rotations_out[j] = (exp_map(rotation_x_[j]) * rotations_ls[j]).normalized();
     translations_out[j] = translations_ls[j] + translation_x_[j];
   }

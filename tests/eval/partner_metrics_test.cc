@@ -261,6 +261,56 @@ TEST(PartnerMetricsAccumulator, PoolsFramesHandsSlipsAndJumpWindows) {
   EXPECT_NEAR(m2.mean_jerk_mps3, 40.0, 1e-12);
 }
 
+TEST(PartnerMetricsAccumulator, SteadinessAndTheTransitionAfterAJump) {
+  // 30 frames at 10 Hz, true jumps at frames 5 and 20. After the first, the hands rejoin at
+  // frame 8 (0.3 s) and the spacing at frame 7; after the second, the hands never rejoin.
+  Performance performance;
+  for (int f = 0; f < 30; ++f) {
+    performance.times_s.push_back(0.1 * f);
+    performance.truth.push_back({0, static_cast<double>(f), false, f == 5 || f == 20});
+  }
+  std::vector<PartnerFrameRecord> records(30);
+  for (int f = 0; f < 30; ++f) {
+    PartnerFrameRecord& r = records[static_cast<std::size_t>(f)];
+    r.max_angular_speed_rad_s = 1.0 + 0.01 * f;  // p99 of frames 1..29: frame 29's 1.29
+    if (f >= 5 && f < 8) r.hands_joined = false;
+    if (f >= 20) r.hands_joined = false;
+    r.spacing_error_m = f >= 5 && f < 7 ? 0.5 : (f >= 20 && f < 25 ? 0.4 - 0.1 * (f - 20) : 0.01);
+    // A planted foot slides at 0.5 m/s at frame 6 (after the first jump) and at 0.2 at frame 12.
+    r.planted_slide_mps = f == 6 ? 0.5 : (f == 12 ? 0.2 : (f % 2 ? 0.1 : -1.0));
+  }
+  PartnerMetricsAccumulator accumulator;
+  accumulator.add(performance, records);
+  CapturedReference reference;
+  for (int k = 1; k <= 100; ++k) reference.frame_max_rad_s.push_back(0.01 * k);  // p99: 0.99
+  accumulator.add_reference(reference);
+
+  const PartnerMetrics m = accumulator.summary();
+  ASSERT_EQ(m.jumps, 2);
+  EXPECT_NEAR(m.frame_speed_deg_s, rad_to_deg(1.29), 1e-9);
+  EXPECT_NEAR(m.captured_frame_speed_deg_s, rad_to_deg(0.99), 1e-9);
+  EXPECT_TRUE(std::isinf(m.max_rejoin_s));  // the second jump never rejoins
+  EXPECT_TRUE(std::isinf(m.median_rejoin_s));
+  EXPECT_EQ(m.jumps_rejoined_in_time, 1);  // the first, at 0.3 s
+  // Spacing 0.3 s after each jump: 1 cm (frame 8) and 10 cm (frame 23 -> 0.4 - 0.3).
+  EXPECT_NEAR(m.median_spacing_error_cm, 5.5, 1e-9);
+  EXPECT_NEAR(m.max_spacing_error_cm, 10.0, 1e-9);
+  EXPECT_NEAR(m.max_jump_slide_mps, 0.5, 1e-12);
+  EXPECT_EQ(m.jumps_sliding, 1);
+  EXPECT_NEAR(m.max_slide_mps, 0.5, 1e-12);
+  EXPECT_EQ(m.sliding_frames, 1);
+
+  // The first jump alone rejoins: 0.3 s, the time the hands need.
+  records[20].hands_joined = true;
+  for (int f = 21; f < 30; ++f) records[static_cast<std::size_t>(f)].hands_joined = true;
+  PartnerMetricsAccumulator both;
+  both.add(performance, records);
+  const PartnerMetrics m2 = both.summary();
+  EXPECT_EQ(m2.jumps_rejoined_in_time, 1);  // the second: spacing within 5 cm only at 0.4 s
+  EXPECT_NEAR(m2.max_rejoin_s, 0.4, 1e-9);
+  EXPECT_NEAR(m2.median_rejoin_s, 0.35, 1e-9);
+}
+
 // The whole run on a real take: the user dances 60_10 exactly, so the true response is the
 // captured follower placed relative to the user and the raw pose (align only) matches it.
 TEST(PartnerRun, RealTakeFollowedExactly) {

@@ -1,7 +1,9 @@
 #include "duet/eval/performance.h"
+#include "duet/eval/runner.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "duet/features/feature_extractor.h"
@@ -341,6 +343,70 @@ TEST(Perturbations, FrameLossDropsInBurstsAndDelaysTimestamps) {
   EXPECT_NEAR(static_cast<double>(late) / steady.frame_count(), 0.2 * (1.0 - 3.0 / 25.0), 0.05);
   EXPECT_EQ(lossy.truth.size(), static_cast<std::size_t>(lossy.frame_count()));
   EXPECT_EQ(lossy.times_s.size(), static_cast<std::size_t>(lossy.frame_count()));
+}
+
+TEST(Perturbations, RepeatedFramesShowThePreviousPoseAndPassTheJumpOn) {
+  const Fixture f = make_fixture(1800);
+  const SourceTake source = f.source();
+  const Performance full = improvise(std::span(&source, 1), improv_options(0.0)).value();
+  FrameLossOptions options;
+  options.repeat_fraction = 0.03;
+  options.seed = 5;
+  ASSERT_TRUE(options.active());
+  const Performance repeated = with_frame_loss(full, options);
+  ASSERT_EQ(repeated.frame_count(), full.frame_count());  // nothing dropped
+  int repeats = 0, full_jumps = 0, jumps = 0;
+  for (int k = 0; k < full.frame_count(); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    full_jumps += full.truth[i].jump ? 1 : 0;
+    jumps += repeated.truth[i].jump ? 1 : 0;
+    EXPECT_DOUBLE_EQ(repeated.times_s[i], full.times_s[i]);  // sent on time, stale
+    const bool same_as_source =
+        repeated.motion.rotations_ls(k)[1].isApprox(full.motion.rotations_ls(k)[1], 1e-12) &&
+        repeated.truth[i].template_frame == full.truth[i].template_frame;
+    if (same_as_source) continue;
+    ++repeats;
+    ASSERT_GT(k, 0);
+    EXPECT_TRUE(
+        repeated.motion.rotations_ls(k)[1].isApprox(repeated.motion.rotations_ls(k - 1)[1], 0.0));
+    EXPECT_EQ(repeated.truth[i].template_frame, repeated.truth[i - 1].template_frame);
+    EXPECT_FALSE(repeated.truth[i].jump);
+  }
+  EXPECT_NEAR(static_cast<double>(repeats) / full.frame_count(), 0.03, 0.01);
+  EXPECT_EQ(jumps, full_jumps);  // a repeated jump frame passes its flag on
+  // Without repeats, the other perturbations draw the very same numbers as before.
+  const Performance lossy = with_frame_loss(full, {0.10, 0.20, 1.5, 0.002, 3});
+  FrameLossOptions same{0.10, 0.20, 1.5, 0.002, 3};
+  same.repeat_fraction = 0.0;
+  EXPECT_EQ(with_frame_loss(full, same).times_s, lossy.times_s);
+}
+
+TEST(EvalCases, HarshCaseAndNoiseSweepHaveIssue11sMagnitudes) {
+  const std::vector<EvalCase> cases = standard_cases();
+  const auto harsh = std::ranges::find(cases, std::string("harsh"), &EvalCase::name);
+  ASSERT_NE(harsh, cases.end());
+  EXPECT_TRUE(harsh->recipe.improvise);
+  EXPECT_DOUBLE_EQ(harsh->recipe.improvise_options.rate_hz, 30.0);
+  EXPECT_NEAR(harsh->recipe.noise.rotation_deg, 4.0 * std::sqrt(3.0), 1e-12);  // 4 per axis
+  EXPECT_DOUBLE_EQ(harsh->recipe.noise.position_m, 0.01);
+  EXPECT_DOUBLE_EQ(harsh->recipe.loss.repeat_fraction, 0.03);
+  EXPECT_DOUBLE_EQ(harsh->recipe.body_scale, 1.1);
+  // Fixed: a gentler --noise-deg does not soften it.
+  CaseSettings gentle;
+  gentle.noise_rotation_deg = 0.5;
+  const std::vector<EvalCase> other = standard_cases(gentle);
+  EXPECT_EQ(std::ranges::find(other, std::string("harsh"), &EvalCase::name)->recipe.noise.rotation_deg,
+            harsh->recipe.noise.rotation_deg);
+
+  const std::vector<EvalCase> sweep = noise_sweep_cases();
+  ASSERT_EQ(sweep.size(), 6u);
+  for (int deg = 0; deg <= 5; ++deg) {
+    const EvalCase& c = sweep[static_cast<std::size_t>(deg)];
+    EXPECT_EQ(c.name, "noise-sweep-" + std::to_string(deg));
+    EXPECT_NEAR(c.recipe.noise.rotation_deg, deg * std::sqrt(3.0), 1e-12);
+    EXPECT_EQ(c.recipe.noise.active(), deg > 0);
+    EXPECT_TRUE(c.recipe.improvise);
+  }
 }
 
 TEST(Perturbations, BodyScaleAndRoomPlacementLeaveTheFeaturesThatShouldNotChange) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -269,8 +270,8 @@ TEST(PartnerSynthesis, ContactMovesThePartnersWristToTheUsersHand) {
 
 TEST(PartnerSynthesis, SmoothFiltersTheContactTargetsJitter) {
   // Hands held throughout; the sensor jitters the user's left wrist by 1 cm per axis per frame.
-  // With smooth on, the IK target goes through the 1-euro filter: the partner's right wrist
-  // travels much less; once the jitter stops it settles on the unfiltered target.
+  // With smooth on, the IK's correction goes through the 1-euro filter and its speed limit: the
+  // partner's right wrist travels much less; once the jitter stops it settles on the target.
   const Vec3 grip(0.0, 0.0, 0.04);
   Duet duet(240, 0, 240, grip);
   const std::size_t wrist = duet.wrist(Role::kRightWrist);
@@ -298,6 +299,42 @@ TEST(PartnerSynthesis, SmoothFiltersTheContactTargetsJitter) {
   EXPECT_GT(path[1], 1.0);  // ~1.6 cm per frame unfiltered
   EXPECT_LT(path[0], 0.5 * path[1]);
   EXPECT_LT((settled[0] - settled[1]).norm(), 1e-4);
+}
+
+TEST(PartnerSynthesis, TheIkAddsAtMostItsSpeedLimitToTheArmUnderJitter) {
+  // Hands held throughout on a standing duet (the captured arm does not move), the user's wrist
+  // jittering by 2 cm per axis per frame at 30 Hz: with smooth on, the shoulder and elbow turn
+  // by at most ik_correction_max_speed_rad_s (4 rad/s); without it, the IK passes the jitter on.
+  const Vec3 grip(0.0, 0.0, 0.04);
+  Duet duet(240, 0, 240, grip);
+  const std::size_t shoulder = static_cast<std::size_t>(duet.roles[Role::kRightShoulder]);
+  const std::size_t elbow = static_cast<std::size_t>(duet.roles[Role::kRightElbow]);
+  const double dt = 1.0 / 30.0;
+  double largest[2] = {0.0, 0.0};
+  for (const bool smooth : {true, false}) {
+    PartnerParams params = only(true, true, smooth, false, false);
+    ASSERT_EQ(params.ik_correction_max_speed_rad_s, 4.0);
+    Runner run(duet.model, params);
+    std::mt19937 rng(7);
+    std::normal_distribution<double> jitter(0.0, 0.02);
+    Quat previous_shoulder = Quat::Identity(), previous_elbow = Quat::Identity();
+    for (int f = 0; f < 120; ++f) {
+      UserPose user = user_from(duet.leader, 2 * f, duet.roles);
+      user.wrist_positions_ws[0] += Vec3(jitter(rng), jitter(rng), jitter(rng));
+      run.step(2 * f, duet.follower.translations_ls(2 * f), duet.follower.rotations_ls(2 * f), user,
+               false, dt);
+      if (f > 20) {  // the contact has faded in
+        largest[smooth ? 0 : 1] =
+            std::max({largest[smooth ? 0 : 1], run.r[shoulder].angularDistance(previous_shoulder),
+                      run.r[elbow].angularDistance(previous_elbow)});
+      }
+      previous_shoulder = run.r[shoulder];
+      previous_elbow = run.r[elbow];
+    }
+  }
+  // The standing pose's own smoothing adds nothing (it does not move); 1e-6 for rounding.
+  EXPECT_LE(largest[0], 4.0 * dt + 1e-6);
+  EXPECT_GT(largest[1], 2.0 * largest[0]);
 }
 
 TEST(PartnerSynthesis, SmoothDampsJitter) {
@@ -441,7 +478,10 @@ TEST(PartnerSynthesis, AJumpOutOfAContactDropsTheIkAndTheBlendTakesIt) {
     EXPECT_EQ(weights[49], 1.0);
     if (blend) {
       EXPECT_EQ(weights[50], 0.0);
-      EXPECT_LT(fastest, 0.05);  // the 2 m move is blended: well under 3 m/s
+      // The 2 m move is blended: crossed at blend_max_root_speed_mps (3 m/s, 5 cm a frame) at
+      // most, where a snap would move the wrist 2 m in one frame.
+      EXPECT_LE(fastest, 3.0 * kDt + 1e-6);
+      EXPECT_GT(fastest, 0.5 * 3.0 * kDt);  // and at about that speed: no long tail
     } else {
       EXPECT_GT(weights[50], 0.9);  // fading out
       EXPECT_GT(weights[60], 0.0);

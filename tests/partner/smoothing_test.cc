@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -110,9 +111,12 @@ struct JumpRun {
   std::vector<double> output_steps;  // per-frame angular change of the output
   double final_error = 0.0;          // output vs input at the end
   double largest_input_step = 0.0;   // excluding the jump
+  std::vector<double> translation_steps;
 };
 
-JumpRun run_jump(double jump, double half_life, double fps, double seconds) {
+JumpRun run_jump(double jump, double half_life, double fps, double seconds,
+                 double max_rotation_speed = std::numeric_limits<double>::infinity(),
+                 double max_translation_speed = std::numeric_limits<double>::infinity()) {
   PoseInertializer inertializer(1);
   const Vec3 axis = Vec3(0.2, 1.0, 0.1).normalized();
   const double w = 1.5;  // rad/s
@@ -130,8 +134,10 @@ JumpRun run_jump(double jump, double half_life, double fps, double seconds) {
     t[0] = Vec3(i >= 30 ? 0.5 : 0.0, 0, 0);
     if (jumped)
       inertializer.transition(std::vector<Vec3>{previous_t}, std::vector<Quat>{previous_out}, t, r);
-    inertializer.update(t, r, half_life, dt, t_out, r_out);
+    inertializer.update(t, r, half_life, dt, t_out, r_out, max_rotation_speed,
+                        max_translation_speed);
     if (i > 0) run.output_steps.push_back(r_out[0].angularDistance(previous_out));
+    if (i > 0) run.translation_steps.push_back((t_out[0] - previous_t).norm());
     if (i > 0 && !jumped) run.largest_input_step = std::max(run.largest_input_step, w * dt);
     previous_out = r_out[0];
     previous_t = t_out[0];
@@ -155,6 +161,24 @@ TEST(PoseInertializer, OutputIsContinuousAcrossAJumpAndConverges) {
     }
     EXPECT_LT(*std::max_element(run.output_steps.begin(), run.output_steps.end()), 0.25 * 1.2);
     EXPECT_LT(run.final_error, 1e-6);  // 2 s after the jump = 20 half-lives
+  }
+}
+
+TEST(PoseInertializer, SpeedLimitsHoldTheOffsetsAndTheyStillArrive) {
+  // A 2 rad turn and a 0.5 m move at a jump, each offset held to 4 rad/s and 3 m/s: no frame
+  // turns faster than the input plus the cap, and the short half-life brings it home soon after
+  // the cap's own crossing time (0.5 s for 2 rad), where a half-life stretched to keep the
+  // decay under 4 rad/s (2 * 2 ln 2 / (e * 4) = 0.26 s) is still 6 cm / 0.1 rad away.
+  for (const double fps : {30.0, 60.0, 120.0}) {
+    const JumpRun run = run_jump(2.0, 0.1, fps, 3.0, 4.0, 3.0);
+    for (const double step : run.output_steps) {
+      ASSERT_LE(step, run.largest_input_step + 4.0 / fps + 1e-9) << "fps " << fps;
+    }
+    for (const double step : run.translation_steps) ASSERT_LE(step, 3.0 / fps + 1e-9);
+    EXPECT_LT(run.final_error, 1e-6);
+    // 0.9 s after the jump (frame 30): within 0.02 rad.
+    const JumpRun short_run = run_jump(2.0, 0.1, fps, 30.0 / fps + 0.9, 4.0, 3.0);
+    EXPECT_LT(short_run.final_error, 0.02) << "fps " << fps;
   }
 }
 

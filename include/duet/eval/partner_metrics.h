@@ -14,7 +14,13 @@
 //   jump speed    the largest local joint angular speed in the window after each true jump,
 //                 against the captured response's 99th percentile (5.3 blending);
 //   jerk          mean over joints of |third derivative| of the world positions, against the
-//                 true response's over the same performance.
+//                 true response's over the same performance;
+//   steadiness    the 99th percentile of the per-frame largest joint angular speed, against the
+//                 captured response's over its takes (issue 11: the user's sensor noise must not
+//                 reach the partner's joints);
+//   after a jump  the time until the hands are rejoined and the spacing is the captured one
+//                 again, the spacing error a fixed time after the jump, and the speed of planted
+//                 feet in the window after the jump.
 //
 // Offline code: allocates freely (it is not on the live path; the synthesis it measures is).
 #pragma once
@@ -42,6 +48,20 @@ struct PartnerMetricsOptions {
   FootSlipThresholds slip;
   double post_jump_window_s = 0.5;  // frames with t_jump <= t < t_jump + window follow a jump
   double reference_percentile = 0.99;
+  // After a jump (issue 11's targets): the partner has rejoined when every hand pair the true
+  // response holds is within rejoin_tolerance_m of the captured wrist distance and the spacing
+  // (horizontal pelvis-to-pelvis distance) within rejoin_tolerance_m of the true response's, and
+  // stays so for rejoin_hold_s; searched up to rejoin_search_s after the jump (not found: the
+  // jump counts as not rejoined). The spacing error is also read rejoin_deadline_s after it.
+  double rejoin_tolerance_m = 0.05;
+  double rejoin_hold_s = 0.1;
+  double rejoin_search_s = 1.0;
+  double rejoin_deadline_s = 0.3;
+  // A planted foot: the true response's toe is planted at the true frame (within
+  // slip.height_margin_m of its ground and slower than planted_speed_mps) and the partner's toe
+  // is near the ground; it slides when the partner's toe moves faster than slide_limit_mps.
+  double planted_speed_mps = 0.3;
+  double slide_limit_mps = 0.3;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -147,6 +167,14 @@ struct PartnerFrameRecord {
   double jerk_mps3 = -1.0;
   double true_jerk_mps3 = -1.0;
   double step_us = 0.0;  // wall-clock time of the loop step that made it
+  // Every hand pair the true response holds at this frame is within rejoin_tolerance_m of the
+  // captured wrist distance (true when it holds none).
+  bool hands_joined = true;
+  // | partner-to-user - true-response-to-user horizontal pelvis distance |, metres.
+  double spacing_error_m = 0.0;
+  // Largest horizontal speed of a partner toe on a planted foot since the previous frame (see
+  // PartnerMetricsOptions), m/s; -1 when no foot is planted.
+  double planted_slide_mps = -1.0;
 };
 
 // The captured response of the takes a performance was made from, at the take's own rate: the
@@ -161,6 +189,8 @@ struct CapturedReference {
   // itself exceeds its percentile inside such a window (context for the jump metric).
   long long windows = 0;
   std::vector<double> window_max_rad_s;
+  // The largest animated joint's angular speed of every frame from the second.
+  std::vector<double> frame_max_rad_s;
 };
 // Adds one take's response clip (roles: its joint roles; ground: the PartnerModel's heights).
 void add_captured_reference(const Clip& response, const JointRoles& roles,
@@ -203,6 +233,26 @@ struct PartnerMetrics {
   // spikes the dance itself does not have there (a captured take may itself spin a joint faster
   // than the reference, e.g. 61_07's left hand at 4100 deg/s in its first frames).
   long long jumps_over_window_reference_and_truth = 0;
+
+  // Steadiness: the reference_percentile of the per-frame largest joint angular speed, of the
+  // output (frames from the second) and of the captured response over the same takes.
+  double frame_speed_deg_s = 0.0;
+  double captured_frame_speed_deg_s = 0.0;
+  // After the jumps (the `jumps` above): rejoin time, median and largest over jumps (seconds;
+  // infinity when some jump did not rejoin within rejoin_search_s), and how many rejoined within
+  // rejoin_deadline_s.
+  double median_rejoin_s = 0.0;
+  double max_rejoin_s = 0.0;
+  long long jumps_rejoined_in_time = 0;
+  // Spacing error rejoin_deadline_s after each jump, cm: median and largest over jumps.
+  double median_spacing_error_cm = 0.0;
+  double max_spacing_error_cm = 0.0;
+  // Planted feet in the window after each jump: the largest slide speed over jumps (m/s) and the
+  // jumps where it exceeds slide_limit_mps; and over every frame of the performance.
+  double max_jump_slide_mps = 0.0;
+  long long jumps_sliding = 0;
+  double max_slide_mps = 0.0;
+  long long sliding_frames = 0;  // frames with a planted foot above slide_limit_mps
 };
 
 // Pools the records of performances (frames and jumps weigh equally across performances) and
@@ -229,6 +279,12 @@ class PartnerMetricsAccumulator {
   std::vector<double> hand_errors_m_;
   std::vector<double> jump_max_rad_s_;  // one per jump window
   std::vector<double> jump_true_max_rad_s_;
+  std::vector<double> frame_max_rad_s_;    // output, frames from the second
+  std::vector<double> jump_rejoin_s_;      // per jump window; infinity: not rejoined
+  std::vector<double> jump_spacing_m_;     // per jump, rejoin_deadline_s after it
+  std::vector<double> jump_slide_mps_;     // per jump, largest planted slide in the window
+  double max_slide_mps_ = 0.0;
+  long long sliding_frames_ = 0;
   CapturedReference reference_;
 };
 

@@ -122,15 +122,20 @@ Performance with_sensor_noise(Performance performance, const SensorNoiseOptions&
 // drop_fraction of all frames; the first frame is kept); late_fraction of the kept frames carry a
 // timestamp up to late_max_frames sensor periods late; every timestamp gets uniform jitter in
 // [0, jitter_s]. Timestamps stay strictly increasing. A jump flag on a dropped frame moves to the
-// next kept frame.
+// next kept frame. repeat_fraction of the kept frames (never the first) repeat the previous kept
+// frame's pose, as a sensor that sends a stale sample again does; their truth is the repeated
+// pose's (a jump flag moves on to the next frame).
 struct FrameLossOptions {
   double drop_fraction = 0.0;
   double late_fraction = 0.0;
   double late_max_frames = 1.5;
   double jitter_s = 0.0;
   std::uint64_t seed = 1;
+  double repeat_fraction = 0.0;
 
-  bool active() const { return drop_fraction > 0.0 || late_fraction > 0.0 || jitter_s > 0.0; }
+  bool active() const {
+    return drop_fraction > 0.0 || late_fraction > 0.0 || jitter_s > 0.0 || repeat_fraction > 0.0;
+  }
 };
 Performance with_frame_loss(Performance performance, const FrameLossOptions& options);
 

@@ -57,8 +57,12 @@ struct CaseSettings {
 
 // The standard cases, in report order: clean, tempo-slow, tempo-fast, drift, improv,
 // improv-pause, improv-library, noise, 30hz-noisy, late-frames, body-size, room-place,
-// partner-role, improv-30hz-noisy.
+// partner-role, improv-30hz-noisy, harsh (issue 11's sensor: fixed magnitudes, not the settings).
 std::vector<EvalCase> standard_cases(const CaseSettings& settings = {});
+
+// The noise sweep (`duet eval --noise-sweep`): noise-sweep-0 ... noise-sweep-5, improv-pause at
+// the take's rate with 0 to 5 degrees of rotation noise per axis (and 1 cm of root noise above 0).
+std::vector<EvalCase> noise_sweep_cases();
 
 enum class TrackerKind {
   kHmm,               // the jump HMM with EvalOptions::hmm (the defaults unless tuned)

@@ -135,14 +135,22 @@ struct PartnerParams {
   // 11 Hz, about 15 ms of lag. Measured (docs/evaluation.md, partner metrics): toe speed near the
   // ground 86 -> 58 cm/s on `improv-30hz-noisy`, 29 -> 31 cm/s on noise-free `improv-pause`.
   OneEuroParams user_filter;
-  // smooth: the contact IK's target (the user's hand plus the captured offset) goes through a
-  // gentler 1-euro filter (5 Hz still, +20 Hz per m/s): the IK otherwise carries every jitter of
-  // the user's wrist into the partner's arm, near full extension magnified into forearm flicks.
-  // Measured (docs/evaluation.md, partner metrics), unfiltered -> filtered: joint jerk 2384 ->
-  // 1774 m/s^3 on `improv-30hz-noisy` and 20787 -> 13023 on `noise`; post-jump spikes the true
-  // response does not have 1/24 -> 0/24; for a median hand-relation error of 0.79 -> 1.18 cm
-  // (0.21 -> 0.46 cm noise-free). Restarts at a jump (the blend takes the jump).
-  OneEuroParams ik_target_filter{5.0, 20.0, 1.0};
+  // smooth: the correction the contact IK adds to the captured arm (per arm joint, the rotation
+  // from the captured local rotation to the IK's, as a rotation vector) goes through a 1-euro
+  // filter: 1 Hz still, +1 Hz per rad/s the correction changes at. The IK otherwise carries every
+  // jitter of the user's wrist into the partner's arm, near full extension magnified into
+  // forearm flicks (issue 11: p99 largest joint speed 1703 deg/s against 529 captured). The
+  // correction, not the target, is filtered, so the captured arm's own motion keeps its detail
+  // and only the slowly varying difference between the two bodies lags. Measured in
+  // docs/evaluation.md ("Partner steadiness"). Restarts at a jump (the blend takes the jump).
+  OneEuroParams ik_correction_filter{1.0, 1.0, 1.0};
+  // smooth: and the filtered correction changes at most this fast (rad/s, per joint), so the IK
+  // adds at most this to any arm joint's angular speed (infinity: no limit). Noise makes the
+  // 1-euro filter's speed estimate, and so its cutoff, rise; the limit holds regardless.
+  // Measured (docs/evaluation.md, "Partner steadiness"): with it the partner's p99 largest joint
+  // speed is about what it is with the IK off; 2 rad/s was as steady but slowed a persistent
+  // correction (`body-size`: median hand error 1.25 cm, 0.99 at 4 rad/s).
+  double ik_correction_max_speed_rad_s = 4.0;
   // smooth: the response is shown at a real frame that advances at the dancer's tempo
   // (response_playhead.h; used by LiveLoop, which samples the pose there and passes it as
   // PartnerSynthesisJob::frame_position).
@@ -161,6 +169,13 @@ struct PartnerParams {
   double blend_half_life_s = 0.1;
   double blend_max_speed_rad_s = 4.0;
   double blend_max_root_speed_mps = 3.0;
+  // How the caps hold. true: the offsets decay with blend_half_life_s but none moves faster
+  // than its cap (PoseInertializer::update's limits): a far jump crosses at the cap and arrives
+  // (issue 11: the partner at its new place within 0.3 s). false: the half-life is stretched
+  // until the decay alone stays under the caps (the earlier behaviour), which leaves a long
+  // tail: a 0.7 m change took 0.6 s to come within 5 cm. Measured in docs/evaluation.md
+  // ("Partner steadiness").
+  bool blend_speed_limited = true;
 
   // contact: IK target and the time the IK weight takes to go from 0 to 1 (and back) when a
   // contact starts (ends). The weight follows a smoothstep of that linear ramp.
@@ -246,7 +261,9 @@ class PartnerContext {
   // facing direction (a unit horizontal vector, so the yaw never wraps).
   OneEuroFilter3 user_root_filter_;
   OneEuroFilter3 user_facing_filter_;
-  std::array<OneEuroFilter3, 2> ik_target_filter_;  // per response hand (smooth)
+  // Per response hand, per arm joint (shoulder, elbow): the IK's correction (smooth).
+  std::array<std::array<OneEuroFilter3, 2>, 2> ik_correction_filter_;
+  std::array<std::array<Vec3, 2>, 2> ik_correction_{};  // their outputs last frame
   std::array<double, 2> ik_ramp_{0.0, 0.0};  // per response hand, linear fade state in [0, 1]
   std::array<int, 2> ik_pair_{-1, -1};       // pair that last drove that hand
   // IK target continuity, per response hand: last frame's raw and shown targets (valid when the

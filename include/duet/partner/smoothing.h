@@ -7,6 +7,7 @@
 // resize() and noexcept, so it runs on the per-frame path.
 #pragma once
 
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -76,10 +77,16 @@ class PoseInertializer {
                   std::span<const Quat> source_rotations_ls,
                   std::span<const Vec3> destination_translations_ls,
                   std::span<const Quat> destination_rotations_ls) noexcept;
-  // Decays the offsets by dt_s and writes input + offset to out (out may alias in).
+  // Decays the offsets by dt_s and writes input + offset to out (out may alias in). No offset
+  // changes faster than max_rotation_speed_rad_s (each joint's rotation vector) or
+  // max_translation_speed_mps (infinity or <= 0: no limit): a large offset (a jump to a far
+  // place) then crosses at that speed and the short half-life only shapes its end, where a
+  // half-life long enough to keep the whole decay under the speed leaves a long tail.
   void update(std::span<const Vec3> translations_ls, std::span<const Quat> rotations_ls,
               double half_life_s, double dt_s, std::span<Vec3> translations_out,
-              std::span<Quat> rotations_out) noexcept;
+              std::span<Quat> rotations_out,
+              double max_rotation_speed_rad_s = std::numeric_limits<double>::infinity(),
+              double max_translation_speed_mps = std::numeric_limits<double>::infinity()) noexcept;
 
   // Largest remaining rotation offset over all joints, radians (0 after convergence).
   double max_rotation_offset() const noexcept;
