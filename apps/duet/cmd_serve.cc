@@ -188,8 +188,8 @@ Result<std::unique_ptr<FrameSource>> make_source(const SourceSpec& spec, const S
       }
       const double rate = args.source_fps ? *args.source_fps : library.frame_rate();
       return std::unique_ptr<FrameSource>(std::make_unique<VmcSource>(
-          VmcStreamOptions{},
-          fmt::format("VMC (OSC over UDP) on {}:{}", spec.host, spec.port), rate));
+          VmcStreamOptions{}, fmt::format("VMC (OSC over UDP) on {}:{}", spec.host, spec.port),
+          rate));
     }
     case SourceKind::kWebSocket: {
       const std::string path = !spec.path.empty() ? spec.path : args.source_skeleton;
@@ -356,9 +356,9 @@ Command register_serve(CLI::App& app) {
   add_partner_options(app, args->partner);
   app.add_option("--source", args->source,
                  "Where the user's motion comes from: replay:FILE.bvh[?speed=S&loop=1&start=SEC], "
-                 "neuron-tcp:HOST:PORT, neuron-udp:[ADDR:]PORT, ws[:SKELETON.bvh], vmc[:[ADDR:]PORT] (VMC "
-                 "protocol over UDP from XR Animator, SlimeVR, VSeeFace, Warudo; default port "
-                 "39539; docs/vmc.md)")
+                 "neuron-tcp:HOST:PORT, neuron-udp:[ADDR:]PORT, ws[:SKELETON.bvh], "
+                 "vmc[:[ADDR:]PORT] (VMC protocol over UDP from XR Animator, SlimeVR, VSeeFace, "
+                 "Warudo; default port 39539; docs/vmc.md)")
       ->capture_default_str();
   app.add_option("--source-skeleton", args->source_skeleton,
                  "BVH whose hierarchy describes the live stream (neuron; ws without a skeleton)")

@@ -39,15 +39,15 @@ VmcSource::VmcSource(const VmcStreamOptions& options, std::string name, double f
   current_.resize(skeleton_.joint_count());
   const Skeleton& s = *skeleton_.skeleton;
   for (int j = 0; j < s.joint_count(); ++j) {
-    current_.translations_ls[static_cast<std::size_t>(j)] = s.joints[static_cast<std::size_t>(j)].offset;
+    current_.translations_ls[static_cast<std::size_t>(j)] =
+        s.joints[static_cast<std::size_t>(j)].offset;
     current_.rotations_ls[static_cast<std::size_t>(j)] = Quat::Identity();
   }
   hips_position_ = s.joints[0].offset;
 }
 
 bool VmcSource::check(const Vec3& position, const Quat& rotation, Quat& unit) noexcept {
-  if (!finite(position) || !rotation.coeffs().allFinite() ||
-      position.norm() > kMaxPositionM) {
+  if (!finite(position) || !rotation.coeffs().allFinite() || position.norm() > kMaxPositionM) {
     reject(VmcReject::kNonFinite);
     return false;
   }

@@ -80,11 +80,12 @@ SkeletonMap vmc_map() {
   SkeletonMap map;
   map.name = "vmc";
   const std::array<const char*, kRoleCount> names = {
-      "Hips",          "Spine",        "UpperChest",   "Neck",         "Head",
-      "LeftUpperArm",  "LeftLowerArm", "LeftHand",     "RightUpperArm", "RightLowerArm",
-      "RightHand",     "LeftUpperLeg", "LeftLowerLeg", "LeftFoot",      "LeftToes",
-      "RightUpperLeg", "RightLowerLeg", "RightFoot",   "RightToes"};
-  for (int r = 0; r < kRoleCount; ++r) map.joint_names[static_cast<std::size_t>(r)] = names[static_cast<std::size_t>(r)];
+      "Hips",          "Spine",         "UpperChest",   "Neck",          "Head",
+      "LeftUpperArm",  "LeftLowerArm",  "LeftHand",     "RightUpperArm", "RightLowerArm",
+      "RightHand",     "LeftUpperLeg",  "LeftLowerLeg", "LeftFoot",      "LeftToes",
+      "RightUpperLeg", "RightLowerLeg", "RightFoot",    "RightToes"};
+  for (int r = 0; r < kRoleCount; ++r)
+    map.joint_names[static_cast<std::size_t>(r)] = names[static_cast<std::size_t>(r)];
   return map;
 }
 

@@ -19,8 +19,8 @@
 #include "duet/live/source_vmc.h"
 #include "duet/net/neuron_receiver.h"
 #include "duet/net/osc_output.h"
-#include "duet/net/vmc_receiver.h"
 #include "duet/net/thread_priority.h"
+#include "duet/net/vmc_receiver.h"
 
 namespace duet::net {
 

@@ -15,10 +15,9 @@ bool OscBundleWriter::put(const void* data, std::size_t n) noexcept {
 }
 
 bool OscBundleWriter::put_be32(std::uint32_t value) noexcept {
-  const unsigned char bytes[4] = {static_cast<unsigned char>(value >> 24),
-                                  static_cast<unsigned char>(value >> 16),
-                                  static_cast<unsigned char>(value >> 8),
-                                  static_cast<unsigned char>(value)};
+  const unsigned char bytes[4] = {
+      static_cast<unsigned char>(value >> 24), static_cast<unsigned char>(value >> 16),
+      static_cast<unsigned char>(value >> 8), static_cast<unsigned char>(value)};
   return put(bytes, 4);
 }
 
@@ -30,8 +29,8 @@ bool OscBundleWriter::put_string(std::string_view s) noexcept {
 void OscBundleWriter::begin() noexcept {
   size_ = 0;
   ok_ = true;
-  put("#bundle", 8);         // with its NUL: 8 bytes
-  put_be32(0);               // time tag 1 = "immediately"
+  put("#bundle", 8);  // with its NUL: 8 bytes
+  put_be32(0);        // time tag 1 = "immediately"
   put_be32(1);
 }
 
@@ -61,10 +60,9 @@ bool OscBundleWriter::message(std::string_view address, std::string_view types,
   }
   if (!ok_) return false;
   const auto length = static_cast<std::uint32_t>(size_ - start);
-  const unsigned char bytes[4] = {static_cast<unsigned char>(length >> 24),
-                                  static_cast<unsigned char>(length >> 16),
-                                  static_cast<unsigned char>(length >> 8),
-                                  static_cast<unsigned char>(length)};
+  const unsigned char bytes[4] = {
+      static_cast<unsigned char>(length >> 24), static_cast<unsigned char>(length >> 16),
+      static_cast<unsigned char>(length >> 8), static_cast<unsigned char>(length)};
   std::memcpy(buffer_.data() + size_at, bytes, 4);
   return true;
 }

@@ -25,13 +25,17 @@ bool is_bundle(const char* data, std::size_t size) {
 }
 
 // Reads arguments [first, first + count) as numbers ('f' or 'd'); false if any is not one.
+// Copied byte-wise: in an OSC message a double is only 4-byte aligned.
 bool numbers(const char* types, lo_arg** argv, int first, int count, double* out) {
   for (int k = 0; k < count; ++k) {
     const char t = types[first + k];
+    const char* bytes = reinterpret_cast<const char*>(argv[first + k]);
     if (t == 'f') {
-      out[k] = static_cast<double>(argv[first + k]->f);
+      float f = 0.0f;
+      std::memcpy(&f, bytes, sizeof f);
+      out[k] = static_cast<double>(f);
     } else if (t == 'd') {
-      out[k] = argv[first + k]->d;
+      std::memcpy(&out[k], bytes, sizeof(double));
     } else {
       return false;
     }
@@ -45,7 +49,7 @@ bool transform(const char* types, int argc, lo_arg** argv, std::string_view& nam
   if (argc < 8 || types[0] != 's') return false;
   double v[7];
   if (!numbers(types, argv, 1, 7, v)) return false;
-  name = std::string_view(&argv[0]->s);
+  name = std::string_view(reinterpret_cast<const char*>(argv[0]));
   position = Vec3(v[0], v[1], v[2]);
   rotation = Quat(v[6], v[3], v[4], v[5]);  // w, x, y, z
   return true;

@@ -94,9 +94,8 @@ Accuracy follow_accuracy(const fs::path& dir) {
 }
 
 std::vector<std::string> library_args(const std::string& source, const fs::path& record) {
-  return {"--library", kLibrary,          "--data-dir", DUET_DATA_DIR, "--source",
-          source,      "--record",        record.string(), "--log-interval", "0",
-          "--priority", "normal"};
+  return {"--library", kLibrary,        "--data-dir",     DUET_DATA_DIR, "--source",   source,
+          "--record",  record.string(), "--log-interval", "0",           "--priority", "normal"};
 }
 
 // "arrival->sent p50 X ms, p99 Y ms" from the summary line.
@@ -137,9 +136,9 @@ TEST(ServeVmc, FollowsAVmcReplayAsWellAsTheBvhReplay) {
   ASSERT_TRUE(viewer.connect(vmc.port()));
   ASSERT_TRUE(viewer.read_type("hello"));
   Child sender;
-  ASSERT_TRUE(sender.start({"vmc-send", take, "--fps", "60", "--to",
-                            "127.0.0.1:" + std::to_string(port)},
-                           dir.path / "send.log"));
+  ASSERT_TRUE(
+      sender.start({"vmc-send", take, "--fps", "60", "--to", "127.0.0.1:" + std::to_string(port)},
+                   dir.path / "send.log"));
   int viewed = 0;
   const auto deadline = std::chrono::steady_clock::now() + 180s;
   while (!sender.poll() && std::chrono::steady_clock::now() < deadline) {
@@ -155,8 +154,8 @@ TEST(ServeVmc, FollowsAVmcReplayAsWellAsTheBvhReplay) {
       "take 60_01 against the salsa library, template frame within 100 ms:\n"
       "  BVH replay: %.2f%% of %d frames\n  VMC replay: %.2f%% of %d frames (viewer saw %d)\n"
       "  VMC bundle arrival -> frame sent: p50 %.3f ms, p99 %.3f ms\n",
-      100.0 * bvh.fraction(), bvh.frames, 100.0 * over_vmc.fraction(), over_vmc.frames, viewed,
-      p50, p99);
+      100.0 * bvh.fraction(), bvh.frames, 100.0 * over_vmc.fraction(), over_vmc.frames, viewed, p50,
+      p99);
   EXPECT_GE(bvh.frames, 2200) << replay.log();
   // Every bundle made a frame (loopback UDP loses none; a few may be dropped under load).
   EXPECT_GE(over_vmc.frames, 2200) << vmc.log();
@@ -234,12 +233,12 @@ TEST(ServeVmc, OscOutMatchesTheFrameMessages) {
   });
 
   ServeProcess server;
-  const bool started = server.start(
-      {"--pair", salsa("60", "03"), salsa("61", "03"), "--fps", "60", "--source",
-       "replay:" + salsa("60", "03") + "?start=5", "--source-fps", "60", "--no-record",
-       "--log-interval", "0", "--osc-out", "127.0.0.1:" + std::to_string(osc_port),
-       "--queue-frames", "64"},
-      dir.path / "serve.log");
+  const bool started =
+      server.start({"--pair", salsa("60", "03"), salsa("61", "03"), "--fps", "60", "--source",
+                    "replay:" + salsa("60", "03") + "?start=5", "--source-fps", "60", "--no-record",
+                    "--log-interval", "0", "--osc-out", "127.0.0.1:" + std::to_string(osc_port),
+                    "--queue-frames", "64"},
+                   dir.path / "serve.log");
   std::map<long long, Json> viewed;
   if (started) {
     WsClient viewer;
@@ -282,8 +281,7 @@ TEST(ServeVmc, OscOutMatchesTheFrameMessages) {
   // Loopback UDP: every frame the viewer saw came as OSC too.
   EXPECT_GE(compared, 295) << capture.bundles << " bundles";
   const std::string log = server.log();
-  EXPECT_NE(log.find("OSC out to 127.0.0.1:" + std::to_string(osc_port)), std::string::npos)
-      << log;
+  EXPECT_NE(log.find("OSC out to 127.0.0.1:" + std::to_string(osc_port)), std::string::npos) << log;
   EXPECT_NE(log.find("OSC out: "), std::string::npos) << log;
 }
 

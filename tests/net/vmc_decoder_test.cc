@@ -68,8 +68,9 @@ Bytes frame_bundle(float hips_x, float arm_qy) {
   lo_bundle_add_message(b, "/VMC/Ext/Bone/Pos",
                         transform_message("Hips", {hips_x, 0.9f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f}));
   const float w = std::sqrt(1.0f - arm_qy * arm_qy);
-  lo_bundle_add_message(b, "/VMC/Ext/Bone/Pos",
-                        transform_message("LeftUpperArm", {0.1f, 0.0f, 0.0f, 0.0f, arm_qy, 0.0f, w}));
+  lo_bundle_add_message(
+      b, "/VMC/Ext/Bone/Pos",
+      transform_message("LeftUpperArm", {0.1f, 0.0f, 0.0f, 0.0f, arm_qy, 0.0f, w}));
   lo_bundle_add_message(
       b, "/VMC/Ext/Bone/Pos",
       transform_message("LeftIndexProximal", {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f}));
@@ -147,8 +148,7 @@ TEST(VmcDecoder, BadMessagesAreCountedNotUsed) {
   feed(serialise(transform_message("Hips", {nan, 1, 0, 0, 0, 0, 1}), "/VMC/Ext/Bone/Pos"), source);
   feed(serialise(transform_message("Hips", {1e6f, 1, 0, 0, 0, 0, 1}), "/VMC/Ext/Bone/Pos"), source);
   feed(serialise(transform_message("Hips", {0, 1, 0, 0, 0, 0, 0}), "/VMC/Ext/Bone/Pos"), source);
-  feed(serialise(transform_message("root", {0, 0, 0, 0, 0, 0, 1e9f}), "/VMC/Ext/Root/Pos"),
-       source);
+  feed(serialise(transform_message("root", {0, 0, 0, 0, 0, 0, 1e9f}), "/VMC/Ext/Root/Pos"), source);
   // Not VMC at all.
   feed(serialise(int_message(3), "/avatar/parameters/Foo"), source);
   EXPECT_EQ(source.stats().rejected, 7);

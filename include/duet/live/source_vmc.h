@@ -33,11 +33,11 @@ struct VmcStreamOptions {
 
 enum class VmcReject {
   kNone,
-  kMalformed,    // not OSC: a bad bundle or message (decided by the receiver)
-  kForeign,      // OSC, but not a /VMC/ address
-  kBadArguments, // a VMC address with the wrong argument types or count
-  kNonFinite,    // a number that is nan or inf, or a position further than 1 km
-  kBadRotation,  // a quaternion far from unit length
+  kMalformed,     // not OSC: a bad bundle or message (decided by the receiver)
+  kForeign,       // OSC, but not a /VMC/ address
+  kBadArguments,  // a VMC address with the wrong argument types or count
+  kNonFinite,     // a number that is nan or inf, or a position further than 1 km
+  kBadRotation,   // a quaternion far from unit length
 };
 const char* vmc_reject_name(VmcReject reason);
 
