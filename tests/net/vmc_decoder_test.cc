@@ -202,6 +202,15 @@ TEST(VmcDecoder, GarbageAndTruncatedPacketsNeverCrash) {
     if (k % 2 == 0 && noise.data.size() >= 8) std::memcpy(noise.data.data(), "#bundle", 8);
     feed(noise, source);
   }
+  // Near-valid packets: the good bundle with a few bytes changed (sizes, type tags, addresses,
+  // string padding), where a decoder is most likely to trust what it should not.
+  for (int k = 0; k < 5000; ++k) {
+    Bytes mutated = good;
+    for (int flips = 1 + static_cast<int>(random() % 4); flips > 0; --flips) {
+      mutated.data[random() % mutated.data.size()] = static_cast<char>(random());
+    }
+    feed(mutated, source);
+  }
   EXPECT_GT(source.stats().rejected, expected_rejections + 3);
   SourceFrame frame;
   frame.resize(source.source_skeleton().joint_count());
