@@ -156,9 +156,10 @@ TEST(ServeVmc, FollowsAVmcReplayAsWellAsTheBvhReplay) {
       "  VMC bundle arrival -> frame sent: p50 %.3f ms, p99 %.3f ms\n",
       100.0 * bvh.fraction(), bvh.frames, 100.0 * over_vmc.fraction(), over_vmc.frames, viewed, p50,
       p99);
-  EXPECT_GE(bvh.frames, 2200) << replay.log();
-  // Every bundle made a frame (loopback UDP loses none; a few may be dropped under load).
-  EXPECT_GE(over_vmc.frames, 2200) << vmc.log();
+  // Of 2242 frames: a replay held up for over 0.25 s (a loaded machine) skips to the frame due
+  // now, and a VMC frame the loop had no time for is pushed out of the source's queue.
+  EXPECT_GE(bvh.frames, 2000) << replay.log();
+  EXPECT_GE(over_vmc.frames, 2000) << vmc.log();
   EXPECT_GT(viewed, 100);
   EXPECT_GE(bvh.fraction(), 0.9);
   EXPECT_NEAR(over_vmc.fraction(), bvh.fraction(), 0.01);
