@@ -12,6 +12,20 @@
 namespace duet::net {
 namespace {
 
+// lo_arg is a union holding a double, but OSC aligns arguments to 4 bytes only: read through
+// bytes, not the union (UBSan reports a misaligned member access otherwise).
+inline std::int32_t arg_int(lo_arg* a) {
+  std::int32_t v = 0;
+  std::memcpy(&v, a, sizeof v);
+  return v;
+}
+inline float arg_float(lo_arg* a) {
+  float v = 0.0f;
+  std::memcpy(&v, a, sizeof v);
+  return v;
+}
+inline const char* arg_string(lo_arg* a) { return reinterpret_cast<const char*>(a); }
+
 struct Decoded {
   std::vector<std::string> paths;
   std::vector<std::string> types;
@@ -25,9 +39,9 @@ int collect(const char* path, const char* types, lo_arg** argv, int argc, lo_mes
   d->types.push_back(types);
   std::vector<double> values;
   for (int k = 0; k < argc; ++k) {
-    if (types[k] == 'i') values.push_back(argv[k]->i);
-    if (types[k] == 'f') values.push_back(argv[k]->f);
-    if (types[k] == 's') d->strings.push_back(&argv[k]->s);
+    if (types[k] == 'i') values.push_back(arg_int(argv[k]));
+    if (types[k] == 'f') values.push_back(arg_float(argv[k]));
+    if (types[k] == 's') d->strings.push_back(arg_string(argv[k]));
   }
   d->numbers.push_back(values);
   return 0;

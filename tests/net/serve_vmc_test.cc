@@ -7,6 +7,7 @@
 
 #include <boost/asio/ip/udp.hpp>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <mutex>
 
@@ -14,6 +15,20 @@
 
 namespace duet::test {
 namespace {
+
+// lo_arg is a union holding a double, but OSC aligns arguments to 4 bytes only: read through
+// bytes, not the union (UBSan reports a misaligned member access otherwise).
+inline std::int32_t arg_int(lo_arg* a) {
+  std::int32_t v = 0;
+  std::memcpy(&v, a, sizeof v);
+  return v;
+}
+inline float arg_float(lo_arg* a) {
+  float v = 0.0f;
+  std::memcpy(&v, a, sizeof v);
+  return v;
+}
+inline const char* arg_string(lo_arg* a) { return reinterpret_cast<const char*>(a); }
 
 const std::string kLibrary = std::string(DUET_TESTDATA_DIR) + "/../../libraries/cmu-salsa.toml";
 
@@ -190,17 +205,17 @@ int on_osc(const char* path, const char* types, lo_arg** argv, int argc, lo_mess
   if (argc != 1) return 0;
   OscFrame& f = c->pending;
   ++f.fields;
-  if (p == "/duet/seq" && types[0] == 'i') c->seq = argv[0]->i;
-  if (p == "/duet/take" && types[0] == 'i') f.take = argv[0]->i;
-  if (p == "/duet/take/name" && types[0] == 's') f.name = &argv[0]->s;
-  if (p == "/duet/frame" && types[0] == 'i') f.frame = argv[0]->i;
-  if (p == "/duet/time" && types[0] == 'f') f.time = argv[0]->f;
-  if (p == "/duet/confidence" && types[0] == 'f') f.confidence = argv[0]->f;
-  if (p == "/duet/tempo" && types[0] == 'f') f.tempo = argv[0]->f;
-  if (p == "/duet/jumped" && types[0] == 'i') f.jumped = argv[0]->i;
-  if (p == "/duet/lost" && types[0] == 'i') f.lost = argv[0]->i;
-  if (p == "/duet/contact/left" && types[0] == 'i') f.left = argv[0]->i;
-  if (p == "/duet/contact/right" && types[0] == 'i') f.right = argv[0]->i;
+  if (p == "/duet/seq" && types[0] == 'i') c->seq = arg_int(argv[0]);
+  if (p == "/duet/take" && types[0] == 'i') f.take = arg_int(argv[0]);
+  if (p == "/duet/take/name" && types[0] == 's') f.name = arg_string(argv[0]);
+  if (p == "/duet/frame" && types[0] == 'i') f.frame = arg_int(argv[0]);
+  if (p == "/duet/time" && types[0] == 'f') f.time = arg_float(argv[0]);
+  if (p == "/duet/confidence" && types[0] == 'f') f.confidence = arg_float(argv[0]);
+  if (p == "/duet/tempo" && types[0] == 'f') f.tempo = arg_float(argv[0]);
+  if (p == "/duet/jumped" && types[0] == 'i') f.jumped = arg_int(argv[0]);
+  if (p == "/duet/lost" && types[0] == 'i') f.lost = arg_int(argv[0]);
+  if (p == "/duet/contact/left" && types[0] == 'i') f.left = arg_int(argv[0]);
+  if (p == "/duet/contact/right" && types[0] == 'i') f.right = arg_int(argv[0]);
   return 0;
 }
 
