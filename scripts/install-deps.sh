@@ -4,7 +4,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build ccache clang git curl ca-certificates
   libeigen3-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfmt-dev libspdlog-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev gnuplot-nox libboost1.81-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev gnuplot-nox libboost1.81-dev liblo-dev pkgconf
   chromium fonts-liberation
 )
 # Installed without their recommends. blender: the BVH output is opened in Blender's importer by

@@ -13,8 +13,10 @@
 #include "duet/live/source_pose.h"
 #include "duet/live/source_replay.h"
 #include "duet/live/source_spec.h"
+#include "duet/live/source_vmc.h"
 #include "duet/motion/head_hands.h"
 #include "duet/net/live_server.h"
+#include "duet/net/osc_output.h"
 #include "input_points.h"
 #include "library_options.h"
 #include "number_checks.h"
@@ -46,6 +48,7 @@ struct ServeArgs {
   double log_interval_s = 5.0;
   int queue_frames = 2;
   std::string priority = "realtime";
+  std::string osc_out;
 };
 
 void fail(const std::string& message) { fmt::print(stderr, "duet serve: {}\n", message); }
@@ -180,6 +183,19 @@ Result<std::unique_ptr<FrameSource>> make_source(const SourceSpec& spec, const S
       return std::unique_ptr<FrameSource>(
           std::make_unique<NeuronSource>(std::move(skeleton).value(), options, name));
     }
+    case SourceKind::kVmc: {
+      // VMC carries the humanoid's bone rotations, not a skeleton of its own: the user's skeleton
+      // is the VMC humanoid (duet/live/vmc_humanoid.h).
+      if (!args.source_skeleton.empty() || !args.source_map.empty() || args.source_scale) {
+        return Error{
+            "a vmc source drives the VMC humanoid skeleton: --source-skeleton, --source-map and "
+            "--source-scale do not apply"};
+      }
+      const double rate = args.source_fps ? *args.source_fps : library.frame_rate();
+      return std::unique_ptr<FrameSource>(std::make_unique<VmcSource>(
+          VmcStreamOptions{}, fmt::format("VMC (OSC over UDP) on {}:{}", spec.host, spec.port),
+          rate));
+    }
     case SourceKind::kWebSocket: {
       const std::string path = !spec.path.empty() ? spec.path : args.source_skeleton;
       SourceSkeleton skeleton;
@@ -254,6 +270,11 @@ int run_serve(const ServeArgs& args) {
     return kExitUsage;
   }
   net::LiveServerOptions options;
+  if (!args.osc_out.empty() &&
+      !net::parse_osc_target(args.osc_out, options.osc_host, options.osc_port)) {
+    fail("--osc-out '" + args.osc_out + "': expected HOST:PORT (e.g. 127.0.0.1:9000)");
+    return kExitUsage;
+  }
   if (!parse_http(args.http, options.server.address, options.server.port)) {
     fail("--http '" + args.http + "': expected ADDR:PORT (e.g. 127.0.0.1:8080)");
     return kExitUsage;
@@ -352,6 +373,10 @@ int run_serve(const ServeArgs& args) {
       summary.frames, summary.clients_seen, milliseconds(summary.latency_total.p50),
       milliseconds(summary.latency_total.p99), milliseconds(summary.latency_total.max),
       summary.dropped, summary.rejected);
+  if (!options.osc_host.empty()) {
+    fmt::print(stderr, "duet serve: OSC out: {} bundles sent, {} dropped\n", summary.osc_sent,
+               summary.osc_dropped);
+  }
   if (!summary.recordings.empty()) {
     fmt::print(stderr, "duet serve: recorded {} frames{}: {}\n", summary.recorded,
                summary.record_lost ? fmt::format(" ({} lost)", summary.record_lost) : "",
@@ -373,9 +398,10 @@ Command register_serve(CLI::App& app) {
   add_partner_options(app, args->partner);
   app.add_option("--source", args->source,
                  "Where the user's motion comes from: replay:FILE.bvh[?speed=S&loop=1&start=SEC], "
-                 "neuron-tcp:HOST:PORT, neuron-udp:[ADDR:]PORT, ws[:SKELETON.bvh], xr (a VR "
-                 "headset and controllers from the viewer's VR session); replay also plays a "
-                 "three-point CSV")
+                 "neuron-tcp:HOST:PORT, neuron-udp:[ADDR:]PORT, ws[:SKELETON.bvh], "
+                 "vmc[:[ADDR:]PORT] (VMC protocol over UDP from XR Animator, SlimeVR, VSeeFace, "
+                 "Warudo; default port 39539; docs/vmc.md), xr (a VR headset and controllers "
+                 "from the viewer's VR session); replay also plays a three-point CSV")
       ->capture_default_str();
   app.add_option("--input-points", args->input_points, kInputPointsHelp)
       ->check(CLI::IsMember({"full", "head,hands"}));
@@ -392,6 +418,9 @@ Command register_serve(CLI::App& app) {
   app.add_option("--source-map", args->source_map,
                  "Skeleton map JSON for the source's joint names (docs/skeleton-maps.md)")
       ->check(CLI::ExistingFile);
+  app.add_option("--osc-out", args->osc_out,
+                 "Send the follower's state (take, frame, time, confidence, tempo, jumped, lost, "
+                 "contacts) as OSC over UDP to HOST:PORT, one bundle per frame (docs/osc.md)");
   app.add_option("--http", args->http,
                  "Address and port to serve on; 0 as port picks a free one. Loopback unless "
                  "told otherwise")

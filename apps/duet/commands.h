@@ -22,5 +22,6 @@ Command register_eval(CLI::App& app);
 Command register_improvise(CLI::App& app);
 Command register_contacts(CLI::App& app);
 Command register_retarget(CLI::App& app);
+Command register_vmc_send(CLI::App& app);
 
 }  // namespace duet::app

@@ -62,6 +62,8 @@ int main(int argc, char** argv) {
       duet::app::register_contacts);
   add("retarget", "Put a motion onto another skeleton, keeping the body's directions and feet",
       duet::app::register_retarget);
+  add("vmc-send", "Play a take as VMC messages (OSC over UDP), for trying `serve --source vmc`",
+      duet::app::register_vmc_send);
 
   // Mistakes CLI11 would report misleadingly: a misspelt command, an unknown option.
   if (const std::optional<std::string> mistake = duet::app::find_command_line_mistake(

@@ -94,6 +94,9 @@ std::optional<std::string> apply_query(std::string_view query, SourceSpec& spec)
       }
       return "unknown option '" + std::string(key) + "' (neuron takes reference)";
     }
+    if (spec.kind == SourceKind::kVmc) {
+      return "unknown option '" + std::string(key) + "' (vmc takes no options)";
+    }
     return "unknown option '" + std::string(key) + "'";
   }
   return std::nullopt;
@@ -113,6 +116,8 @@ const char* source_kind_name(SourceKind kind) {
       return "ws";
     case SourceKind::kXr:
       return "xr";
+    case SourceKind::kVmc:
+      return "vmc";
   }
   return "?";
 }
@@ -142,9 +147,12 @@ Result<SourceSpec> parse_source_spec(std::string_view text) {
     spec.kind = SourceKind::kNeuronTcp;
   } else if (kind == "neuron-udp") {
     spec.kind = SourceKind::kNeuronUdp;
+  } else if (kind == "vmc") {
+    spec.kind = SourceKind::kVmc;
   } else {
     return spec_error(text, "unknown source kind '" + std::string(kind) +
-                                "' (replay:FILE.bvh, neuron-tcp:HOST:PORT, neuron-udp:PORT, ws, xr)");
+                                "' (replay:FILE.bvh, neuron-tcp:HOST:PORT, neuron-udp:PORT, ws, "
+                                "xr, vmc:PORT)");
   }
   // The query starts at the last '?' so a file name may hold one.
   const std::size_t question = rest.rfind('?');
@@ -159,7 +167,14 @@ Result<SourceSpec> parse_source_spec(std::string_view text) {
     return spec;
   }
   spec.host = "127.0.0.1";
+  if (spec.kind == SourceKind::kVmc && colon == std::string_view::npos) {
+    spec.port = kVmcDefaultPort;
+    return spec;
+  }
   if (!parse_host_port(rest, spec.host, spec.port)) {
+    if (spec.kind == SourceKind::kVmc) {
+      return spec_error(text, "expected vmc, vmc:PORT or vmc:ADDR:PORT (e.g. vmc:39539)");
+    }
     return spec_error(text, spec.kind == SourceKind::kNeuronTcp
                                 ? "expected neuron-tcp:HOST:PORT (e.g. neuron-tcp:127.0.0.1:7001)"
                                 : "expected neuron-udp:PORT or neuron-udp:ADDR:PORT");

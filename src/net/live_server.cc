@@ -16,8 +16,11 @@
 #include "duet/live/source_neuron.h"
 #include "duet/live/source_pose.h"
 #include "duet/live/source_replay.h"
+#include "duet/live/source_vmc.h"
 #include "duet/net/neuron_receiver.h"
+#include "duet/net/osc_output.h"
 #include "duet/net/thread_priority.h"
+#include "duet/net/vmc_receiver.h"
 
 namespace duet::net {
 
@@ -89,6 +92,7 @@ struct LiveServer::Impl {
       options.log = [](const std::string& line) { fmt::print(stderr, "duet serve: {}\n", line); };
     }
     neuron = dynamic_cast<NeuronSource*>(source.get());
+    vmc = dynamic_cast<VmcSource*>(source.get());
     pose = dynamic_cast<PoseSource*>(source.get());
     replay = dynamic_cast<ReplaySource*>(source.get());
     frame.resize(source->source_skeleton().joint_count());
@@ -126,6 +130,17 @@ struct LiveServer::Impl {
       auto r = NeuronReceiver::bind_udp(io, spec.host, spec.port, *neuron, on_input, log_fn);
       if (!r) return r.error();
       receiver = std::move(r).value();
+    } else if (spec.kind == SourceKind::kVmc) {
+      if (vmc == nullptr) return Error{"a vmc source spec needs a VMC source"};
+      auto r = VmcReceiver::bind(io, spec.host, spec.port, *vmc, on_input, log_fn);
+      if (!r) return r.error();
+      vmc_receiver = std::move(r).value();
+    }
+    if (!options.osc_host.empty()) {
+      auto o = OscOutput::open(io, options.osc_host, options.osc_port);
+      if (!o) return o.error();
+      osc = std::move(o).value();
+      log("OSC out to " + osc->where());
     }
     if (options.handle_signals) {
       signals.emplace(io, SIGINT, SIGTERM);
@@ -193,6 +208,7 @@ struct LiveServer::Impl {
 
     // Stopped: the loop thread is this one, so no frame is in flight any more.
     if (receiver) receiver->stop();
+    if (vmc_receiver) vmc_receiver->stop();
     server.stop();
     if (loader.joinable()) loader.join();
     // A model (and its recording) that finished loading after the stop is still in the queue.
@@ -212,6 +228,7 @@ struct LiveServer::Impl {
     role_timer.cancel();
     if (signals) signals->cancel();
     if (receiver) receiver->stop();
+    if (vmc_receiver) vmc_receiver->stop();
     server.stop();  // close frames to the WebSocket clients
     wait_for_close(SteadyClock::now() + kCloseGrace);
   }
@@ -237,6 +254,10 @@ struct LiveServer::Impl {
     built.merge(loop_window);
     summary.latency_total = summarize(send);
     summary.loop_total = summarize(built);
+    if (osc) {
+      summary.osc_sent = osc->sent();
+      summary.osc_dropped = osc->dropped();
+    }
   }
 
   // ---- Frames ----
@@ -273,6 +294,7 @@ struct LiveServer::Impl {
     format_frame(out, loop->params(), step_us, *text, frames);  // seq: since the start
     loop_window.record(microseconds(SteadyClock::now() - input.arrival));
     server.broadcast_frame(std::move(text), input.arrival);
+    if (osc) osc->send(out, *loop, frames);
     ++frames;
   }
 
@@ -547,6 +569,9 @@ struct LiveServer::Impl {
   asio::steady_timer shutdown_timer;
   std::optional<asio::signal_set> signals;
   std::unique_ptr<NeuronReceiver> receiver;
+  VmcSource* vmc = nullptr;
+  std::unique_ptr<VmcReceiver> vmc_receiver;
+  std::unique_ptr<OscOutput> osc;
   bool stopping = false;
 
   // The active role's recording and the other role's (opened with its model).

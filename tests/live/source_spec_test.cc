@@ -24,6 +24,35 @@ TEST(SourceSpec, Replay) {
   EXPECT_FALSE(parse_source_spec("replay:a.bvh?colour=red"));
 }
 
+TEST(SourceSpec, Vmc) {
+  Result<SourceSpec> port_only = parse_source_spec("vmc:39540");
+  ASSERT_TRUE(port_only) << port_only.error().message;
+  EXPECT_EQ(port_only.value().kind, SourceKind::kVmc);
+  EXPECT_EQ(port_only.value().host, "127.0.0.1");
+  EXPECT_EQ(port_only.value().port, 39540);
+  Result<SourceSpec> plain = parse_source_spec("vmc");
+  ASSERT_TRUE(plain) << plain.error().message;
+  EXPECT_EQ(plain.value().port, kVmcDefaultPort);
+  Result<SourceSpec> any = parse_source_spec("vmc:0.0.0.0:39539");
+  ASSERT_TRUE(any);
+  EXPECT_EQ(any.value().host, "0.0.0.0");
+  Result<SourceSpec> v6 = parse_source_spec("vmc:[::1]:39539");
+  ASSERT_TRUE(v6);
+  EXPECT_EQ(v6.value().host, "::1");
+  EXPECT_STREQ(source_kind_name(SourceKind::kVmc), "vmc");
+  // Bad specs say what was expected.
+  for (const char* bad : {"vmc:", "vmc:port", "vmc:0", "vmc:70000", "vmc:1.2.3.4:", "vmc:[::1]"}) {
+    Result<SourceSpec> s = parse_source_spec(bad);
+    ASSERT_FALSE(s) << bad;
+    EXPECT_NE(s.error().message.find("expected vmc"), std::string::npos) << s.error().message;
+    EXPECT_NE(s.error().message.find(bad), std::string::npos) << s.error().message;
+  }
+  Result<SourceSpec> option = parse_source_spec("vmc:39539?reference=1");
+  ASSERT_FALSE(option);
+  EXPECT_NE(option.error().message.find("vmc takes no options"), std::string::npos)
+      << option.error().message;
+}
+
 TEST(SourceSpec, Neuron) {
   Result<SourceSpec> tcp = parse_source_spec("neuron-tcp:192.168.1.5:7001");
   ASSERT_TRUE(tcp) << tcp.error().message;

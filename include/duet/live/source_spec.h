@@ -6,7 +6,10 @@
 //   ws[:SKELETON.bvh]                                  poses from WebSocket clients
 //   xr                                                 a VR headset and two controllers over
 //                                                      the WebSocket (the viewer's VR session)
+//   vmc[:[ADDR:]PORT]                                  receive VMC protocol (OSC over UDP), from
+//                                                      XR Animator, SlimeVR, VSeeFace, Warudo, ...
 //
+// vmc without a port listens on VMC's usual port, 39539.
 // HOST defaults to 127.0.0.1; ADDR (the local address to bind) too. IPv6 addresses go in
 // brackets: neuron-tcp:[::1]:7001.
 #pragma once
@@ -20,13 +23,16 @@
 
 namespace duet {
 
-enum class SourceKind { kReplay, kNeuronTcp, kNeuronUdp, kWebSocket, kXr };
+enum class SourceKind { kReplay, kNeuronTcp, kNeuronUdp, kWebSocket, kXr, kVmc };
+
+// The port VMC performers (XR Animator, VSeeFace, ...) send to by default.
+constexpr std::uint16_t kVmcDefaultPort = 39539;
 const char* source_kind_name(SourceKind kind);
 
 struct SourceSpec {
   SourceKind kind = SourceKind::kWebSocket;
   std::string path;  // replay: the file; ws: the skeleton file (empty: the template's skeleton)
-  std::string host;  // neuron-tcp: the server; neuron-udp: the local address to bind
+  std::string host;  // neuron-tcp: the server; neuron-udp, vmc: the local address to bind
   std::uint16_t port = 0;
   ReplayOptions replay;
   bool reference = false;  // neuron: records start with a reference bone's 6 values

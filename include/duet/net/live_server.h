@@ -35,6 +35,9 @@ struct LiveServerOptions {
   // Raise the loop thread's scheduling priority (see thread_priority.h) while run() runs.
   bool realtime = true;
   std::function<void(const std::string&)> log;  // default: a line on stderr
+  // --osc-out: the follower's state as OSC to this host and port (osc_output.h); empty: none.
+  std::string osc_host;
+  std::uint16_t osc_port = 0;
 };
 
 // Builds the loop for a role (the library of that role, a tracker, the partner models). Called on
@@ -52,12 +55,14 @@ struct ServeSummary {
   std::vector<std::string> recordings;  // files written, in order
   long long recorded = 0;
   long long record_lost = 0;
+  long long osc_sent = 0;     // --osc-out bundles sent
+  long long osc_dropped = 0;  // and refused by the socket
 };
 
 class LiveServer {
  public:
-  // `source` is fed according to `spec` (a timer for replay, a socket for neuron-tcp/udp, `pose`
-  // messages for ws). `loop` must have been made for the source's skeleton.
+  // `source` is fed according to `spec` (a timer for replay, a socket for neuron-tcp/udp and vmc,
+  // `pose` messages for ws). `loop` must have been made for the source's skeleton.
   LiveServer(LiveServerOptions options, SourceSpec spec, std::unique_ptr<FrameSource> source,
              std::unique_ptr<LiveLoop> loop, LoopFactory factory);
   ~LiveServer();
