@@ -149,9 +149,9 @@ Result<Clip> parse_points_csv(std::string_view text, const std::string& name,
       header_seen = true;
       continue;
     }
-    if (static_cast<long long>(samples.size()) >= kMaxClipFrames) {
+    if (static_cast<long long>(samples.size()) >= options.max_frames) {
       return make_error(name, line_number,
-                        fmt::format("more than {} samples", kMaxClipFrames));
+                        fmt::format("more than {} samples", options.max_frames));
     }
     Result<Sample> sample = parse_line(line, name, line_number);
     if (!sample) return sample.error();
@@ -174,9 +174,14 @@ Result<Clip> parse_points_csv(std::string_view text, const std::string& name,
   }
   const double duration = samples.back().time_s - samples.front().time_s;
   const double frames_exact = std::floor(duration * rate + 1e-6) + 1.0;
-  if (frames_exact > static_cast<double>(kMaxClipFrames)) {
+  if (frames_exact > static_cast<double>(std::min(options.max_frames, kMaxClipFrames))) {
     return make_error(name, 0, fmt::format("{:.0f} s at {} Hz is more than {} frames", duration,
-                                           rate, kMaxClipFrames));
+                                           rate, std::min(options.max_frames, kMaxClipFrames)));
+  }
+  if (frames_exact < 2.0) {
+    return make_error(name, 0,
+                      fmt::format("the samples span {:.6g} s, less than two frames at {} Hz",
+                                  duration, rate));
   }
   const int frames = static_cast<int>(frames_exact);
   Clip clip(make_head_hands_skeleton(), rate, frames);
@@ -205,7 +210,7 @@ Result<Clip> read_points_csv(const std::string& path, const PointsCsvReadOptions
 std::string format_points_csv(const Clip& points) {
   std::string out = points_csv_header() + "\n";
   for (int f = 0; f < points.frame_count(); ++f) {
-    out += fmt::format("{:.6f}", f / points.frame_rate());
+    out += fmt::format("{:.9f}", f / points.frame_rate());
     for (int p = 1; p <= kPoints; ++p) {
       const Vec3& x = points.translations_ls(f)[static_cast<std::size_t>(p)];
       const Quat& q = points.rotations_ls(f)[static_cast<std::size_t>(p)];

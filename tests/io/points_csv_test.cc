@@ -87,6 +87,10 @@ TEST(PointsCsv, BadInputNamesTheLineAndWhatIsWrong) {
   EXPECT_NE(error_of(header + line(0, 1, 0) + line(0.1, 1, 0) + "nan" + line(0.2, 1, 0).substr(3))
                 .find("not a finite number"),
             std::string::npos);
+  // Two samples closer than a frame period (found by the fuzzer): no clip of one frame.
+  EXPECT_NE(error_of(header + line(0, 1, 0) + line(0.0166, 1, 0)).find("less than two frames"),
+            std::string::npos)
+      << error_of(header + line(0, 1, 0) + line(0.0166, 1, 0));
   // Times in milliseconds read as a 0.001 Hz rate: said, not allocated.
   EXPECT_NE(error_of(header + line(0, 1, 0) + line(1000, 1, 0)).find("outside 1-1000 Hz"),
             std::string::npos);

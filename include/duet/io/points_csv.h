@@ -22,6 +22,9 @@ const std::string& points_csv_header();
 struct PointsCsvReadOptions {
   // The rate of the even grid; unset: the median sample rate, rounded to a whole Hz.
   std::optional<double> frame_rate;
+  // The most frames (and samples) accepted: a gap of hours at 1 kHz would otherwise allocate
+  // gigabytes.
+  long long max_frames = 10'000'000;  // kMaxClipFrames
 };
 
 // A clip on make_head_hands_skeleton(), time 0 at the first sample. Gaps between samples are
