@@ -149,22 +149,7 @@ FeatureExtractor::Context::Sample FeatureExtractor::extract_full_body(
     put(to_heading * (body_point(positions, role) - now.root) * per_leg);
   }
 
-  Vec3 root_velocity_heading = Vec3::Zero();
-  double yaw_rate = 0.0;
-  std::array<double, 4> effector_speed{};
-  if (const Context::Sample* reference = velocity_reference(context, time_s)) {
-    const double dt = now.time_s - reference->time_s;
-    root_velocity_heading = to_heading * ((now.root - reference->root) * (per_leg / dt));
-    yaw_rate = wrap_angle(now.yaw - reference->yaw) / dt;
-    for (std::size_t e = 0; e < 4; ++e) {
-      effector_speed[e] = (now.effectors[e] - reference->effectors[e]).norm() * per_leg / dt;
-    }
-  }
-  out[d++] = static_cast<float>(root_velocity_heading.z());  // forward
-  out[d++] = static_cast<float>(root_velocity_heading.x());  // lateral
-  out[d++] = static_cast<float>(root_velocity_heading.y());  // vertical
-  out[d++] = static_cast<float>(yaw_rate);
-  for (double speed : effector_speed) out[d++] = static_cast<float>(speed);
+  put_velocities(context, now, to_heading, per_leg, 4, out.subspan(d));
   return now;
 }
 
@@ -195,23 +180,32 @@ FeatureExtractor::Context::Sample FeatureExtractor::extract_head_hands(
   out[d++] = static_cast<float>(head.y() * per_height);
   if (spec_.head_tilt) put(to_heading * (head_canonical * Vec3::UnitY()));  // nod and roll
 
-  Vec3 head_velocity_heading = Vec3::Zero();
+  put_velocities(context, now, to_heading, per_height, 2, out.subspan(d));
+  return now;
+}
+
+void FeatureExtractor::put_velocities(const Context& context, const Context::Sample& now,
+                                      const Quat& to_heading, double per_unit, int effectors,
+                                      std::span<float> out) const noexcept {
+  Vec3 root_velocity_heading = Vec3::Zero();
   double yaw_rate = 0.0;
-  std::array<double, 2> hand_speed{};
-  if (const Context::Sample* reference = velocity_reference(context, time_s)) {
+  std::array<double, 4> effector_speed{};
+  if (const Context::Sample* reference = velocity_reference(context, now.time_s)) {
     const double dt = now.time_s - reference->time_s;
-    head_velocity_heading = to_heading * ((now.root - reference->root) * (per_height / dt));
+    root_velocity_heading = to_heading * ((now.root - reference->root) * (per_unit / dt));
     yaw_rate = wrap_angle(now.yaw - reference->yaw) / dt;
-    for (std::size_t e = 0; e < 2; ++e) {
-      hand_speed[e] = (now.effectors[e] - reference->effectors[e]).norm() * per_height / dt;
+    for (std::size_t e = 0; e < static_cast<std::size_t>(effectors); ++e) {
+      effector_speed[e] = (now.effectors[e] - reference->effectors[e]).norm() * per_unit / dt;
     }
   }
-  out[d++] = static_cast<float>(head_velocity_heading.z());
-  out[d++] = static_cast<float>(head_velocity_heading.x());
-  out[d++] = static_cast<float>(head_velocity_heading.y());
+  std::size_t d = 0;
+  out[d++] = static_cast<float>(root_velocity_heading.z());  // forward
+  out[d++] = static_cast<float>(root_velocity_heading.x());  // lateral
+  out[d++] = static_cast<float>(root_velocity_heading.y());  // vertical
   out[d++] = static_cast<float>(yaw_rate);
-  for (double speed : hand_speed) out[d++] = static_cast<float>(speed);
-  return now;
+  for (int e = 0; e < effectors; ++e) {
+    out[d++] = static_cast<float>(effector_speed[static_cast<std::size_t>(e)]);
+  }
 }
 
 const FeatureExtractor::Context::Sample* FeatureExtractor::velocity_reference(

@@ -18,20 +18,24 @@ namespace duet::test {
 
 inline const std::string kSalsaData = DUET_DATA_DIR;
 
+// The 14 duets with features of `points` (the whole body, or a headset's head and hands).
+inline DuetLibrary load_salsa_library(InputPoints points) {
+  std::vector<PairFiles> pairs;
+  for (const char* trial :
+       {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13", "14", "15"}) {
+    pairs.push_back({{kSalsaData + "/cmu-salsa/bvh/60/60_" + trial + "_scaled.bvh"},
+                     {kSalsaData + "/cmu-salsa/bvh/61/61_" + trial + "_scaled.bvh"}});
+  }
+  LibraryOptions options;
+  options.load.frame_rate = 60.0;
+  options.features.input_points = points;
+  Result<DuetLibrary> l = DuetLibrary::load(pairs, options);
+  if (!l) throw std::runtime_error(l.error().message);
+  return std::move(l).value();
+}
+
 inline const DuetLibrary& salsa_library() {
-  static const DuetLibrary loaded = [] {
-    std::vector<PairFiles> pairs;
-    for (const char* trial :
-         {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13", "14", "15"}) {
-      pairs.push_back({{kSalsaData + "/cmu-salsa/bvh/60/60_" + trial + "_scaled.bvh"},
-                       {kSalsaData + "/cmu-salsa/bvh/61/61_" + trial + "_scaled.bvh"}});
-    }
-    LibraryOptions options;
-    options.load.frame_rate = 60.0;
-    Result<DuetLibrary> l = DuetLibrary::load(pairs, options);
-    if (!l) throw std::runtime_error(l.error().message);
-    return std::move(l).value();
-  }();
+  static const DuetLibrary loaded = load_salsa_library(InputPoints::kFullBody);
   return loaded;
 }
 

@@ -9,22 +9,14 @@
 #include <string>
 #include <vector>
 
+#include "net/lo_args.h"
+
 namespace duet::net {
 namespace {
 
-// lo_arg is a union holding a double, but OSC aligns arguments to 4 bytes only: read through
-// bytes, not the union (UBSan reports a misaligned member access otherwise).
-inline std::int32_t arg_int(lo_arg* a) {
-  std::int32_t v = 0;
-  std::memcpy(&v, a, sizeof v);
-  return v;
-}
-inline float arg_float(lo_arg* a) {
-  float v = 0.0f;
-  std::memcpy(&v, a, sizeof v);
-  return v;
-}
-inline const char* arg_string(lo_arg* a) { return reinterpret_cast<const char*>(a); }
+using test_osc::arg_float;
+using test_osc::arg_int;
+using test_osc::arg_string;
 
 struct Decoded {
   std::vector<std::string> paths;

@@ -82,6 +82,10 @@ class FeatureExtractor {
   // (the first frames of a performance); null when there is none.
   const Context::Sample* velocity_reference(const Context& context, double time_s) const noexcept;
   static void remember(Context& context, const Context::Sample& sample) noexcept;
+  // The velocity blocks: the root's velocity in the heading frame and the yaw rate, then the
+  // speeds of the first `effectors` effectors, lengths times per_unit (FeatureSpec).
+  void put_velocities(const Context& context, const Context::Sample& now, const Quat& to_heading,
+                      double per_unit, int effectors, std::span<float> out) const noexcept;
 
   FeatureSpec spec_;
   JointRoles roles_;
