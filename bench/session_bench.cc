@@ -5,6 +5,8 @@
 // BM_FollowSessionStep/0: take 01 on the library's own rig (DAZ BVH, 43 joints).
 // BM_FollowSessionStep/1: take 01 on the CMU ASF rig (31 joints).
 // BM_FollowSessionStepScalar/*: the same on the scalar kernels (DUET_SIMD=scalar), same run.
+// BM_FollowSessionStepHeadHands: take 01 as a headset's three points (head and hands) against the
+// library built from the same three points (16 dims).
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -18,35 +20,43 @@
 #include "duet/io/motion_file.h"
 #include "duet/live/duet_library.h"
 #include "duet/live/follow_session.h"
+#include "duet/motion/head_hands.h"
 
 namespace duet {
 namespace {
 
 const std::string kSalsa = std::string(DUET_DATA_DIR) + "/cmu-salsa";
 
-const DuetLibrary* salsa_library() {
-  static const std::optional<DuetLibrary> library = []() -> std::optional<DuetLibrary> {
-    std::vector<PairFiles> pairs;
-    for (const char* t :
-         {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13", "14", "15"}) {
-      pairs.push_back(PairFiles{{kSalsa + "/bvh/60/60_" + t + "_scaled.bvh"},
-                                {kSalsa + "/bvh/61/61_" + t + "_scaled.bvh"}});
-    }
-    LibraryOptions options;
-    options.load.frame_rate = 60.0;
-    Result<DuetLibrary> loaded = DuetLibrary::load(pairs, options);
-    if (!loaded) return std::nullopt;
-    return std::move(loaded).value();
-  }();
+std::optional<DuetLibrary> load_salsa(InputPoints points) {
+  std::vector<PairFiles> pairs;
+  for (const char* t :
+       {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13", "14", "15"}) {
+    pairs.push_back(PairFiles{{kSalsa + "/bvh/60/60_" + t + "_scaled.bvh"},
+                              {kSalsa + "/bvh/61/61_" + t + "_scaled.bvh"}});
+  }
+  LibraryOptions options;
+  options.load.frame_rate = 60.0;
+  options.features.input_points = points;
+  Result<DuetLibrary> loaded = DuetLibrary::load(pairs, options);
+  if (!loaded) return std::nullopt;
+  return std::move(loaded).value();
+}
+
+const DuetLibrary* salsa_library(InputPoints points = InputPoints::kFullBody) {
+  static const std::optional<DuetLibrary> full = load_salsa(InputPoints::kFullBody);
+  static const std::optional<DuetLibrary> head_hands = load_salsa(InputPoints::kHeadHands);
+  const std::optional<DuetLibrary>& library =
+      points == InputPoints::kHeadHands ? head_hands : full;
   return library ? &*library : nullptr;
 }
 
-void follow_session_step(benchmark::State& state, SimdLevel level) {
+void follow_session_step(benchmark::State& state, SimdLevel level,
+                         InputPoints points = InputPoints::kFullBody) {
   if (!set_simd_level(level)) {
     state.SkipWithError("this CPU cannot run this instruction set");
     return;
   }
-  const DuetLibrary* library = salsa_library();
+  const DuetLibrary* library = salsa_library(points);
   if (library == nullptr) {
     state.SkipWithError("salsa data not found");
     return;
@@ -61,6 +71,15 @@ void follow_session_step(benchmark::State& state, SimdLevel level) {
   if (!input) {
     state.SkipWithError(input.error().message.c_str());
     return;
+  }
+  if (points == InputPoints::kHeadHands) {
+    Result<Clip> three = head_hands_clip(input.value().clip, input.value().roles);
+    if (!three) {
+      state.SkipWithError(three.error().message.c_str());
+      return;
+    }
+    input.value().clip = std::move(three).value();
+    input.value().roles = head_hands_roles();
   }
   const Clip& clip = input.value().clip;
   Result<HmmFollower> follower = HmmFollower::create(library->model(), FollowParams{});
@@ -95,6 +114,12 @@ void BM_FollowSessionStepScalar(benchmark::State& state) {
   follow_session_step(state, SimdLevel::kScalar);
 }
 BENCHMARK(BM_FollowSessionStepScalar)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->MinTime(3.0);
+
+// Three points (issue 12): the head and hands of take 01.
+void BM_FollowSessionStepHeadHands(benchmark::State& state) {
+  follow_session_step(state, detect_simd_level(), InputPoints::kHeadHands);
+}
+BENCHMARK(BM_FollowSessionStepHeadHands)->Arg(0)->Unit(benchmark::kMicrosecond)->MinTime(3.0);
 
 }  // namespace
 }  // namespace duet
