@@ -35,7 +35,17 @@ TEST(BeamFollow, EstimatesTheSameStatesAsTheExactStepOnRealTakes) {
     ASSERT_TRUE(created) << created.error().message;
     auto beam_follower = std::make_unique<BeamFollower>(std::move(created).value());
     const BeamFollower* beam_view = beam_follower.get();
-    const std::vector<FollowResult> beam = test::follow_clip(input.value(), std::move(beam_follower));
+    // The session owns the follower: it must outlive the reads of beam_view below.
+    Result<FollowSession> session =
+        FollowSession::create(test::salsa_library(), input.value().clip.skeleton_ptr(),
+                              input.value().roles, std::move(beam_follower));
+    ASSERT_TRUE(session) << session.error().message;
+    const Clip& clip = input.value().clip;
+    std::vector<FollowResult> beam;
+    for (int f = 0; f < clip.frame_count(); ++f) {
+      beam.push_back(session.value().step(clip.translations_ls(f), clip.rotations_ls(f),
+                                          f / clip.frame_rate()));
+    }
 
     ASSERT_EQ(exact.size(), beam.size());
     int different = 0;
