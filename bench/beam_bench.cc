@@ -28,23 +28,19 @@
 #include "duet/follow/model_cache.h"
 #include "duet/follow/synthetic_library.h"
 #include "duet/live/duet_library.h"
+#include "salsa_pairs.h"
 
 namespace duet {
 namespace {
 
-const std::string kSalsa = std::string(DUET_DATA_DIR) + "/cmu-salsa";
+using bench::kSalsa;
 constexpr int kRealStates = 27495;
 
 // The salsa library's model alone: the library's motion is dropped (and its memory returned to
 // the system), so that the resident memory measured is the follower's.
 const TemplateModel* salsa_model() {
   static const std::optional<TemplateModel> model = []() -> std::optional<TemplateModel> {
-    std::vector<PairFiles> pairs;
-    for (const char* t :
-         {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13", "14", "15"}) {
-      pairs.push_back(PairFiles{{kSalsa + "/bvh/60/60_" + t + "_scaled.bvh"},
-                                {kSalsa + "/bvh/61/61_" + t + "_scaled.bvh"}});
-    }
+    const std::vector<PairFiles> pairs = bench::salsa_pairs();
     LibraryOptions options;
     options.load.frame_rate = 60.0;
     std::optional<TemplateModel> copy;

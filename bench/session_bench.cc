@@ -21,23 +21,18 @@
 #include "duet/live/duet_library.h"
 #include "duet/live/follow_session.h"
 #include "duet/motion/head_hands.h"
+#include "salsa_pairs.h"
 
 namespace duet {
 namespace {
 
-const std::string kSalsa = std::string(DUET_DATA_DIR) + "/cmu-salsa";
+using bench::kSalsa;
 
 std::optional<DuetLibrary> load_salsa(InputPoints points) {
-  std::vector<PairFiles> pairs;
-  for (const char* t :
-       {"01", "02", "03", "04", "05", "06", "07", "09", "10", "11", "12", "13", "14", "15"}) {
-    pairs.push_back(PairFiles{{kSalsa + "/bvh/60/60_" + t + "_scaled.bvh"},
-                              {kSalsa + "/bvh/61/61_" + t + "_scaled.bvh"}});
-  }
   LibraryOptions options;
   options.load.frame_rate = 60.0;
   options.features.input_points = points;
-  Result<DuetLibrary> loaded = DuetLibrary::load(pairs, options);
+  Result<DuetLibrary> loaded = DuetLibrary::load(bench::salsa_pairs(), options);
   if (!loaded) return std::nullopt;
   return std::move(loaded).value();
 }
