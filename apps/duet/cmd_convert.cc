@@ -19,11 +19,6 @@ namespace duet::app {
 
 namespace {
 
-std::string io_lower(std::string text) {
-  for (char& c : text) c = (c >= 'A' && c <= 'Z') ? static_cast<char>(c + 32) : c;
-  return text;
-}
-
 struct ConvertArgs {
   std::vector<std::string> inputs;
   std::string output;
@@ -32,10 +27,6 @@ struct ConvertArgs {
   std::optional<double> output_units_per_metre;  // default: units duet reads back unaided
   std::string points;  // "head,hands": write the three-point CSV of the motion
 };
-
-bool has_csv_extension(const std::string& path) {
-  return path.size() >= 4 && io_lower(path.substr(path.size() - 4)) == ".csv";
-}
 
 // The three points a headset and controllers would have reported (duet/io/points_csv.h).
 int write_points(const LoadedMotion& loaded, const Clip& clip, const std::string& output) {
@@ -55,7 +46,7 @@ int write_points(const LoadedMotion& loaded, const Clip& clip, const std::string
 }
 
 int run_convert(const ConvertArgs& args) {
-  if (args.points.empty() && has_csv_extension(args.output)) {
+  if (args.points.empty() && is_points_csv_path(args.output)) {
     fmt::print(stderr,
                "duet convert: {} is a .csv: a CSV output holds three points; add --points "
                "head,hands (or name a .bvh output)\n",

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "commands.h"
+#include "duet/io/points_csv.h"
 #include "duet/live/live_loop.h"
 #include "duet/live/source_neuron.h"
 #include "duet/live/source_pose.h"
@@ -233,9 +234,7 @@ Result<std::unique_ptr<FrameSource>> make_source(const SourceSpec& spec, const S
 // --input-points head,hands; else the whole body. Decided before the library is built, since its
 // templates must give the same points.
 Result<InputPoints> serve_input_points(const SourceSpec& spec, const ServeArgs& args) {
-  const bool csv = spec.kind == SourceKind::kReplay && spec.path.size() >= 4 &&
-                   (spec.path.substr(spec.path.size() - 4) == ".csv" ||
-                    spec.path.substr(spec.path.size() - 4) == ".CSV");
+  const bool csv = spec.kind == SourceKind::kReplay && is_points_csv_path(spec.path);
   InputPoints asked = InputPoints::kFullBody;
   if (!args.input_points.empty()) parse_input_points(args.input_points, asked);
   if (spec.kind == SourceKind::kXr || csv) {

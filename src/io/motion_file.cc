@@ -166,7 +166,7 @@ Result<LoadedMotion> load_motion(const std::vector<std::string>& paths,
     if (!clip) return clip.error();
     loaded.clip = std::move(clip).value();
     loaded.description = paths[0];
-  } else if (paths.size() == 1 && lowercase_extension(paths[0]) == ".csv") {
+  } else if (paths.size() == 1 && is_points_csv_path(paths[0])) {
     return load_points_csv(paths[0], options);
   } else if (paths.size() == 2) {
     std::string asf = paths[0], amc = paths[1];

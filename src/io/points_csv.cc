@@ -115,6 +115,13 @@ double median_interval(const std::vector<Sample>& samples) {
 
 }  // namespace
 
+bool is_points_csv_path(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string extension = path.substr(path.size() - 4);
+  for (char& c : extension) c = io_internal::ascii_lower(c);
+  return extension == ".csv";
+}
+
 const std::string& points_csv_header() {
   static const std::string header = [] {
     std::string h;

@@ -16,6 +16,10 @@
 
 namespace duet {
 
+// Whether `path` names a three-point CSV: it ends in .csv, in any case (what load_motion reads as
+// one).
+bool is_points_csv_path(const std::string& path);
+
 // The header line, exactly (22 columns).
 const std::string& points_csv_header();
 
