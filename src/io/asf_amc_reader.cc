@@ -598,11 +598,16 @@ bool AsfParser::finish() {
     if (bones[b].parent < 0) {
       return fail(bones[b].line, "bone '" + bones[b].name + "' is not in the :hierarchy");
     }
-    // Walk up the parents until a bone repeats: that bone lies on the cycle.
+    // Walk up the parents until a bone repeats (that bone lies on the cycle) or until a bone
+    // without a parent (a subtree hung under a bone the :hierarchy never places).
     std::vector<char> visited(bones.size(), 0);
     auto on_cycle = b;
     while (!visited[on_cycle]) {
       visited[on_cycle] = 1;
+      if (bones[on_cycle].parent < 0) {
+        return fail(bones[on_cycle].line,
+                    "bone '" + bones[on_cycle].name + "' is not in the :hierarchy");
+      }
       on_cycle = static_cast<std::size_t>(bones[on_cycle].parent);
     }
     return fail(bones[on_cycle].parent_line,

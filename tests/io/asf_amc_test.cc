@@ -431,6 +431,12 @@ TEST(AsfAmcErrors, HierarchyCycleAndTwoParents) {
   asf = mini_asf();
   asf.erase(asf.begin() + 25);  // b never gets a parent
   EXPECT_EQ(asf_error(asf), "t.asf:17: bone 'b' is not in the :hierarchy");
+  // a hangs under b, which the hierarchy never places (found by the fuzzer: the walk up from a
+  // ran off the root-less b).
+  asf = mini_asf();
+  asf[24] = "    b a";
+  asf.erase(asf.begin() + 25);
+  EXPECT_EQ(asf_error(asf), "t.asf:17: bone 'b' is not in the :hierarchy");
   asf = mini_asf();
   asf.resize(26);
   EXPECT_EQ(asf_error(asf), "t.asf:23: :hierarchy has no 'end'");
