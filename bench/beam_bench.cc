@@ -243,7 +243,8 @@ void BM_StartUpFromCache(benchmark::State& state) {
       break;
     }
     CachedModel& c = cached.value();
-    Result<BeamFollower> beam = BeamFollower::create(c.model, {}, {}, std::move(c.index));
+    Result<BeamFollower> beam = BeamFollower::create(
+        c.model, {}, {}, std::make_shared<const JumpCandidateIndex>(std::move(c.index)));
     benchmark::DoNotOptimize(beam.ok());
   }
   state.counters["cache_mb"] = static_cast<double>(std::filesystem::file_size(path)) / 1e6;

@@ -252,6 +252,7 @@ int run_eval(EvalArgs& args) {
     } else {
       LibraryArgs partner_args = args.library;
       partner_args.role = "partner";
+      partner_args.model_cache.clear();  // the cache holds the leader's model
       partner_library = load_library(partner_args, kCommand, features);
       if (!partner_library) return kExitFailure;
       partner = &*partner_library;

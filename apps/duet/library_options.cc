@@ -47,6 +47,17 @@ void add_library_options(CLI::App& app, LibraryArgs& args) {
                  "known per skeleton convention)")
       ->check(scale_check());
   app.add_flag("--trim", args.trim, "Trim a pair whose two clips differ in length to the shorter");
+  app.add_option("--grow-library", args.grow_to_states,
+                 "Grow the follower's library to STATES template states with time-warped, noisy "
+                 "copies of its takes (scale tests: docs/follower.md \"Beam mode\"); a copy's "
+                 "place is reported as the copied take's. Pair it with --beam and --model-cache")
+      ->type_name("STATES")
+      ->check(CLI::Range(1, 50'000'000));
+  app.add_option("--model-cache", args.model_cache,
+                 "Read the library's template model and the beam's index from FILE when it was "
+                 "written for this library, else build them and write FILE (docs/file-formats.md "
+                 "\"Model cache\"); a big library then starts in well under a second")
+      ->type_name("FILE");
   // Checked once the whole command line is read, so a mistake exits 2 like any usage error.
   app.parse_complete_callback([&args] {
     if (args.pair_files.size() % 2 != 0) {
@@ -85,6 +96,8 @@ Result<LibrarySetup> resolve_library(const LibraryArgs& args, const FeatureSpec&
   if (args.fps) setup.options.load.frame_rate = args.fps;
   if (args.scale) setup.options.load.metres_per_unit = args.scale;
   if (args.trim) setup.options.trim_to_shorter = true;
+  setup.options.grow_to_states = args.grow_to_states;
+  setup.options.model_cache = args.model_cache;
   return setup;
 }
 
@@ -106,6 +119,10 @@ std::optional<DuetLibrary> load_library(const LibraryArgs& args, const char* com
   if (!library) {
     fmt::print(stderr, "duet {}: {}\n", command, library.error().message);
     return std::nullopt;
+  }
+  if (!library.value().model_cache_note().empty()) {
+    fmt::print(stderr, "duet {}: {}; built the model and wrote the cache\n", command,
+               library.value().model_cache_note());
   }
   return std::move(library).value();
 }

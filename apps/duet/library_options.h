@@ -1,5 +1,5 @@
 // Command-line options that describe a duet library: --library FILE|DIR, --pair (repeated),
-// --data-dir, --role, --fps, --scale, --trim.
+// --data-dir, --role, --fps, --scale, --trim, --grow-library, --model-cache.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -20,6 +20,8 @@ struct LibraryArgs {
   std::optional<double> fps;
   std::optional<double> scale;
   bool trim = false;
+  int grow_to_states = 0;   // --grow-library STATES (LibraryOptions::grow_to_states)
+  std::string model_cache;  // --model-cache FILE
 };
 
 // Registers the options. The command line must give --library or --pair (else exit 2); each

@@ -39,8 +39,8 @@ void add_tracker_options(CLI::App& app, TrackerArgs& args) {
                "the beam may have lost the dancer (docs/follower.md \"Beam mode\")");
 }
 
-Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args,
-                                              const TemplateModel& model) {
+Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args, const TemplateModel& model,
+                                              std::shared_ptr<const JumpCandidateIndex> index) {
   FollowParams params = args.preset == "paper" ? FollowParams::paper() : FollowParams{};
   if (args.sigma) params.emission_sigma = *args.sigma;
   if (args.fixed_band) params.tempo_adaptive = false;
@@ -51,6 +51,10 @@ Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args,
   if (args.kind == "dtw") return boxed(OnlineDtwTracker::create(model, OnlineDtwParams{}));
   if (args.kind == "naive") return boxed(NaiveHmmFollower::create(model, params));
   if (args.kind == "left-to-right") params.jump_enabled = false;
+  if (args.beam && index) {
+    return boxed(
+        BeamFollower::create(model, params, BeamParams::suited_to(params), std::move(index)));
+  }
   if (args.beam) return boxed(BeamFollower::create(model, params, BeamParams::suited_to(params)));
   return boxed(HmmFollower::create(model, params));
 }

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "duet/base/result.h"
+#include "duet/follow/jump_candidates.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tracker.h"
 
@@ -21,6 +22,10 @@ struct TrackerArgs {
 };
 
 void add_tracker_options(CLI::App& app, TrackerArgs& args);
-Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args, const TemplateModel& model);
+// index: the beam's jump candidate index for this model when one exists
+// (DuetLibrary::candidate_index); else the beam builds its own.
+Result<std::unique_ptr<Tracker>> make_tracker(
+    const TrackerArgs& args, const TemplateModel& model,
+    std::shared_ptr<const JumpCandidateIndex> index = nullptr);
 
 }  // namespace duet::app

@@ -299,7 +299,11 @@ namespace {
 
 // The jump HMM, in beam mode when EvalOptions::beam asks for it.
 Result<std::unique_ptr<Tracker>> hmm_tracker(const TemplateModel& model, const FollowParams& params,
-                                             const EvalOptions& options) {
+                                             const EvalOptions& options,
+                                             std::shared_ptr<const JumpCandidateIndex> index) {
+  if (options.beam && index) {
+    return boxed(BeamFollower::create(model, params, BeamParams::suited_to(params), std::move(index)));
+  }
   if (options.beam) {
     return boxed(BeamFollower::create(model, params, BeamParams::suited_to(params)));
   }
@@ -309,10 +313,11 @@ Result<std::unique_ptr<Tracker>> hmm_tracker(const TemplateModel& model, const F
 }  // namespace
 
 Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const TemplateModel& model,
-                                                   const EvalOptions& options) {
+                                                   const EvalOptions& options,
+                                                   std::shared_ptr<const JumpCandidateIndex> index) {
   switch (kind) {
     case TrackerKind::kHmm:
-      return hmm_tracker(model, options.hmm, options);
+      return hmm_tracker(model, options.hmm, options, std::move(index));
     case TrackerKind::kHmmPaper: {
       // The paper's transitions [4.2]; the emission and decision settings are ours.
       FollowParams params = FollowParams::paper();
@@ -327,7 +332,7 @@ Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const Templ
       params.lost_residual_factor = options.hmm.lost_residual_factor;
       params.confidence_window_frames = options.hmm.confidence_window_frames;
       params.max_steps_per_frame = options.hmm.max_steps_per_frame;
-      return hmm_tracker(model, params, options);
+      return hmm_tracker(model, params, options, std::move(index));
     }
     case TrackerKind::kLeftToRight: {
       FollowParams params = options.hmm;
@@ -438,7 +443,7 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
                                   std::string(tracker_kind_name(trackers[k]));
         if (progress) progress(done, total, label);
         Result<std::unique_ptr<Tracker>> tracker =
-            make_eval_tracker(trackers[k], lib.model(), options);
+            make_eval_tracker(trackers[k], lib.model(), options, lib.candidate_index());
         if (!tracker) return Error{label + ": " + tracker.error().message};
         Result<std::vector<FrameEstimate>> estimates =
             follow_performance(lib, performance, std::move(tracker).value());
@@ -470,7 +475,7 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
                                   lib.takes()[static_cast<std::size_t>(take)].name + " / partner";
         if (progress) progress(done, total, label);
         Result<std::unique_ptr<Tracker>> tracker =
-            make_eval_tracker(TrackerKind::kHmm, lib.model(), options);
+            make_eval_tracker(TrackerKind::kHmm, lib.model(), options, lib.candidate_index());
         if (!tracker) return Error{label + ": " + tracker.error().message};
         Result<PartnerPerformanceResult> partner = run_partner_performance(
             lib, performance, std::move(tracker).value(), options.partner_configs, options.partner);

@@ -113,16 +113,19 @@ Result<BeamForward> BeamForward::create(const TemplateModel& model, const Follow
   if (!params.jump_enabled) return left_to_right_error();
   Result<JumpCandidateIndex> index = JumpCandidateIndex::build(model);
   if (!index) return index.error();
-  return create(model, params, beam, std::move(index).value());
+  return create(model, params, beam,
+                std::make_shared<const JumpCandidateIndex>(std::move(index).value()));
 }
 
 Result<BeamForward> BeamForward::create(const TemplateModel& model, const FollowParams& params,
-                                        const BeamParams& beam, JumpCandidateIndex index) {
+                                        const BeamParams& beam,
+                                        std::shared_ptr<const JumpCandidateIndex> index) {
   if (Status status = beam.validate(); !status.ok()) return status.error();
   if (!params.jump_enabled) return left_to_right_error();
-  if (index.num_states() != model.num_states()) {
+  if (!index) return make_error("beam follower", 0, "no jump candidate index");
+  if (index->num_states() != model.num_states()) {
     return make_error("beam follower", 0,
-                      "jump candidate index of " + std::to_string(index.num_states()) +
+                      "jump candidate index of " + std::to_string(index->num_states()) +
                           " states for a model of " + std::to_string(model.num_states()));
   }
   Result<HmmForward> exact = HmmForward::create(model, params);
@@ -193,7 +196,7 @@ bool BeamForward::sparse_emission(const float* phi, int wanted, BeamContext& con
 
   // The jump candidates, merged into the beam (both sorted) in next_.
   float bound = 0.0f;
-  const int found = index_.nearest(phi, wanted, context.candidates_.data(),
+  const int found = index_->nearest(phi, wanted, context.candidates_.data(),
                                    context.candidate_d2_.data(), bound);
   std::uint32_t* candidates = context.candidates_.data();
   std::sort(candidates, candidates + found);
@@ -482,7 +485,8 @@ Result<BeamFollower> BeamFollower::create(const TemplateModel& model, const Foll
 }
 
 Result<BeamFollower> BeamFollower::create(const TemplateModel& model, const FollowParams& params,
-                                          const BeamParams& beam, JumpCandidateIndex index) {
+                                          const BeamParams& beam,
+                                          std::shared_ptr<const JumpCandidateIndex> index) {
   Result<BeamForward> forward = BeamForward::create(model, params, beam, std::move(index));
   if (!forward.ok()) return forward.error();
   return BeamFollower(std::move(forward).value(), make_context(model, params, beam));

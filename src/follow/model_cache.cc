@@ -13,6 +13,8 @@
 #include <streambuf>
 #include <vector>
 
+#include "duet/base/content_hash.h"
+
 namespace duet {
 namespace {
 
@@ -35,21 +37,6 @@ struct Header {
   std::uint64_t file_bytes;
   std::uint64_t checksum;  // of bytes [sizeof(Header), file_bytes)
 };
-
-// 64-bit words mixed FNV-style (the tail byte-wise): ~5 GB/s, enough to catch damage; not a
-// defence against a crafted file.
-std::uint64_t checksum(const unsigned char* data, std::size_t size) {
-  std::uint64_t h = 0xcbf29ce484222325ull;
-  std::size_t i = 0;
-  for (; i + 8 <= size; i += 8) {
-    std::uint64_t word;
-    std::memcpy(&word, data + i, 8);
-    h = (h ^ word) * 0x100000001b3ull;
-    h ^= h >> 29;
-  }
-  for (; i < size; ++i) h = (h ^ data[i]) * 0x100000001b3ull;
-  return h;
-}
 
 // An istream over bytes in memory (the mapped index section), without a copy.
 class MemoryBuffer : public std::streambuf {
@@ -142,7 +129,7 @@ Status write_model_cache(const std::string& path, const TemplateModel& model,
   std::memcpy(out + header.takes_bytes, model.features().data(), header.features_bytes);
   std::memcpy(out + header.takes_bytes + header.features_bytes, index_blob.data(),
               index_blob.size());
-  header.checksum = checksum(body.data(), body.size());
+  header.checksum = content_hash(body.data(), body.size());
 
   const std::string temporary = path + ".tmp";
   {
@@ -187,7 +174,7 @@ Result<CachedModel> read_model_cache(const std::string& path, std::uint64_t feat
     return fail("model cache written on a machine of another byte order");
   }
   if (header.feature_spec_hash != feature_spec_hash) {
-    return fail("model cache made with another feature spec (hash " +
+    return fail("model cache made for another library or feature spec (key " +
                 std::to_string(header.feature_spec_hash) + ", expected " +
                 std::to_string(feature_spec_hash) + ")");
   }
@@ -211,7 +198,7 @@ Result<CachedModel> read_model_cache(const std::string& path, std::uint64_t feat
                 std::to_string(header.num_takes) + " takes in " + std::to_string(size) +
                 " bytes)");
   }
-  if (checksum(file.data() + sizeof(Header), size - sizeof(Header)) != header.checksum) {
+  if (content_hash(file.data() + sizeof(Header), size - sizeof(Header)) != header.checksum) {
     return fail("model cache damaged (checksum mismatch)");
   }
 

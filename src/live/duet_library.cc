@@ -4,6 +4,8 @@
 #include <cmath>
 #include <filesystem>
 
+#include "duet/base/content_hash.h"
+#include "duet/follow/model_cache.h"
 #include "duet/io/motion_argument.h"
 
 namespace duet {
@@ -117,12 +119,75 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
   library.normalizer_.apply(all);
   // The feature vector ends with its velocity blocks (root velocity, effector speed).
   const int velocity_dims = options.features.velocity_dims();
+  const std::uint64_t key = model_key(all, take_start, velocity_dims, options);
   Result<TemplateModel> model =
       TemplateModel::build(std::move(all), std::move(take_start),
                            library.takes_[0].template_motion.clip.frame_rate(), velocity_dims);
   if (!model) return model.error();
-  library.model_ = std::make_shared<const TemplateModel>(std::move(model).value());
+  if (Status grown = library.grow_and_cache(std::move(model).value(), key); !grown) {
+    return grown.error();
+  }
   return library;
+}
+
+std::uint64_t DuetLibrary::model_key(const FeatureMatrix& features,
+                                     const std::vector<int>& take_start, int velocity_dims,
+                                     const LibraryOptions& options) {
+  std::uint64_t key = content_hash(features.data(), static_cast<std::size_t>(features.size()) *
+                                                        sizeof(float));
+  key = content_hash(take_start.data(), take_start.size() * sizeof(int), key);
+  const std::int64_t shape[] = {features.rows(), features.cols(), velocity_dims,
+                                options.grow_to_states, options.grow_seed};
+  return content_hash(shape, sizeof(shape), key);
+}
+
+Status DuetLibrary::grow_and_cache(TemplateModel captured, std::uint64_t key) {
+  const int captured_states = captured.num_states();
+  SyntheticLibraryOptions grow;
+  grow.num_states = options_.grow_to_states;
+  grow.seed = options_.grow_seed;
+  grow.keep_real_takes = true;
+  if (options_.grow_to_states != 0) {
+    if (options_.grow_to_states < captured_states) {
+      return Error{"the library cannot grow to " + std::to_string(options_.grow_to_states) +
+                   " states: its takes already have " + std::to_string(captured_states)};
+    }
+    Result<std::vector<SyntheticTakeSource>> sources = synthetic_take_sources(captured, grow);
+    if (!sources) return sources.error();
+    copy_sources_.assign(sources.value().begin() + captured.num_takes(), sources.value().end());
+  }
+  auto build = [&]() -> Result<TemplateModel> {
+    if (options_.grow_to_states == 0) return captured;
+    return synthesize_library(captured, grow);
+  };
+  if (options_.model_cache.empty()) {
+    Result<TemplateModel> model = build();
+    if (!model) return model.error();
+    model_ = std::make_shared<const TemplateModel>(std::move(model).value());
+  } else {
+    Result<CachedModel> cached =
+        load_or_build_model_cache(options_.model_cache, key, build, &model_cache_note_);
+    if (!cached) return cached.error();
+    model_ = std::make_shared<const TemplateModel>(std::move(cached.value().model));
+    candidate_index_ =
+        std::make_shared<const JumpCandidateIndex>(std::move(cached.value().index));
+  }
+  const std::size_t takes = takes_.size() + copy_sources_.size();
+  if (static_cast<std::size_t>(model_->num_takes()) != takes) {
+    return Error{"the library model has " + std::to_string(model_->num_takes()) +
+                 " takes where " + std::to_string(takes) + " were expected"};
+  }
+  return Ok{};
+}
+
+LibraryPlace DuetLibrary::place_of(int model_take, int frame) const noexcept {
+  const int captured = static_cast<int>(takes_.size());
+  if (model_take < 0 || frame < 0) return {};
+  if (model_take < captured) return {model_take, frame};
+  const auto copy = static_cast<std::size_t>(model_take - captured);
+  if (copy >= copy_sources_.size()) return {};
+  const SyntheticTakeSource& source = copy_sources_[copy];
+  return {source.real_take, source.real_frame(frame)};
 }
 
 Result<FeatureExtractor> DuetLibrary::make_extractor(std::shared_ptr<const Skeleton> skeleton,

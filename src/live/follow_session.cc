@@ -1,6 +1,7 @@
 #include "duet/live/follow_session.h"
 
 #include <cmath>
+#include <cstdlib>
 
 namespace duet {
 
@@ -35,7 +36,7 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
     has_previous_ = true;
   }
   bias_.correct(features_);
-  const FollowResult result = tracker_->step(features_, dt_s);
+  FollowResult result = tracker_->step(features_, dt_s);
   // Learn only from frames the library explains well: a motion that is no dance (a walk) must
   // stay lost, not teach the offset that would make it look like one. A step of the estimate
   // backwards (jitter the follower does not call a jump) says the match is off by a frame or
@@ -54,7 +55,23 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
                                        static_cast<std::size_t>(rows.cols())),
                 dt_s, result.confidence);
   }
+  if (library_->grown()) report_captured_place(result);
   return result;
+}
+
+void FollowSession::report_captured_place(FollowResult& result) noexcept {
+  if (result.take < 0) return;
+  const LibraryPlace place = library_->place_of(result.take, result.frame_in_take);
+  // Copies of one take at other speeds hold the same moment at nearby frames: a move between
+  // them that lands within a few frames of the previous place is no jump for the partner.
+  constexpr int kSamePlaceFrames = 8;
+  if (result.jumped && previous_place_.take == place.take &&
+      std::abs(place.frame - previous_place_.frame) <= kSamePlaceFrames) {
+    result.jumped = false;
+  }
+  result.take = place.take;
+  result.frame_in_take = place.frame;
+  previous_place_ = place;
 }
 
 void FollowSession::reset() noexcept {
@@ -63,6 +80,7 @@ void FollowSession::reset() noexcept {
   bias_.reset();
   has_previous_ = false;
   previous_state_ = -1;
+  previous_place_ = {};
 }
 
 }  // namespace duet

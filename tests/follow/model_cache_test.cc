@@ -74,7 +74,8 @@ TEST_F(ModelCacheTest, ReadsBackTheModelAndAnIndexThatFindsTheSameCandidates) {
   }
   // A beam follower runs on what was read.
   Result<BeamFollower> beam =
-      BeamFollower::create(model, {}, {}, std::move(read).value().index);
+      BeamFollower::create(
+          model, {}, {}, std::make_shared<const JumpCandidateIndex>(std::move(read).value().index));
   ASSERT_TRUE(beam) << beam.error().message;
   EXPECT_GE(beam.value().step(test::features_at(model, 40.0), 1.0 / 60).state, 0);
 }
@@ -82,7 +83,7 @@ TEST_F(ModelCacheTest, ReadsBackTheModelAndAnIndexThatFindsTheSameCandidates) {
 TEST_F(ModelCacheTest, RejectsMissingTruncatedForeignStaleAndDamagedCaches) {
   EXPECT_NE(rejected().find("cannot open"), std::string::npos);
   write();
-  EXPECT_NE(rejected(kSpec + 1).find("another feature spec"), std::string::npos);
+  EXPECT_NE(rejected(kSpec + 1).find("another library or feature spec"), std::string::npos);
   const auto full = std::filesystem::file_size(path_);
   std::filesystem::resize_file(path_, full - 100);
   const std::string truncated = rejected();

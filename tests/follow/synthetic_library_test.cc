@@ -49,6 +49,50 @@ TEST(SyntheticLibrary, WarpsTimeAndAddsNoise) {
   EXPECT_FALSE(synthesize_library(real, options).value().features().isApprox(big.features()));
 }
 
+TEST(SyntheticLibrary, KeepsTheRealTakesFirstAndNamesEachCopysSource) {
+  const TemplateModel real = test::make_model({200, 150}, 12, 5, 60.0, 4);
+  SyntheticLibraryOptions options;
+  options.num_states = 3000;
+  options.keep_real_takes = true;
+  const TemplateModel big = synthesize_library(real, options).value();
+  ASSERT_EQ(big.num_states(), 3000);
+  EXPECT_TRUE(big.features().topRows(350).isApprox(real.features()));
+  EXPECT_EQ(big.take_begin(1), 200);
+  EXPECT_EQ(big.take_begin(2), 350);
+
+  const std::vector<SyntheticTakeSource> sources = synthetic_take_sources(real, options).value();
+  ASSERT_EQ(static_cast<int>(sources.size()), big.num_takes());
+  for (int k = 0; k < big.num_takes(); ++k) {
+    const SyntheticTakeSource& source = sources[static_cast<std::size_t>(k)];
+    const int real_begin = real.take_begin(source.real_take);
+    EXPECT_EQ(source.real_length, real.take_end(source.real_take) - real_begin);
+    if (k < 2) {
+      EXPECT_EQ(source.real_take, k);
+      EXPECT_EQ(source.speed, 1.0f);
+      continue;
+    }
+    EXPECT_GE(source.speed, options.min_speed);
+    EXPECT_LE(source.speed, options.max_speed);
+    // The copy's frame t shows the real frame real_frame(t): its posture features are the real
+    // ones up to the noise and the interpolation between neighbouring frames.
+    const int posture = big.num_dims() - big.velocity_dims();
+    for (int t = 0; t < big.take_end(k) - big.take_begin(k); t += 17) {
+      const int shown = source.real_frame(t);
+      ASSERT_GE(shown, 0);
+      ASSERT_LT(shown, source.real_length);
+      const float gap = (big.features().row(big.take_begin(k) + t).head(posture) -
+                         real.features().row(real_begin + shown).head(posture))
+                            .cwiseAbs()
+                            .maxCoeff();
+      EXPECT_LT(gap, 0.2f) << "take " << k << " frame " << t;
+    }
+  }
+  // A library smaller than the real one cannot keep it.
+  options.num_states = 300;
+  EXPECT_FALSE(synthesize_library(real, options));
+  EXPECT_FALSE(synthetic_take_sources(real, options));
+}
+
 TEST(SyntheticLibrary, RejectsBadOptions) {
   const TemplateModel real = test::make_model({50}, 4, 1);
   SyntheticLibraryOptions options;

@@ -175,8 +175,11 @@ Result<std::vector<FrameEstimate>> follow_performance(const DuetLibrary& library
                                                       const Performance& performance,
                                                       std::unique_ptr<Tracker> tracker);
 
-// The tracker of a kind on a model (kNaiveHmm is built too, but only fits small models).
-Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const TemplateModel& model,
-                                                   const EvalOptions& options);
+// The tracker of a kind on a model (kNaiveHmm is built too, but only fits small models). index:
+// the beam's jump candidate index for this model when one exists (DuetLibrary::candidate_index);
+// else the beam builds its own.
+Result<std::unique_ptr<Tracker>> make_eval_tracker(
+    TrackerKind kind, const TemplateModel& model, const EvalOptions& options,
+    std::shared_ptr<const JumpCandidateIndex> index = nullptr);
 
 }  // namespace duet

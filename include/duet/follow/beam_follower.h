@@ -24,6 +24,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string_view>
 #include <utility>
@@ -119,9 +120,11 @@ class BeamForward {
   // Validates the parameters and builds the jump candidate index (allocates, O(M log M)).
   static Result<BeamForward> create(const TemplateModel& model, const FollowParams& params,
                                     const BeamParams& beam = {});
-  // The same with an index already built for this model (e.g. read from the model cache).
+  // The same with an index already built for this model (e.g. read from the model cache),
+  // shared with other followers of the same model.
   static Result<BeamForward> create(const TemplateModel& model, const FollowParams& params,
-                                    const BeamParams& beam, JumpCandidateIndex index);
+                                    const BeamParams& beam,
+                                    std::shared_ptr<const JumpCandidateIndex> index);
 
   // One input frame, as HmmForward::step. Allocates nothing, throws nothing.
   FollowResult step(std::span<const float> features, double dt_s,
@@ -129,10 +132,11 @@ class BeamForward {
 
   const HmmForward& exact() const { return exact_; }
   const BeamParams& beam_params() const { return beam_; }
-  const JumpCandidateIndex& index() const { return index_; }
+  const JumpCandidateIndex& index() const { return *index_; }
 
  private:
-  BeamForward(HmmForward exact, JumpCandidateIndex index, const BeamParams& beam)
+  BeamForward(HmmForward exact, std::shared_ptr<const JumpCandidateIndex> index,
+              const BeamParams& beam)
       : exact_(std::move(exact)), index_(std::move(index)), beam_(beam) {}
 
   float resume_share(int i) const noexcept;  // R_i
@@ -149,7 +153,7 @@ class BeamForward {
   int sparse_argmax(const BeamContext& context) const noexcept;
 
   HmmForward exact_;
-  JumpCandidateIndex index_;
+  std::shared_ptr<const JumpCandidateIndex> index_;  // never null
   BeamParams beam_;
   float max_resume_share_ = 0.0f;  // max_i R_i
 };
@@ -160,7 +164,8 @@ class BeamFollower final : public Tracker {
   static Result<BeamFollower> create(const TemplateModel& model, const FollowParams& params,
                                      const BeamParams& beam = {});
   static Result<BeamFollower> create(const TemplateModel& model, const FollowParams& params,
-                                     const BeamParams& beam, JumpCandidateIndex index);
+                                     const BeamParams& beam,
+                                     std::shared_ptr<const JumpCandidateIndex> index);
 
   void reset() noexcept override { context_.reset(); }
   FollowResult step(std::span<const float> features, double dt_s) noexcept override {

@@ -5,7 +5,13 @@
 // noise on every feature, so no two copies are alike and the follower's beam meets as many
 // look-alike places as in a big real library. Mirroring is left out: the follow module sees
 // feature vectors, not the joints that a mirror would swap.
+//
+// Each copy remembers where it comes from (SyntheticTakeSource), so that a grown duet library
+// (DuetLibrary with LibraryOptions::grow_to_states) can show the partner of the real take at the
+// real frame whichever copy the follower is in.
 #pragma once
+
+#include <vector>
 
 #include "duet/base/result.h"
 #include "duet/follow/template_model.h"
@@ -18,11 +24,27 @@ struct SyntheticLibraryOptions {
   float max_speed = 1.25f;
   float noise = 0.02f;  // standard deviation of the noise added to every feature
   unsigned seed = 1;
+  // Keep the real takes, unchanged, as the library's first takes; the copies follow them.
+  bool keep_real_takes = false;
+};
+
+// Where a take of a synthetic library comes from.
+struct SyntheticTakeSource {
+  int real_take = 0;
+  float speed = 1.0f;  // real frames per copy frame
+  int real_length = 0;  // frames of the real take
+  // The real take's frame nearest to the copy's frame `frame` (>= 0).
+  int real_frame(int frame) const noexcept;
 };
 
 // Copies of real's takes, in turn, until num_states states (the last copy cut short, but kept at
 // least 3 frames long). Same dimensions, velocity dimensions and frame rate as real. Allocates.
 Result<TemplateModel> synthesize_library(const TemplateModel& real,
                                          const SyntheticLibraryOptions& options);
+
+// The source of each take of synthesize_library(real, options), in order, without building the
+// features (cheap: a reader of a cached grown library calls it).
+Result<std::vector<SyntheticTakeSource>> synthetic_take_sources(
+    const TemplateModel& real, const SyntheticLibraryOptions& options);
 
 }  // namespace duet

@@ -3,6 +3,7 @@
 // standardised over the whole library, and the follower's template model.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -11,6 +12,8 @@
 
 #include "duet/base/result.h"
 #include "duet/features/feature_extractor.h"
+#include "duet/follow/jump_candidates.h"
+#include "duet/follow/synthetic_library.h"
 #include "duet/follow/template_model.h"
 #include "duet/io/motion_file.h"
 
@@ -38,6 +41,21 @@ struct LibraryOptions {
   FeatureSpec features;
   // Trim a pair whose two clips differ in length to the shorter one instead of failing.
   bool trim_to_shorter = false;
+  // Grow the follower's library to this many template states with time-warped, noisy copies of
+  // the takes (synthetic_library.h), for scale tests (issue 13); 0: the takes as captured. A copy
+  // is followed like any take; its place is reported as the real take's (DuetLibrary::place_of).
+  int grow_to_states = 0;
+  unsigned grow_seed = 1;
+  // A model cache file (model_cache.h): the template model and the beam's jump candidate index
+  // are read from it when it was written for this library (its features, takes and growth),
+  // else built and written to it. Empty: no cache.
+  std::string model_cache;
+};
+
+// A place in the library's captured takes.
+struct LibraryPlace {
+  int take = -1;
+  int frame = -1;
 };
 
 struct DuetTake {
@@ -66,16 +84,38 @@ class DuetLibrary {
   // Standardised template features of take k, frame f (a row of the model).
   int state_of(int take, int frame) const { return takes_[static_cast<std::size_t>(take)].first_state + frame; }
 
+  // The captured take and frame shown for frame `frame` of the model's take `model_take`: the
+  // same for a captured take, the copied take's frame for a copy (LibraryOptions::grow_to_states).
+  // {-1, -1} for an invalid model take. Allocates nothing.
+  LibraryPlace place_of(int model_take, int frame) const noexcept;
+  bool grown() const { return !copy_sources_.empty(); }
+  // The beam follower's jump candidate index, when the model cache provided one (else null: the
+  // beam builds its own).
+  std::shared_ptr<const JumpCandidateIndex> candidate_index() const { return candidate_index_; }
+  // Why the model cache was not read (empty when it was, or when there is none); the cache was
+  // then rebuilt.
+  const std::string& model_cache_note() const { return model_cache_note_; }
+
   // An extractor for a user whose motion uses `skeleton` (any convention with the needed
   // roles); its raw output is standardised with normalizer().
   Result<FeatureExtractor> make_extractor(std::shared_ptr<const Skeleton> skeleton,
                                           const JointRoles& roles) const;
 
  private:
+  // What a model cache made for this library is keyed by: its features, takes and growth.
+  static std::uint64_t model_key(const FeatureMatrix& features, const std::vector<int>& take_start,
+                                 int velocity_dims, const LibraryOptions& options);
+  // Grows the captured model (options_.grow_to_states) and reads or writes the model cache.
+  Status grow_and_cache(TemplateModel captured, std::uint64_t key);
+
   std::vector<DuetTake> takes_;
   std::shared_ptr<const TemplateModel> model_;
   FeatureNormalizer normalizer_;
   LibraryOptions options_;
+  // Per model take beyond the captured ones (a grown library): what it copies.
+  std::vector<SyntheticTakeSource> copy_sources_;
+  std::shared_ptr<const JumpCandidateIndex> candidate_index_;
+  std::string model_cache_note_;
 };
 
 }  // namespace duet

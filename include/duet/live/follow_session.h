@@ -24,7 +24,9 @@ class FollowSession {
                                       const PostureBiasParams& bias = {});
 
   // One input frame: local pose of the user's skeleton at time_s (seconds, increasing). The time
-  // since the previous frame drives the tracker's rate handling. Allocates nothing.
+  // since the previous frame drives the tracker's rate handling. Allocates nothing. In a grown
+  // library (LibraryOptions::grow_to_states) the result's take and frame_in_take are the
+  // captured take's (DuetLibrary::place_of); state stays the model's.
   FollowResult step(std::span<const Vec3> translations_ls, std::span<const Quat> rotations_ls,
                     double time_s) noexcept;
   void reset() noexcept;
@@ -37,6 +39,8 @@ class FollowSession {
  private:
   FollowSession(const DuetLibrary& library, FeatureExtractor extractor,
                 std::unique_ptr<Tracker> tracker, const PostureBiasParams& bias);
+  // A grown library: the estimate's take and frame as the captured take's.
+  void report_captured_place(FollowResult& result) noexcept;
 
   const DuetLibrary* library_;
   FeatureExtractor extractor_;
@@ -47,6 +51,7 @@ class FollowSession {
   double previous_time_s_ = 0.0;
   bool has_previous_ = false;
   int previous_state_ = -1;  // the estimate of the previous frame
+  LibraryPlace previous_place_;  // its captured take and frame (a grown library)
 };
 
 }  // namespace duet
