@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "duet/features/feature_mirror.h"
 #include "duet/follow/beam_follower.h"
 #include "duet/follow/hmm_follower.h"
 #include "duet/follow/model_cache.h"
@@ -36,24 +37,34 @@ namespace {
 using bench::kSalsa;
 constexpr int kRealStates = 27495;
 
-// The salsa library's model alone: the library's motion is dropped (and its memory returned to
-// the system), so that the resident memory measured is the follower's.
-const TemplateModel* salsa_model() {
-  static const std::optional<TemplateModel> model = []() -> std::optional<TemplateModel> {
+// The salsa library's model alone, and its features' mirror map: the library's motion is
+// dropped (and its memory returned to the system), so that the resident memory measured is the
+// follower's.
+struct SalsaModel {
+  TemplateModel model;
+  std::vector<MirroredDim> mirror;
+};
+const SalsaModel* salsa() {
+  static const std::optional<SalsaModel> salsa = []() -> std::optional<SalsaModel> {
     const std::vector<PairFiles> pairs = bench::salsa_pairs();
     LibraryOptions options;
     options.load.frame_rate = 60.0;
-    std::optional<TemplateModel> copy;
+    std::optional<SalsaModel> copy;
     {
       Result<DuetLibrary> loaded = DuetLibrary::load(pairs, options);
       if (!loaded) return std::nullopt;
-      copy.emplace(loaded.value().model());
+      Result<std::vector<MirroredDim>> mirror =
+          feature_mirror(options.features, loaded.value().normalizer());
+      if (!mirror) return std::nullopt;
+      copy.emplace(SalsaModel{loaded.value().model(), std::move(mirror).value()});
     }
     malloc_trim(0);
     return copy;
   }();
-  return model ? &*model : nullptr;
+  return salsa ? &*salsa : nullptr;
 }
+
+const TemplateModel* salsa_model() { return salsa() ? &salsa()->model : nullptr; }
 
 // The library of `states` states; one kept at a time (a 1M-state model is 450 MB).
 const TemplateModel* library_of(int states) {
@@ -65,6 +76,7 @@ const TemplateModel* library_of(int states) {
     cached.reset();
     SyntheticLibraryOptions options;
     options.num_states = states;
+    options.mirror = salsa()->mirror;  // every second copy mirrored
     Result<TemplateModel> model = synthesize_library(*real, options);
     if (!model) return nullptr;
     cached = std::make_unique<TemplateModel>(std::move(model).value());

@@ -27,6 +27,19 @@ Result<std::vector<PlannedTake>> plan_takes(const TemplateModel& real,
   if (!(options.noise >= 0.0f && std::isfinite(options.noise))) {
     return make_error("synthetic library", 0, "noise must be >= 0");
   }
+  if (!options.mirror.empty()) {
+    if (static_cast<int>(options.mirror.size()) != real.num_dims()) {
+      return make_error("synthetic library", 0,
+                        "the mirror map has " + std::to_string(options.mirror.size()) +
+                            " dimensions, the library " + std::to_string(real.num_dims()));
+    }
+    for (const MirroredDim& m : options.mirror) {
+      if (m.source < 0 || m.source >= real.num_dims() || !std::isfinite(m.scale) ||
+          !std::isfinite(m.offset)) {
+        return make_error("synthetic library", 0, "the mirror map is not valid for this library");
+      }
+    }
+  }
   if (options.keep_real_takes && options.num_states < real.num_states()) {
     return make_error("synthetic library", 0,
                       "num_states (" + std::to_string(options.num_states) +
@@ -40,7 +53,7 @@ Result<std::vector<PlannedTake>> plan_takes(const TemplateModel& real,
   if (options.keep_real_takes) {
     for (int take = 0; take < real.num_takes(); ++take) {
       const int length = real.take_end(take) - real.take_begin(take);
-      plan.push_back({{take, 1.0f, length}, length});
+      plan.push_back({{take, 1.0f, length, false}, length});
       states += length;
     }
   }
@@ -56,7 +69,8 @@ Result<std::vector<PlannedTake>> plan_takes(const TemplateModel& real,
       plan.back().frames += options.num_states - states;
       break;
     }
-    plan.push_back({{take, speed, length}, frames});
+    const bool mirrored = !options.mirror.empty() && copy % 2 == 1;
+    plan.push_back({{take, speed, length, mirrored}, frames});
     states += frames;
   }
   return plan;
@@ -79,6 +93,7 @@ Result<TemplateModel> synthesize_library(const TemplateModel& real,
   std::normal_distribution<float> noise(0.0f, std::max(options.noise, 1e-30f));
   const bool noisy = options.noise > 0.0f;
 
+  std::vector<float> unmirrored(static_cast<std::size_t>(dims));
   FeatureMatrix out(options.num_states, dims);
   std::vector<int> starts;
   int row = 0;
@@ -96,8 +111,15 @@ Result<TemplateModel> synthesize_library(const TemplateModel& real,
       const int i1 = std::min(i0 + 1, length - 1);
       const float w = position - static_cast<float>(i0);
       for (int d = 0; d < dims; ++d) {
-        float value =
+        unmirrored[static_cast<std::size_t>(d)] =
             (1.0f - w) * real.features()(begin + i0, d) + w * real.features()(begin + i1, d);
+      }
+      for (int d = 0; d < dims; ++d) {
+        float value = unmirrored[static_cast<std::size_t>(d)];
+        if (source.mirrored) {
+          const MirroredDim& m = options.mirror[static_cast<std::size_t>(d)];
+          value = m.scale * unmirrored[static_cast<std::size_t>(m.source)] + m.offset;
+        }
         if (!copy) {
           out(row, d) = value;
           continue;

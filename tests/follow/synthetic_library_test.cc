@@ -93,6 +93,37 @@ TEST(SyntheticLibrary, KeepsTheRealTakesFirstAndNamesEachCopysSource) {
   EXPECT_FALSE(synthetic_take_sources(real, options));
 }
 
+TEST(SyntheticLibrary, MirrorsEverySecondCopy) {
+  const TemplateModel real = test::make_model({200, 150}, 6, 5, 60.0, 2);
+  SyntheticLibraryOptions options;
+  options.num_states = 1400;
+  options.min_speed = options.max_speed = 1.0f;
+  options.noise = 0.0f;
+  // A mirror map of the kind feature_mirror() makes: dims 0 and 1 swap, 2 flips about 0.5.
+  options.mirror = {{1, 1.0f, 0.0f}, {0, 1.0f, 0.0f}, {2, -1.0f, 1.0f},
+                    {3, 1.0f, 0.0f}, {4, 1.0f, 0.0f}, {5, -1.0f, 0.0f}};
+  const TemplateModel big = synthesize_library(real, options).value();
+  const std::vector<SyntheticTakeSource> sources = synthetic_take_sources(real, options).value();
+  ASSERT_EQ(static_cast<int>(sources.size()), big.num_takes());
+  for (int k = 0; k < big.num_takes(); ++k) {
+    const SyntheticTakeSource& source = sources[static_cast<std::size_t>(k)];
+    EXPECT_EQ(source.mirrored, k % 2 == 1);
+    const int real_begin = real.take_begin(source.real_take);
+    const int row = big.take_begin(k) + 10;
+    const auto x = real.features().row(real_begin + 10);
+    if (source.mirrored) {
+      EXPECT_FLOAT_EQ(big.features()(row, 0), x(1));
+      EXPECT_FLOAT_EQ(big.features()(row, 1), x(0));
+      EXPECT_FLOAT_EQ(big.features()(row, 2), 1.0f - x(2));
+      EXPECT_FLOAT_EQ(big.features()(row, 5), -x(5));
+    } else {
+      EXPECT_TRUE(big.features().row(row).isApprox(x));
+    }
+  }
+  options.mirror.pop_back();
+  EXPECT_FALSE(synthesize_library(real, options));
+}
+
 TEST(SyntheticLibrary, RejectsBadOptions) {
   const TemplateModel real = test::make_model({50}, 4, 1);
   SyntheticLibraryOptions options;

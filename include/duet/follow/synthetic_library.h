@@ -3,8 +3,9 @@
 // states. Each copy plays one real take at a random speed (linear interpolation between its
 // frames; the velocity dimensions scale with the speed, as a faster dancer's would) with Gaussian
 // noise on every feature, so no two copies are alike and the follower's beam meets as many
-// look-alike places as in a big real library. Mirroring is left out: the follow module sees
-// feature vectors, not the joints that a mirror would swap.
+// look-alike places as in a big real library. Given the features' mirror map
+// (duet/features/feature_mirror.h), every second copy is the mirror image of its take: the dance
+// with left and right swapped, a new dance for the follower.
 //
 // Each copy remembers where it comes from (SyntheticTakeSource), so that a grown duet library
 // (DuetLibrary with LibraryOptions::grow_to_states) can show the partner of the real take at the
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "duet/base/result.h"
+#include "duet/features/feature_mirror.h"
 #include "duet/follow/template_model.h"
 
 namespace duet {
@@ -26,6 +28,8 @@ struct SyntheticLibraryOptions {
   unsigned seed = 1;
   // Keep the real takes, unchanged, as the library's first takes; the copies follow them.
   bool keep_real_takes = false;
+  // Non-empty (one entry per dimension, feature_mirror()): every second copy is mirrored.
+  std::vector<MirroredDim> mirror;
 };
 
 // Where a take of a synthetic library comes from.
@@ -33,6 +37,7 @@ struct SyntheticTakeSource {
   int real_take = 0;
   float speed = 1.0f;  // real frames per copy frame
   int real_length = 0;  // frames of the real take
+  bool mirrored = false;  // left and right swapped
   // The real take's frame nearest to the copy's frame `frame` (>= 0).
   int real_frame(int frame) const noexcept;
 };
