@@ -66,20 +66,24 @@ const SalsaModel* salsa() {
 
 const TemplateModel* salsa_model() { return salsa() ? &salsa()->model : nullptr; }
 
-// The library of `states` states; one kept at a time (a 1M-state model is 450 MB).
-const TemplateModel* library_of(int states) {
+// The library of `states` states; one kept at a time (a 1M-state model is 450 MB). mirrored:
+// every second copy is the mirror image of its take (salsa's basic steps alternate sides, so a
+// mirrored copy looks like its take half a step later: many more look-alike places).
+const TemplateModel* library_of(int states, bool mirrored = false) {
   static std::unique_ptr<TemplateModel> cached;
+  static bool cached_mirrored = false;
   const TemplateModel* real = salsa_model();
   if (real == nullptr) return nullptr;
   if (states == real->num_states()) return real;
-  if (!cached || cached->num_states() != states) {
+  if (!cached || cached->num_states() != states || cached_mirrored != mirrored) {
     cached.reset();
     SyntheticLibraryOptions options;
     options.num_states = states;
-    options.mirror = salsa()->mirror;  // every second copy mirrored
+    if (mirrored) options.mirror = salsa()->mirror;
     Result<TemplateModel> model = synthesize_library(*real, options);
     if (!model) return nullptr;
     cached = std::make_unique<TemplateModel>(std::move(model).value());
+    cached_mirrored = mirrored;
   }
   return cached.get();
 }
@@ -173,8 +177,9 @@ BENCHMARK(BM_ExactStepAtScale)
     ->Arg(1000000)->Iterations(200)
     ->Unit(benchmark::kMicrosecond);
 
+// Arguments: states, and 1 for a library with mirrored copies.
 void BM_BeamStepAtScale(benchmark::State& state) {
-  const TemplateModel* model = library_of(static_cast<int>(state.range(0)));
+  const TemplateModel* model = library_of(static_cast<int>(state.range(0)), state.range(1) != 0);
   if (model == nullptr) {
     state.SkipWithError("salsa data not found");
     return;
@@ -195,9 +200,11 @@ void BM_BeamStepAtScale(benchmark::State& state) {
   state.counters["index_mb"] = static_cast<double>(beam.forward().index().memory_bytes()) / 1e6;
 }
 BENCHMARK(BM_BeamStepAtScale)
-    ->Arg(kRealStates)
-    ->Arg(100000)
-    ->Arg(1000000)
+    ->Args({kRealStates, 0})
+    ->Args({100000, 0})
+    ->Args({1000000, 0})
+    ->Args({100000, 1})
+    ->Args({1000000, 1})
     ->Iterations(6000)
     ->Unit(benchmark::kMicrosecond);
 
