@@ -7,11 +7,13 @@
 #include "commands.h"
 #include "duet/io/atomic_write.h"
 #include "duet/io/bvh.h"
+#include "duet/io/motion_argument.h"
 #include "duet/io/motion_file.h"
 #include "duet/io/points_csv.h"
 #include "duet/motion/head_hands.h"
 #include "duet/motion/limits.h"
 #include "duet/motion/resample.h"
+#include "library_options.h"
 #include "motion_options.h"
 #include "number_checks.h"
 
@@ -55,7 +57,17 @@ int run_convert(const ConvertArgs& args) {
   }
   MotionLoadOptions load_options;
   if (!make_load_options(args.input, load_options)) return kExitFailure;
-  Result<LoadedMotion> loaded = load_motion(args.inputs, load_options);
+  // One word may name an ASF+AMC pair, as every other command takes it ("60.asf+60_01.amc").
+  std::vector<std::string> files = args.inputs;
+  if (files.size() == 1) {
+    Result<std::vector<std::string>> split = split_motion_argument(files[0]);
+    if (!split) {
+      fmt::print(stderr, "duet convert: {}\n", split.error().message);
+      return kExitFailure;
+    }
+    files = std::move(split).value();
+  }
+  Result<LoadedMotion> loaded = load_motion(files, load_options);
   if (!loaded) {
     fmt::print(stderr, "duet convert: {}\n", loaded.error().message);
     return kExitFailure;
@@ -102,10 +114,12 @@ int run_convert(const ConvertArgs& args) {
 
 Command register_convert(CLI::App& app) {
   auto args = std::make_shared<ConvertArgs>();
-  app.add_option("inputs", args->inputs, "A .bvh file, or an .asf and an .amc file")
+  app.add_option("inputs", args->inputs,
+                 "A .bvh file, or an .asf and an .amc file (two words, or one: "
+                 "SKELETON.asf+MOTION.amc as the other commands take it)")
       ->required()
       ->expected(1, 2)
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingFile | motion_word_check());
   app.add_option("-o,--output", args->output,
                  "Output BVH file, or CSV with --points (written atomically)")
       ->required();

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "apps/run_command.h"
@@ -73,7 +75,22 @@ TEST(CliConvert, AsfAmcToBvhResampledAndBack) {
   EXPECT_EQ(doc["frames"], 1121);  // 2242 frames at 60 Hz span 37.35 s
   EXPECT_EQ(doc["fps"], 30.0);
   EXPECT_NEAR(doc["body_m"]["standing_height"].get<double>(), 1.71, 0.05);  // no --scale needed
+  // The pair as one word, as every other command takes it, writes the same file.
+  const auto again = std::filesystem::temp_directory_path() / "duet_cli_convert_word.bvh";
+  r = run_duet("convert " + kAsf + "+" + kAmc + " --input-fps 60 --fps 30 -o " + again.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream a(out), b(again);
+  const std::string first((std::istreambuf_iterator<char>(a)), std::istreambuf_iterator<char>());
+  const std::string second((std::istreambuf_iterator<char>(b)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(first, second);
+  EXPECT_GT(first.size(), 1000u);
   std::filesystem::remove(out);
+  std::filesystem::remove(again);
+  // A word that is neither a file nor a pair is refused with the reason.
+  r = run_duet("convert " + kAsf + "+missing.amc -o " + again.string());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("missing.amc"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(again));
 }
 
 TEST(CliConvert, UnwritableOutputLeavesNothingBehind) {
