@@ -1,12 +1,13 @@
 #include "duet/partner/foot_hold.h"
 
+#include "duet/math/rotation.h"
+
 #include <algorithm>
 #include <cmath>
 
 namespace duet {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Once the blend is over, a held foot this close to where the pose puts it is let go.
 constexpr double kCaughtUpM = 0.005;
 // A step's horizontal crossing (a smoothstep over this part of the step): it starts as the foot
@@ -28,12 +29,15 @@ double horizontal_distance(const Vec3& a, const Vec3& b) {
   return std::hypot(a.x() - b.x(), a.z() - b.z());
 }
 
-// The turn about the world vertical contained in q (its twist about Y).
-Quat heading_part(const Quat& q) {
-  const double n = std::hypot(q.w(), q.y());
-  if (!(n > 1e-9)) return Quat::Identity();
-  return Quat(q.w() / n, 0.0, q.y() / n, 0.0);
+// The angle of the turn about the world vertical contained in q (its twist about Y), in
+// (-pi, pi].
+double heading_angle(const Quat& q) {
+  if (!(std::hypot(q.w(), q.y()) > 1e-9)) return 0.0;
+  return wrap_angle(2.0 * std::atan2(q.y(), q.w()));
 }
+
+// `angle` (wrapped) taken the way round nearest to `previous` (unwrapped).
+double unwrap(double angle, double previous) { return previous + wrap_angle(angle - previous); }
 
 }  // namespace
 
@@ -57,6 +61,7 @@ void FootHold::hold(Foot& foot, const Vec3& point, const Quat& rotation) noexcep
   foot.state = kHeld;
   foot.point = point;
   foot.rotation = rotation;
+  foot.heading = 0.0;
 }
 
 void FootHold::start_step(Foot& foot, double lift_m) noexcept {
@@ -136,8 +141,14 @@ void FootHold::update(const std::array<Vec3, 2>& ankles_ws,
         } else if (out_of_reach ||
                    (left_behind && (!other_stepping || behind > 2.0 * params.step_trigger_m))) {
           start_step(foot, params.step_height_m);
-        } else if (!blending && behind < kCaughtUpM) {
-          foot.state = kFree;
+        } else if (!blending) {
+          // The blend is over: let go where the pose has caught up, else one step there (a hold
+          // kept on through the dance after it twisted the leg ever further from the pose).
+          if (behind < kCaughtUpM) {
+            foot.state = kFree;
+          } else if (!other_stepping) {
+            start_step(foot, params.step_height_m);
+          }
         }
         break;
       case kStepping:
@@ -153,7 +164,8 @@ void FootHold::update(const std::array<Vec3, 2>& ankles_ws,
     out.active = true;
     if (foot.state == kHeld) {
       out.position_ws = Vec3(foot.point.x(), pose.y(), foot.point.z());
-      out.turn_ws = heading_part(foot.rotation * rotation.conjugate());
+      foot.heading = unwrap(heading_angle(foot.rotation * rotation.conjugate()), foot.heading);
+      out.turn_ws = yaw_rotation(foot.heading);
       shown_[i] = out.position_ws;
       shown_rotations_[i] = (out.turn_ws * rotation).normalized();
       continue;
@@ -189,8 +201,10 @@ void FootHold::update(const std::array<Vec3, 2>& ankles_ws,
     }
     const Vec3 across = foot.point + (end - foot.point) * cross;
     out.position_ws = Vec3(across.x(), pose.y() + foot.lift_m * std::sin(kPi * s), across.z());
-    out.turn_ws =
-        heading_part(foot.rotation * rotation.conjugate()).slerp(cross, Quat::Identity());
+    // The heading turns back with the crossing, the way round it has turned while held (at half
+    // a turn the shorter way flips from one frame to the next).
+    foot.heading = unwrap(heading_angle(foot.rotation * rotation.conjugate()), foot.heading);
+    out.turn_ws = yaw_rotation(foot.heading * (1.0 - cross));
     shown_[i] = out.position_ws;
     shown_rotations_[i] = (out.turn_ws * rotation).normalized();
     if (s < 1.0) continue;

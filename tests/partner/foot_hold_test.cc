@@ -136,6 +136,32 @@ TEST(FootHold, AHeldFootKeepsItsHeadingWhileThePoseTurns) {
   EXPECT_LT(shown.angularDistance(Quat::Identity()), 1e-9);
 }
 
+TEST(FootHold, AStepTurnsTheFootBackTheWayTheBodyTurnedOverIt) {
+  // The blend turns the body at 6 rad/s over the held feet; the captured right foot lifts at 2.5
+  // rad and steps back to the pose's heading while the body turns on past half a turn. The shown
+  // heading turns smoothly: the held heading taken the shorter way round flips sign at half a
+  // turn, which turned the stepping foot by nearly a full turn in one frame (136 rad/s measured).
+  FootHold hold;
+  const FootHoldParams params = on();
+  Quat previous = Quat::Identity();
+  double fastest = 0.0;
+  for (int f = 0; f < 90; ++f) {
+    const double yaw = std::min(f, 45) * 0.1;
+    const Pose pose(0.0, yaw);
+    hold.update(pose.ankles, pose.rotations, pose.hips, pose.legs, {true, f < 25}, true, f == 0,
+                params, kDt);
+    const FootHoldTarget& t = hold.target(1);
+    const Quat shown = t.active ? Quat(t.turn_ws * pose.rotations[1]) : pose.rotations[1];
+    if (f > 0) fastest = std::max(fastest, shown.angularDistance(previous));
+    previous = shown;
+  }
+  EXPECT_FALSE(hold.held(1));  // turned back and let go
+  // The step turns the foot back by what the body turned over it (2.5 rad and more as the body
+  // turns on) over 0.8 of 15 frames along a smoothstep: about 0.46 rad a frame at most. The
+  // shorter way round flipped it by 3.1 rad in a frame.
+  EXPECT_LT(fastest, 0.6);
+}
+
 TEST(FootHold, AFootOutOfReachStepsEvenWhileTheOtherSteps) {
   FootHold hold;
   const FootHoldParams params = on();

@@ -99,6 +99,8 @@ class FootHold {
     bool landing_fixed = false;
     double lift_m = 0.0;                // this step's added height (0: released into the swing)
     double progress = 0.0;              // of the step, 0..1
+    // The held heading less the pose's (radians about the vertical), unwrapped from frame to frame.
+    double heading = 0.0;
   };
   void start_step(Foot& foot, double lift_m) noexcept;
   void hold(Foot& foot, const Vec3& point, const Quat& rotation) noexcept;
