@@ -39,7 +39,7 @@ namespace duet {
 struct FootHoldParams {
   // Off by default: it takes the slides after jumps down (improv-pause: 23 -> 12 of 23 jumps
   // above 0.3 m/s, largest 7.9 -> 4.4 m/s) but its steps swing the legs faster than the capture
-  // (p99 of the largest joint speed 1.02x -> 1.12x the captured partner's). docs/evaluation.md,
+  // (p99 of the largest joint speed 1.02x -> 1.10x the captured partner's). docs/evaluation.md,
   // "Feet through a jump". `duet follow/serve --foot-hold`, `duet eval`'s `foothold` row.
   bool enabled = false;
   // Chosen with `duet eval` on improv-pause / improv-30hz-noisy / harsh (docs/evaluation.md,
