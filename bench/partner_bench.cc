@@ -122,12 +122,10 @@ void BM_Synthesis(benchmark::State& state) {
 }
 BENCHMARK(BM_Synthesis)->DenseRange(0, 6);
 
-void BM_SynthesisSalsa(benchmark::State& state) {
+// 60_01 / 61_01, the user 3 m away and turned by 2 rad; null without the salsa data.
+const Scene* salsa_scene() {
   const std::string dir = std::string(DUET_DATA_DIR) + "/cmu-salsa/bvh/";
-  if (!std::filesystem::exists(dir + "60/60_01_scaled.bvh")) {
-    state.SkipWithError("no salsa data in DUET_DATA_DIR");
-    return;
-  }
+  if (!std::filesystem::exists(dir + "60/60_01_scaled.bvh")) return nullptr;
   static const Scene scene = [&] {
     BvhReadOptions options;
     options.frame_rate = 60.0;
@@ -143,10 +141,34 @@ void BM_SynthesisSalsa(benchmark::State& state) {
     add_users(s, Transform{yaw_rotation(2.0), Vec3(3.0, 0.0, -1.0)});
     return s;
   }();
+  return &scene;
+}
+
+void BM_SynthesisSalsa(benchmark::State& state) {
+  const Scene* scene = salsa_scene();
+  if (scene == nullptr) {
+    state.SkipWithError("no salsa data in DUET_DATA_DIR");
+    return;
+  }
   state.SetLabel("all, 60_01/61_01");
-  run_synthesis(state, scene, PartnerParams{});
+  run_synthesis(state, *scene, PartnerParams{});
 }
 BENCHMARK(BM_SynthesisSalsa);
+
+// The same with the foot hold on (docs/partner.md, "Feet through a jump"): a jump every 100
+// frames, so feet are held or stepping in part of the frames.
+void BM_SynthesisSalsaFootHold(benchmark::State& state) {
+  const Scene* scene = salsa_scene();
+  if (scene == nullptr) {
+    state.SkipWithError("no salsa data in DUET_DATA_DIR");
+    return;
+  }
+  PartnerParams params;
+  params.foot_hold.enabled = true;
+  state.SetLabel("all + foot hold, 60_01/61_01");
+  run_synthesis(state, *scene, params);
+}
+BENCHMARK(BM_SynthesisSalsaFootHold);
 
 void BM_IkTwoBone(benchmark::State& state) {
   const Transform start{quat_from_axis_angle(Vec3::UnitZ(), -1.0), Vec3(0.2, 1.4, 0.0)};

@@ -218,9 +218,10 @@ int run_follow(const FollowArgs& args) {
   const LostSummary summary = summarise_lost(results);
   fmt::print(
       "followed {} frames ({:.1f} s) against {} take(s), {} states: {} jumps, {} lost "
-      "frames; corrections: {}\n",
+      "frames; corrections: {}{}\n",
       user.frame_count(), user.duration(), library->takes().size(), library->model().num_states(),
-      summary.jumps, summary.lost, corrections_string(loop.value().params()));
+      summary.jumps, summary.lost, corrections_string(loop.value().params()),
+      loop.value().params().foot_hold.enabled ? ", foot hold" : "");
   if (truth) print_accuracy_summary(*truth, results, library->frame_rate());
   if (summary.lost_fraction() <= kMostlyLostFraction) return kExitOk;
 

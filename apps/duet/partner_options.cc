@@ -12,6 +12,10 @@ void add_partner_options(CLI::App& app, PartnerArgs& args) {
   app.add_flag("--no-footlock", args.no_footlock,
                "Do not hold the feet the captured partner has planted");
   app.add_flag("--no-blend", args.no_blend, "Cut instead of blending when the follower jumps");
+  app.add_flag("--foot-hold", args.foot_hold,
+               "After a jump, hold the planted feet with leg IK while the blend carries the "
+               "partner, and step to the new place (fewer sliding feet, faster legs; "
+               "docs/partner.md)");
   app.add_option("--ik-target", args.ik_target,
                  "Where a held hand goes: offset (the captured grip relative to the user's hand, "
                  "default) or wrist (the user's wrist, as in the paper)")
@@ -25,6 +29,7 @@ PartnerParams make_partner_params(const PartnerArgs& args) {
   params.smooth = !args.no_smooth;
   params.foot_lock = !args.no_footlock;
   params.blend = !args.no_blend;
+  params.foot_hold.enabled = args.foot_hold;
   parse_ik_target(args.ik_target, params.ik_target);
   return params;
 }

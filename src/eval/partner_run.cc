@@ -83,6 +83,13 @@ std::vector<PartnerConfig> standard_partner_configs(const PartnerParams& base) {
     (void)parsed;
     configs.push_back({name, params});
   }
+  // The foot hold through a jump's blend (foot_hold.h), off by default: all corrections and it.
+  PartnerParams foot_hold = base;
+  const Status all = parse_corrections("all", foot_hold);
+  assert(all.ok());
+  (void)all;
+  foot_hold.foot_hold.enabled = true;
+  configs.insert(configs.begin() + 1, {"foothold", foot_hold});
   return configs;
 }
 

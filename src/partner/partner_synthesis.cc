@@ -20,6 +20,14 @@ constexpr std::array<ArmRoles, 2> kArms = {
     {{Role::kLeftShoulder, Role::kLeftElbow, Role::kLeftWrist},
      {Role::kRightShoulder, Role::kRightElbow, Role::kRightWrist}}};
 constexpr std::array<Role, 2> kToes = {Role::kLeftToe, Role::kRightToe};
+struct LegRoles {
+  Role hip, knee, ankle, toe;
+};
+constexpr std::array<LegRoles, 2> kLegs = {
+    {{Role::kLeftHip, Role::kLeftKnee, Role::kLeftAnkle, Role::kLeftToe},
+     {Role::kRightHip, Role::kRightKnee, Role::kRightAnkle, Role::kRightToe}}};
+// A blend with offsets below these is over (the foot hold starts no new holds).
+constexpr double kBlendingRad = 0.02, kBlendingM = 0.01;
 
 bool is_ancestor(const Skeleton& skeleton, int ancestor, int joint) {
   for (int j = joint; j >= 0; j = skeleton.joints[static_cast<std::size_t>(j)].parent) {
@@ -74,6 +82,28 @@ Status check_response_roles(const Skeleton& skeleton, const JointRoles& roles) {
     }
   }
   return Ok{};
+}
+
+// Each leg a chain thigh -> knee -> ankle -> toe, the two legs separate (the foot hold's IK
+// solves both from one forward kinematics pass).
+bool legs_are_chains(const Skeleton& skeleton, const JointRoles& roles) {
+  for (std::size_t side = 0; side < 2; ++side) {
+    const LegRoles& leg = kLegs[side];
+    const int hip = roles[leg.hip], knee = roles[leg.knee], ankle = roles[leg.ankle];
+    const int toe = roles[leg.toe];
+    for (const int j : {hip, knee, ankle, toe}) {
+      if (!valid_joint(skeleton, j)) return false;
+    }
+    if (hip == knee || knee == ankle || !is_ancestor(skeleton, hip, knee) ||
+        !is_ancestor(skeleton, knee, ankle) || !is_ancestor(skeleton, ankle, toe)) {
+      return false;
+    }
+    const LegRoles& other = kLegs[1 - side];
+    for (const Role role : {other.hip, other.knee, other.ankle}) {
+      if (is_ancestor(skeleton, hip, roles[role])) return false;
+    }
+  }
+  return true;
 }
 
 bool finite_time(double t) { return t >= 0.0 && std::isfinite(t); }
@@ -140,6 +170,7 @@ Result<PartnerModel> PartnerModel::build(const Clip& template_clip,
   model.contacts_ = std::move(contacts).value();
   model.template_height_m_ = measure_body(template_clip.skeleton(), template_roles).standing_height_m;
   model.response_height_m_ = measure_body(response_clip.skeleton(), response_roles).standing_height_m;
+  model.has_legs_ = legs_are_chains(response_clip.skeleton(), response_roles);
 
   // Ground height per foot: a low quantile of the toe's height over the clip.
   const std::vector<Vec3> positions = world_positions(response_clip);
@@ -228,6 +259,7 @@ std::string PartnerParams::validate() const {
   if (const std::string_view problem = ik_correction_filter.validate(); !problem.empty()) {
     return "ik_correction_filter: " + std::string(problem);
   }
+  if (const std::string problem = foot_hold.validate(); !problem.empty()) return problem;
   if (const std::string_view problem = playhead.validate(); !problem.empty()) {
     return "playhead: " + std::string(problem);
   }
@@ -332,6 +364,7 @@ void PartnerContext::reset() noexcept {
   inertializer_.reset();
   smoother_.reset();
   foot_locker_.reset();
+  foot_hold_.reset();
   user_heading_ = Transform();
   user_root_filter_.reset();
   user_facing_filter_.reset();
@@ -447,6 +480,8 @@ bool PartnerSynthesisJob::run() const noexcept {
   }
 
   // 3. Foot lock (5.3): shift the root horizontally to hold planted feet.
+  const std::array<bool, 2> planted = {model->foot_planted(frame, Side::kLeft, p.foot),
+                                       model->foot_planted(frame, Side::kRight, p.foot)};
   const bool need_world = p.foot_lock || p.contact;
   if (need_world) {
     forward_kinematics(skeleton, out_t, out_r, ctx.positions_ws_, ctx.rotations_ws_);
@@ -454,8 +489,6 @@ bool PartnerSynthesisJob::run() const noexcept {
   if (p.foot_lock) {
     const std::array<Vec3, 2> feet = {ctx.positions_ws_[static_cast<std::size_t>(roles[kToes[0]])],
                                       ctx.positions_ws_[static_cast<std::size_t>(roles[kToes[1]])]};
-    const std::array<bool, 2> planted = {model->foot_planted(frame, Side::kLeft, p.foot),
-                                         model->foot_planted(frame, Side::kRight, p.foot)};
     const Vec3 shift = ctx.foot_locker_.update(feet, planted, p.foot, dt);
     out_t[0] += shift;
     for (Vec3& position : ctx.positions_ws_) position += shift;
@@ -641,6 +674,69 @@ bool PartnerSynthesisJob::run() const noexcept {
     const Transform root = heading * Transform{out_r[0], out_t[0]};
     out_t[0] = root.translation;
     out_r[0] = root.rotation.normalized();
+  }
+
+  // 6. Foot hold (issue 11): through a jump's blend, planted feet stay where they stand and the
+  //    legs reach them by two-bone IK; the pose catches up by steps (foot_hold.h). After the blend
+  //    (which carries the root and every leg joint to the new frame's pose, sliding the feet).
+  if (p.foot_lock && p.blend && p.foot_hold.enabled && model->has_legs()) {
+    forward_kinematics(skeleton, out_t, out_r, ctx.positions_ws_, ctx.rotations_ws_);
+    std::array<Vec3, 2> ankles, hips;
+    std::array<Quat, 2> ankle_rotations;
+    std::array<double, 2> leg_lengths;
+    for (std::size_t side = 0; side < 2; ++side) {
+      const auto ankle = static_cast<std::size_t>(roles[kLegs[side].ankle]);
+      const auto knee = static_cast<std::size_t>(roles[kLegs[side].knee]);
+      const auto hip = static_cast<std::size_t>(roles[kLegs[side].hip]);
+      ankles[side] = ctx.positions_ws_[ankle];
+      ankle_rotations[side] = ctx.rotations_ws_[ankle];
+      hips[side] = ctx.positions_ws_[hip];
+      leg_lengths[side] = (ctx.positions_ws_[knee] - hips[side]).norm() +
+                          (ankles[side] - ctx.positions_ws_[knee]).norm();
+    }
+    const bool blending = ctx.inertializer_.max_rotation_offset() > kBlendingRad ||
+                          ctx.inertializer_.max_translation_offset() > kBlendingM;
+    ctx.foot_hold_.update(ankles, ankle_rotations, hips, leg_lengths, planted, blending,
+                          jumped && blending, p.foot_hold, dt);
+    bool any = false;
+    for (std::size_t side = 0; side < 2; ++side) {
+      const FootHoldTarget& target = ctx.foot_hold_.target(static_cast<int>(side));
+      if (!target.active) continue;
+      const LegRoles& leg = kLegs[side];
+      const auto jh = static_cast<std::size_t>(roles[leg.hip]);
+      const auto jk = static_cast<std::size_t>(roles[leg.knee]);
+      const auto ja = static_cast<std::size_t>(roles[leg.ankle]);
+      const Transform start{ctx.rotations_ws_[jh], ctx.positions_ws_[jh]};
+      const Transform mid{ctx.rotations_ws_[jk], ctx.positions_ws_[jk]};
+      const Transform end{ctx.rotations_ws_[ja], ctx.positions_ws_[ja]};
+      const Quat hip_before = out_r[jh], knee_before = out_r[jk];
+      IkTwoBoneJob ik;
+      ik.start_joint_ws = &start;
+      ik.mid_joint_ws = &mid;
+      ik.end_joint_ws = &end;
+      ik.start_rotation_ls = &hip_before;
+      ik.mid_rotation_ls = &knee_before;
+      ik.target_ws = target.position_ws;
+      ik.start_rotation_ls_out = &out_r[jh];
+      ik.mid_rotation_ls_out = &out_r[jk];
+      any = ik.run() || any;
+    }
+    if (any) {
+      // The ankles' world rotations: the pose's, turned to the held heading.
+      forward_kinematics(skeleton, out_t, out_r, ctx.positions_ws_, ctx.rotations_ws_);
+      for (std::size_t side = 0; side < 2; ++side) {
+        const FootHoldTarget& target = ctx.foot_hold_.target(static_cast<int>(side));
+        if (!target.active) continue;
+        const auto ja = static_cast<std::size_t>(roles[kLegs[side].ankle]);
+        const auto parent = static_cast<std::size_t>(skeleton.joints[ja].parent);
+        out_r[ja] = (ctx.rotations_ws_[parent].conjugate() * target.turn_ws *
+                     ankle_rotations[side])
+                        .normalized();
+      }
+    }
+    diagnostics.foot_held = {ctx.foot_hold_.held(0), ctx.foot_hold_.held(1)};
+  } else {
+    ctx.foot_hold_.reset();
   }
 
   ctx.primed_ = true;

@@ -63,7 +63,8 @@ TEST(PartnerSynthesis, PerFrameCallAllocatesNothing) {
         wrist - from_root + Vec3(f > 50 && f < 150 ? 0.0 : 1.0, 0, 0.001 * f);
   }
   const PartnerModel model = PartnerModel::build(leader, roles, follower, roles).value();
-  const PartnerParams params;  // everything on
+  PartnerParams params;  // everything on, the foot hold too
+  params.foot_hold.enabled = true;
   PartnerContext context(skeleton->joint_count());
   std::vector<Vec3> t(skeleton->joints.size());
   std::vector<Quat> r(skeleton->joints.size());

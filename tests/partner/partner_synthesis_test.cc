@@ -542,6 +542,58 @@ TEST(PartnerSynthesis, FootLockHoldsASlidingFoot) {
   EXPECT_LT(travel[0], 0.1 * travel[1]);
 }
 
+TEST(PartnerSynthesis, AJumpKeepsPlantedFeetOnTheFloorAndStepsToTheNewPlace) {
+  // The captured follower stands still (feet planted) beside the leader; from frame 100 on she
+  // stands 0.6 m further left and turned by 1 rad. The follower jumps from frame 50 to 150: the
+  // blend carries the partner across at up to 3 m/s. With the foot hold the planted toes do not
+  // slide (the feet step across instead); without it they slide with the body.
+  Duet duet(240, 0, 240);
+  for (int f = 100; f < 240; ++f) {
+    duet.follower.translations_ls(f)[0] += Vec3(0.6, 0.0, 0.0);
+    duet.follower.rotations_ls(f)[0] = yaw_rotation(1.0);
+  }
+  duet.rebuild();
+  const std::array<std::size_t, 2> toes = {static_cast<std::size_t>(duet.roles[Role::kLeftToe]),
+                                           static_cast<std::size_t>(duet.roles[Role::kRightToe])};
+  double slide[2] = {0, 0}, lift[2] = {0, 0}, arrived[2] = {0, 0};
+  for (const bool hold : {true, false}) {
+    PartnerParams params = only(true, false, false, true, true);
+    params.foot_hold.enabled = hold;
+    Runner run(duet.model, params);
+    std::array<Vec3, 2> previous{Vec3::Zero(), Vec3::Zero()};
+    for (int i = 0; i < 140; ++i) {
+      const int frame = i < 50 ? i : 100 + i;
+      run.step(duet.follower, frame, user_from(duet.leader, i, duet.roles), i == 50);
+      const test::WorldPose w = run.world();
+      for (std::size_t side = 0; side < 2; ++side) {
+        const Vec3& toe = w.positions[toes[side]];
+        const double ground = duet.model.foot_ground_height(static_cast<Side>(side));
+        const double height = toe.y() - ground;
+        // The slide metric's test (docs/evaluation.md): a toe within 3 cm of the floor in both
+        // frames, its horizontal speed.
+        if (i > 0 && height <= 0.03 && previous[side].y() - ground <= 0.03) {
+          const double speed =
+              std::hypot(toe.x() - previous[side].x(), toe.z() - previous[side].z()) / kDt;
+          slide[hold ? 0 : 1] = std::max(slide[hold ? 0 : 1], speed);
+        }
+        if (i >= 50) lift[hold ? 0 : 1] = std::max(lift[hold ? 0 : 1], height);
+        previous[side] = toe;
+      }
+      EXPECT_TRUE(w.positions[0].allFinite());
+    }
+    // Where the partner stands at the end (1.5 s after the jump): the captured place.
+    const test::WorldPose truth = test::world_pose(duet.follower, 239);
+    arrived[hold ? 0 : 1] = std::hypot(run.world().positions[0].x() - truth.positions[0].x(),
+                                       run.world().positions[0].z() - truth.positions[0].z());
+  }
+  EXPECT_GT(slide[1], 1.0);   // without the hold the blend slides the feet at metres per second
+  EXPECT_LT(slide[0], 0.3);   // with it no toe on the floor moves faster than 0.3 m/s
+  EXPECT_LT(lift[1], 0.01);   // the capture never lifts a foot
+  EXPECT_GT(lift[0], 0.03);   // the hold's steps do
+  EXPECT_LT(arrived[0], 0.01);  // and the partner still arrives where the capture stands
+  EXPECT_LT(arrived[1], 0.01);
+}
+
 TEST(PartnerModel, FeetArePlantedWhereTheCapturedFootIsLowAndSlow) {
   Duet duet(60, 0, 0);
   // The captured follower stands for 20 frames, slides at 0.5 m/s for 20, then lifts her left

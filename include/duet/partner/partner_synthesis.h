@@ -27,6 +27,7 @@
 #include "duet/motion/clip.h"
 #include "duet/motion/skeleton_map.h"
 #include "duet/partner/alignment.h"
+#include "duet/partner/foot_hold.h"
 #include "duet/partner/foot_lock.h"
 #include "duet/partner/hand_contacts.h"
 #include "duet/partner/one_euro_filter.h"
@@ -83,6 +84,9 @@ class PartnerModel {
   // toe within thresholds.height_margin_m of the ground height and moving horizontally at most
   // thresholds.speed_threshold_mps since the previous frame (frame 0: towards the next one).
   bool foot_planted(int frame, Side side, const FootLockParams& thresholds) const noexcept;
+  // Whether the response's legs are chains thigh (hip role) -> knee -> ankle -> toe, which the
+  // foot hold (foot_hold.h) needs; without them it stays off.
+  bool has_legs() const noexcept { return has_legs_; }
 
  private:
   std::shared_ptr<const Skeleton> response_skeleton_;
@@ -92,6 +96,7 @@ class PartnerModel {
   double template_height_m_ = 0.0;
   double response_height_m_ = 0.0;
   std::array<double, 2> ground_heights_{0.0, 0.0};
+  bool has_legs_ = false;
   // Per frame and foot (frame * 2 + side): the captured toe's height above its ground height and
   // its horizontal speed, m and m/s.
   struct CapturedFoot {
@@ -196,6 +201,9 @@ struct PartnerParams {
 
   // footlock thresholds and release.
   FootLockParams foot;
+  // footlock with blend: planted feet held by leg IK through a jump's blend, catching up by
+  // steps (foot_hold.h). enabled = false: the blend slides them (before issue 11's last target).
+  FootHoldParams foot_hold;
 
   // Empty when valid; otherwise which parameter is wrong (negative or non-finite times, ...).
   std::string validate() const;
@@ -252,6 +260,7 @@ class PartnerContext {
   PoseInertializer inertializer_;
   PoseSmoother smoother_;
   FootLocker foot_locker_;
+  FootHold foot_hold_;
   std::vector<Vec3> blend_translations_;  // output of the blend stage last frame
   std::vector<Quat> blend_rotations_;
   std::vector<Vec3> positions_ws_;  // forward kinematics scratch
@@ -286,6 +295,7 @@ struct PartnerFrameInfo {
   std::array<Vec3, 2> ik_target_ws{Vec3::Zero(), Vec3::Zero()};
   std::array<double, 2> ik_error_m{0.0, 0.0};
   std::array<bool, 2> foot_locked{false, false};  // per foot (Side)
+  std::array<bool, 2> foot_held{false, false};    // held through a blend or stepping (foot_hold.h)
   Vec3 foot_lock_offset_ws = Vec3::Zero();        // horizontal root shift applied
   double blend_offset_rad = 0.0;  // largest joint rotation offset still being blended out
 };
