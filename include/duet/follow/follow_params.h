@@ -90,13 +90,31 @@ struct FollowParams {
   //  - takes the larger of that and lost_residual_factor times the average best distance of the
   //    frames it plainly follows (explained_residual.h): another rig leaves a residual of its own
   //    (on the CMU handshake rig up to 4% of the followed frames were lost without it).
-  // lost_residual_per_dim = +inf and pause_noise_factor = 0 give the fixed levels (paper).
+  //  - widens the emission (eq. 7): its variance per dimension is emission_sigma^2 (the
+  //    template's own spread) plus emission_noise_factor times the noise, what the sensor adds
+  //    to every dimension of the input. Noise makes the differences between template distances
+  //    noisy, and an emission sharpened for a clean sensor turns each noisy frame into strong,
+  //    wrong evidence: the maximum flickers to look-alike places. At 4 degrees per axis (noise
+  //    about 0.009) factor 3 took 30hz-noisy from 93.2% to 99.7% within 100 ms and its false
+  //    jumps from 136 to 4.5 a minute; clean input (noise 0.00001) is unchanged.
+  // lost_residual_per_dim = +inf and pause_noise_factor = emission_noise_factor = 0 give the
+  // fixed levels (paper).
   double sensor_noise_time_constant_s = 1.0;
   float pause_noise_factor = 3.0f;
   float pause_noise_allowance = 0.001f;
   float lost_residual_per_dim = 0.0015f;
   float lost_noise_factor = 3.5f;
   float lost_residual_factor = 5.0f;
+  float emission_noise_factor = 3.0f;
+  // Smoothing of the input's posture features by the noise (noise_filter.h): the spectral
+  // density of the dance's acceleration that its Kalman filter assumes, in standardised feature
+  // units^2 / s^3 (lower smooths more, 0 turns it off), and the noise it lets through unfiltered
+  // (a clean sensor reads up to about 0.001 on a fast dance; filtered from 0.001 on,
+  // tempo-fast lost up to 1.3 points to the lag). Measured in docs/follower.md: 1000 removed a
+  // third of the remaining false jumps at 4 degrees per axis; 100 and below lagged (`improv`
+  // lost 1-10 points).
+  float noise_filter_density = 1000.0f;
+  float noise_filter_allowance = 0.002f;
 
   // Confidence: posterior mass within +/- this many template frames of the estimate (same take),
   // mapped to the probability of being within 100 ms (confidence_calibration.h) when
