@@ -30,7 +30,10 @@ NoiseScaledLevels::NoiseScaledLevels(const FollowParams& params, int num_dims)
       lost_residual_factor_(params.lost_residual_factor) {}
 
 float NoiseScaledLevels::inv_two_sigma_sq(float noise) const noexcept {
-  return static_cast<float>(0.5 / (sigma_sq_ + emission_noise_factor_ * usable(noise)));
+  // Sigma was chosen on input with up to pause_noise_allowance of noise: only what exceeds it
+  // widens the emission (from 0 on, 1 degree per axis lost 0.4 points in noise-sweep-1).
+  const double excess = std::max(0.0, usable(noise) - pause_noise_allowance_);
+  return static_cast<float>(0.5 / (sigma_sq_ + emission_noise_factor_ * excess));
 }
 
 float NoiseScaledLevels::log_pause_emission(float noise) const noexcept {
