@@ -91,12 +91,13 @@ struct FollowParams {
   //    frames it plainly follows (explained_residual.h): another rig leaves a residual of its own
   //    (on the CMU handshake rig up to 4% of the followed frames were lost without it).
   //  - widens the emission (eq. 7): its variance per dimension is emission_sigma^2 (the
-  //    template's own spread) plus emission_noise_factor times the noise, what the sensor adds
-  //    to every dimension of the input. Noise makes the differences between template distances
+  //    template's own spread) plus emission_noise_factor times what of the noise exceeds
+  //    pause_noise_allowance (sigma was chosen with about that much), what the sensor adds to
+  //    every dimension of the input. Noise makes the differences between template distances
   //    noisy, and an emission sharpened for a clean sensor turns each noisy frame into strong,
   //    wrong evidence: the maximum flickers to look-alike places. At 4 degrees per axis (noise
   //    about 0.009) factor 3 took 30hz-noisy from 93.2% to 99.7% within 100 ms and its false
-  //    jumps from 136 to 4.5 a minute; clean input (noise 0.00001) is unchanged.
+  //    jumps from 136 to 4.5 a minute; input with up to 3 degrees RMS is unchanged.
   // lost_residual_per_dim = +inf and pause_noise_factor = emission_noise_factor = 0 give the
   // fixed levels (paper).
   double sensor_noise_time_constant_s = 1.0;
@@ -110,9 +111,9 @@ struct FollowParams {
   // density of the dance's acceleration that its Kalman filter assumes, in standardised feature
   // units^2 / s^3 (lower smooths more, 0 turns it off), and the noise it lets through unfiltered
   // (a clean sensor reads up to about 0.001 on a fast dance; filtered from 0.001 on,
-  // tempo-fast lost up to 1.3 points to the lag). Measured in docs/follower.md: 1000 removed a
-  // third of the remaining false jumps at 4 degrees per axis; 100 and below lagged (`improv`
-  // lost 1-10 points).
+  // tempo-fast lost 1.3 points to the lag). Measured in docs/follower.md: 1000 took the false
+  // jumps of 30hz-noisy at 4 degrees per axis from 4.5 to 1.7 a minute; 100 and below lagged
+  // (30hz-noisy 95.6-96.7% within 100 ms against 99.7%).
   float noise_filter_density = 1000.0f;
   float noise_filter_allowance = 0.002f;
 
