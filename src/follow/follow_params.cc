@@ -25,6 +25,7 @@ FollowParams FollowParams::paper() {
   params.jump_tolerance_frames = 0;
   params.pause_noise_factor = 0.0f;
   params.emission_noise_factor = 0.0f;
+  params.emission_noise_allowance = 0.0f;
   params.noise_filter_density = 0.0f;
   params.calibrate_confidence = false;
   params.lost_residual_per_dim = std::numeric_limits<float>::infinity();
@@ -82,6 +83,7 @@ Status FollowParams::validate(int num_states) const {
                       {"lost_noise_factor", lost_noise_factor},
                       {"lost_residual_factor", lost_residual_factor},
                       {"emission_noise_factor", emission_noise_factor},
+                      {"emission_noise_allowance", emission_noise_allowance},
                       {"noise_filter_density", noise_filter_density},
                       {"noise_filter_allowance", noise_filter_allowance}};
   for (const auto& level : noise_levels) {

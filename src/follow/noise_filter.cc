@@ -85,14 +85,18 @@ std::span<const float> NoiseFilter::apply(std::span<const float> features, doubl
     start(features, r);
     return out_;
   }
-  const double k0 = s > 0.0 ? p00 / s : 1.0;
+  const double k0 = s > 0.0 && r > 0.0 ? p00 / s : 1.0;
   const double k1 = s > 0.0 ? p01 / s : 0.0;
   for (std::size_t d = 0; d < dims; ++d) {
     const double predicted = position_[d] + velocity_[d] * dt;
     const double innovation = static_cast<double>(features[d]) - predicted;
-    position_[d] = predicted + k0 * innovation;
     velocity_[d] += k1 * innovation;
-    out_[d] = static_cast<float>(position_[d]);
+    if (k0 < 1.0) {
+      position_[d] = predicted + k0 * innovation;
+      out_[d] = static_cast<float>(position_[d]);
+    } else {
+      position_[d] = features[d];  // no noise to remove: the input exactly, not rounded twice
+    }
   }
   p00_ = (1.0 - k0) * p00;
   p01_ = (1.0 - k0) * p01;

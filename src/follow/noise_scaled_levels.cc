@@ -21,6 +21,7 @@ NoiseScaledLevels::NoiseScaledLevels(const FollowParams& params, int num_dims)
     : dims_(num_dims),
       sigma_sq_(double{params.emission_sigma} * params.emission_sigma),
       emission_noise_factor_(params.emission_noise_factor),
+      emission_noise_allowance_(params.emission_noise_allowance),
       pause_distance_per_dim_(params.pause_distance_per_dim),
       pause_noise_factor_(params.pause_noise_factor),
       pause_noise_allowance_(params.pause_noise_allowance),
@@ -30,9 +31,9 @@ NoiseScaledLevels::NoiseScaledLevels(const FollowParams& params, int num_dims)
       lost_residual_factor_(params.lost_residual_factor) {}
 
 float NoiseScaledLevels::inv_two_sigma_sq(float noise) const noexcept {
-  // Sigma was chosen on input with up to pause_noise_allowance of noise: only what exceeds it
-  // widens the emission (from 0 on, 1 degree per axis lost 0.4 points in noise-sweep-1).
-  const double excess = std::max(0.0, usable(noise) - pause_noise_allowance_);
+  // Sigma was chosen on input with up to 3 degrees of noise (on every rig): only what exceeds
+  // that widens the emission.
+  const double excess = std::max(0.0, usable(noise) - emission_noise_allowance_);
   return static_cast<float>(0.5 / (sigma_sq_ + emission_noise_factor_ * excess));
 }
 

@@ -31,6 +31,7 @@ class NoiseScaledLevels {
   double dims_ = 0.0;
   double sigma_sq_ = 0.0;
   double emission_noise_factor_ = 0.0;
+  double emission_noise_allowance_ = 0.0;
   double pause_distance_per_dim_ = 0.0;
   double pause_noise_factor_ = 0.0;
   double pause_noise_allowance_ = 0.0;
