@@ -96,8 +96,8 @@ struct FollowParams {
   //    makes the differences between template distances noisy, and an emission sharpened for a
   //    clean sensor turns each noisy frame into strong, wrong evidence: the maximum flickers to
   //    look-alike places. At 4 degrees per axis (noise about 0.009) the emission's variance
-  //    goes from 0.01 to 0.034: 30hz-noisy went from 93.2% to 99.7% within 100 ms and from 136
-  //    to 1.7 false jumps a minute. sigma was chosen with 3 degrees RMS of noise, which reads
+  //    goes from 0.01 to 0.034: 30hz-noisy went from 93.2% to 99.4% within 100 ms and from 136
+  //    to 8.4 false jumps a minute. sigma was chosen with 3 degrees RMS of noise, which reads
   //    0.0015 on the library's rig and up to 0.002 on others; widened from 0.001 on, 30hz-noisy
   //    on the handshake rig lost 1.5 points and noise on the ASF rig 2.6, so the allowance is
   //    0.003 (input with up to 3 degrees is unchanged on every rig).
