@@ -50,7 +50,8 @@ struct EvalArgs {
   std::optional<int> jump_tolerance;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
       pause_distance, lost_distance, velocity_cap, pause_noise_factor, lost_residual,
-      lost_noise_factor, lost_residual_factor;
+      lost_noise_factor, lost_residual_factor, emission_noise_factor, emission_noise_allowance, noise_filter_density,
+      noise_filter_allowance;
   std::optional<double> tempo_time_constant;
   bool fixed_band = false;
   std::optional<int> dtw_back, dtw_ahead;
@@ -201,6 +202,12 @@ int run_eval(EvalArgs& args) {
   if (args.lost_distance) hmm.lost_distance_per_dim = *args.lost_distance;
   if (args.velocity_cap) hmm.velocity_distance_cap = *args.velocity_cap;
   if (args.pause_noise_factor) hmm.pause_noise_factor = *args.pause_noise_factor;
+  if (args.emission_noise_factor) hmm.emission_noise_factor = *args.emission_noise_factor;
+  if (args.noise_filter_density) hmm.noise_filter_density = *args.noise_filter_density;
+  if (args.emission_noise_allowance) {
+    hmm.emission_noise_allowance = *args.emission_noise_allowance;
+  }
+  if (args.noise_filter_allowance) hmm.noise_filter_allowance = *args.noise_filter_allowance;
   if (args.lost_residual) hmm.lost_residual_per_dim = *args.lost_residual;
   if (args.lost_noise_factor) hmm.lost_noise_factor = *args.lost_noise_factor;
   if (args.lost_residual_factor) hmm.lost_residual_factor = *args.lost_residual_factor;
@@ -303,14 +310,17 @@ int run_eval(EvalArgs& args) {
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
       "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
-      "lost_residual_factor {}\n\n",
+      "lost_residual_factor {} emission_noise_factor {} emission_noise_allowance {} "
+      "noise_filter_density {} noise_filter_allowance {}\n\n",
       library->takes().size(), library->model().num_states(), library->frame_rate(),
       args.library.role, takes, options.seed, hmm.self_prob, hmm.next_prob, hmm.skip_prob,
       hmm.leave_prob, hmm.pause_stay_prob, hmm.emission_sigma, hmm.pause_distance_per_dim,
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
       hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.pause_noise_factor,
-      hmm.lost_residual_per_dim, hmm.lost_noise_factor, hmm.lost_residual_factor);
+      hmm.lost_residual_per_dim, hmm.lost_noise_factor, hmm.lost_residual_factor,
+      hmm.emission_noise_factor, hmm.emission_noise_allowance, hmm.noise_filter_density,
+      hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
   std::fflush(stdout);
 
@@ -454,6 +464,27 @@ Command register_eval(CLI::App& app) {
       ->add_option("--lost-residual-factor", args->lost_residual_factor,
                    "lost_residual_factor: the HMM's lost distance is at least this times the "
                    "average best distance of the frames it plainly follows (all HMM variants)")
+      ->check(non_negative_check());
+  tuning
+      ->add_option("--emission-noise-factor", args->emission_noise_factor,
+                   "emission_noise_factor: what the estimated sensor noise adds to the emission's "
+                   "variance per dimension, per unit of noise (all HMM variants)")
+      ->check(non_negative_check());
+  tuning
+      ->add_option("--emission-noise-allowance", args->emission_noise_allowance,
+                   "emission_noise_allowance: estimated sensor noise that does not widen the "
+                   "emission (all HMM variants)")
+      ->check(non_negative_check());
+  tuning
+      ->add_option("--noise-filter-allowance", args->noise_filter_allowance,
+                   "noise_filter_allowance: estimated sensor noise that the input's smoothing "
+                   "lets through (all HMM variants)")
+      ->check(non_negative_check());
+  tuning
+      ->add_option("--noise-filter-density", args->noise_filter_density,
+                   "noise_filter_density: the dance's acceleration density the Kalman filter "
+                   "of the input's posture features assumes; lower smooths more, 0 for none "
+                   "(all HMM variants)")
       ->check(non_negative_check());
   tuning
       ->add_option("--pause-noise-factor", args->pause_noise_factor,

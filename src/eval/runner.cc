@@ -326,6 +326,10 @@ Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const Templ
       params.lost_distance_per_dim = options.hmm.lost_distance_per_dim;
       params.sensor_noise_time_constant_s = options.hmm.sensor_noise_time_constant_s;
       params.pause_noise_factor = options.hmm.pause_noise_factor;
+      params.emission_noise_factor = options.hmm.emission_noise_factor;
+      params.emission_noise_allowance = options.hmm.emission_noise_allowance;
+      params.noise_filter_density = options.hmm.noise_filter_density;
+      params.noise_filter_allowance = options.hmm.noise_filter_allowance;
       params.pause_noise_allowance = options.hmm.pause_noise_allowance;
       params.lost_residual_per_dim = options.hmm.lost_residual_per_dim;
       params.lost_noise_factor = options.hmm.lost_noise_factor;

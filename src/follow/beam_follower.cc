@@ -100,6 +100,7 @@ void BeamContext::reset() noexcept {
   tempo_.reset();
   jump_gate_.reset();
   sensor_noise_.reset();
+  noise_filter_.reset();
   explained_residual_.reset();
   frame_noise_ = 0.0f;
 }
@@ -191,7 +192,7 @@ bool BeamForward::sparse_emission(const float* phi, int wanted, BeamContext& con
   const TemplateModel& model = *exact_.model_;
   const int num_states = model.num_states();
   const FollowParams& params = exact_.params_;
-  const float inv_two_sigma_sq = exact_.inv_two_sigma_sq_;
+  const float inv_two_sigma_sq = exact_.noise_levels_.inv_two_sigma_sq(context.frame_noise_);
   float* alpha = context.alpha_.data();
 
   // The jump candidates, merged into the beam (both sorted) in next_.
@@ -303,7 +304,8 @@ void BeamForward::full_emission(const float* phi, BeamContext& context,
   const float best = follow_detail::emission_distances(model, phi, params.velocity_distance_cap,
                                                        context.distance_sq_.data());
   result.log_likelihood = follow_detail::weigh_and_normalise(
-      context.alpha_.data(), context.distance_sq_.data(), best, exact_.inv_two_sigma_sq_,
+      context.alpha_.data(), context.distance_sq_.data(), best,
+      exact_.noise_levels_.inv_two_sigma_sq(context.frame_noise_),
       model.num_states(), exact_.noise_levels_.log_pause_emission(context.frame_noise_),
       params.jump_enabled, context.scratch_.data());
   context.alpha_.swap(context.scratch_);
@@ -390,15 +392,18 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   context.sensor_noise_.update(features, dt_s, !result.missing);
   result.sensor_noise_per_dim = context.sensor_noise_.variance_per_dim();
   context.frame_noise_ = result.sensor_noise_per_dim;
+  if (result.missing) context.noise_filter_.miss(dt_s);
   if (!result.missing) {
+    const std::span<const float> phi =
+        context.noise_filter_.apply(features, dt_s, context.frame_noise_);
     // Uncertain with the usual candidates: widen the search; still uncertain, the beam may have
     // lost the dancer: finish the frame with the full step.
-    if (!dense && !sparse_emission(features.data(), beam_.jump_candidates, context, result) &&
-        !sparse_emission(features.data(), beam_.wide_jump_candidates, context, result)) {
+    if (!dense && !sparse_emission(phi.data(), beam_.jump_candidates, context, result) &&
+        !sparse_emission(phi.data(), beam_.wide_jump_candidates, context, result)) {
       materialise(context);
       dense = true;
     }
-    if (dense) full_emission(features.data(), context, result);
+    if (dense) full_emission(phi.data(), context, result);
   } else if (dense) {
     follow_detail::normalise(context.alpha_.data(), num_states + 1, num_states);
     result.best_distance_per_dim = -1.0f;
@@ -472,6 +477,9 @@ BeamContext make_context(const TemplateModel& model, const FollowParams& params,
   context.sensor_noise() = SensorNoiseEstimator(model.num_dims() - model.velocity_dims(),
                                                 params.sensor_noise_time_constant_s,
                                                 model.frame_rate_hz());
+  context.noise_filter() = NoiseFilter(model.num_dims(), model.num_dims() - model.velocity_dims(),
+                                       params.noise_filter_density,
+                                       params.noise_filter_allowance, model.frame_rate_hz());
   return context;
 }
 

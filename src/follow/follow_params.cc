@@ -24,6 +24,9 @@ FollowParams FollowParams::paper() {
   params.jump_hold_s = 0.0f;
   params.jump_tolerance_frames = 0;
   params.pause_noise_factor = 0.0f;
+  params.emission_noise_factor = 0.0f;
+  params.emission_noise_allowance = 0.0f;
+  params.noise_filter_density = 0.0f;
   params.calibrate_confidence = false;
   params.lost_residual_per_dim = std::numeric_limits<float>::infinity();
   return params;
@@ -78,7 +81,11 @@ Status FollowParams::validate(int num_states) const {
   } noise_levels[] = {{"pause_noise_factor", pause_noise_factor},
                       {"pause_noise_allowance", pause_noise_allowance},
                       {"lost_noise_factor", lost_noise_factor},
-                      {"lost_residual_factor", lost_residual_factor}};
+                      {"lost_residual_factor", lost_residual_factor},
+                      {"emission_noise_factor", emission_noise_factor},
+                      {"emission_noise_allowance", emission_noise_allowance},
+                      {"noise_filter_density", noise_filter_density},
+                      {"noise_filter_allowance", noise_filter_allowance}};
   for (const auto& level : noise_levels) {
     if (!(level.value >= 0.0f && std::isfinite(level.value))) {
       return params_error(std::string(level.name) + " must be finite and >= 0, got " +

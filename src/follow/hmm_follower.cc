@@ -35,6 +35,7 @@ void ForwardContext::reset() noexcept {
   tempo_.reset();
   jump_gate_.reset();
   sensor_noise_.reset();
+  noise_filter_.reset();
   explained_residual_.reset();
 }
 
@@ -66,11 +67,9 @@ Result<HmmForward> HmmForward::create(const TemplateModel& model, const FollowPa
   }
   forward.params_.resume_weights.clear();  // kept once, normalised, in resume_
 
-  const double sigma = params.emission_sigma;
-  const double inv_two_sigma_sq = 1.0 / (2.0 * sigma * sigma);
-  forward.inv_two_sigma_sq_ = static_cast<float>(inv_two_sigma_sq);
-  // The pause level and the lost distance follow the sensor noise estimated each frame.
-  forward.noise_levels_ = NoiseScaledLevels(params, model.num_dims(), inv_two_sigma_sq);
+  // The emission scale, the pause level and the lost distance follow the sensor noise estimated
+  // each frame.
+  forward.noise_levels_ = NoiseScaledLevels(params, model.num_dims());
   return forward;
 }
 
@@ -200,11 +199,14 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   result.sensor_noise_per_dim = context.sensor_noise_.variance_per_dim();
   bool unexplained = false;  // past the noise-scaled lost distance
   if (!result.missing) {
+    const std::span<const float> phi =
+        context.noise_filter_.apply(features, dt_s, result.sensor_noise_per_dim);
     const float best = follow_detail::emission_distances(
-        model, features.data(), params_.velocity_distance_cap, context.distance_sq_.data());
+        model, phi.data(), params_.velocity_distance_cap, context.distance_sq_.data());
     const float noise = result.sensor_noise_per_dim;
     result.log_likelihood = follow_detail::weigh_and_normalise(
-        context.alpha_.data(), context.distance_sq_.data(), best, inv_two_sigma_sq_, num_states,
+        context.alpha_.data(), context.distance_sq_.data(), best,
+        noise_levels_.inv_two_sigma_sq(noise), num_states,
         noise_levels_.log_pause_emission(noise), params_.jump_enabled, context.scratch_.data());
     context.alpha_.swap(context.scratch_);
     result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
@@ -215,6 +217,7 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
     unexplained =
         best > noise_levels_.lost_distance_sq(noise, context.explained_residual_.level());
   } else {
+    context.noise_filter_.miss(dt_s);
     // No evidence: the transitions conserve mass; renormalise only to stop float drift.
     follow_detail::normalise(context.alpha_.data(), num_states + 1, num_states);
     result.best_distance_per_dim = -1.0f;
@@ -256,6 +259,9 @@ Result<HmmFollower> HmmFollower::create(const TemplateModel& model, const Follow
   context.sensor_noise() = SensorNoiseEstimator(model.num_dims() - model.velocity_dims(),
                                                 params.sensor_noise_time_constant_s,
                                                 model.frame_rate_hz());
+  context.noise_filter() = NoiseFilter(model.num_dims(), model.num_dims() - model.velocity_dims(),
+                                       params.noise_filter_density,
+                                       params.noise_filter_allowance, model.frame_rate_hz());
   return HmmFollower(std::move(forward).value(), std::move(context));
 }
 

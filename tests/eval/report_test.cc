@@ -172,7 +172,7 @@ TEST(EvalReportPlots, ReliabilityDiagramOfTheHmmPerCase) {
 TEST(EvalReportCsv, HasTheCalibrationErrorAndTheFramesCsvItsRows) {
   EvalReport report = small_report();
   report.rows[0].metrics.confidence_ece = 0.0123;
-  FrameEstimate e{0, 5, true, false, 0.0};
+  FrameEstimate e{0, 5, true, true, 0.0};
   e.confidence = 0.5f;
   e.window_mass = 0.75f;
   e.sensor_noise_per_dim = 0.002f;
@@ -182,8 +182,8 @@ TEST(EvalReportCsv, HasTheCalibrationErrorAndTheFramesCsvItsRows) {
   EXPECT_NE(csv.find(",0.01230\n"), std::string::npos) << csv;
   EXPECT_EQ(format_frames_csv(report),
             "case,tracker,take,error_ms,confidence,window_mass,best_distance_per_dim,"
-            "sensor_noise_per_dim,lost,in_pause\n"
-            "clean,hmm,0,33.3,0.50000,0.75000,0.000000,0.0020000,1,0\n");
+            "sensor_noise_per_dim,lost,in_pause,jumped\n"
+            "clean,hmm,0,33.3,0.50000,0.75000,0.000000,0.0020000,1,0,1\n");
 }
 
 }  // namespace

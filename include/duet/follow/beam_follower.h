@@ -35,6 +35,7 @@
 #include "duet/follow/hmm_follower.h"
 #include "duet/follow/jump_candidates.h"
 #include "duet/follow/jump_gate.h"
+#include "duet/follow/noise_filter.h"
 #include "duet/follow/tempo_band.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tracker.h"
@@ -84,6 +85,7 @@ class BeamContext {
   // Frames that took the full step (the first one, and every fallback).
   long long full_steps() const { return full_steps_; }
   SensorNoiseEstimator& sensor_noise() { return sensor_noise_; }
+  NoiseFilter& noise_filter() { return noise_filter_; }
   long long frames() const { return frames_; }
   double total_log_likelihood() const { return total_log_likelihood_; }
   float tempo() const { return tempo_.tempo(); }
@@ -111,6 +113,7 @@ class BeamContext {
   JumpGate jump_gate_;
   // The noise-scaled pause level and lost distance, as HmmForward's (noise_scaled_levels.h).
   SensorNoiseEstimator sensor_noise_;
+  NoiseFilter noise_filter_;  // the input's smoothing, as HmmForward's (noise_filter.h)
   ExplainedResidual explained_residual_;
   float frame_noise_ = 0.0f;  // the sensor noise estimated at the current frame
 };

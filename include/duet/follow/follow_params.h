@@ -90,13 +90,36 @@ struct FollowParams {
   //  - takes the larger of that and lost_residual_factor times the average best distance of the
   //    frames it plainly follows (explained_residual.h): another rig leaves a residual of its own
   //    (on the CMU handshake rig up to 4% of the followed frames were lost without it).
-  // lost_residual_per_dim = +inf and pause_noise_factor = 0 give the fixed levels (paper).
+  //  - widens the emission (eq. 7): its variance per dimension is emission_sigma^2 (the
+  //    template's own spread) plus emission_noise_factor times what of the noise exceeds
+  //    emission_noise_allowance, what the sensor adds to every dimension of the input. Noise
+  //    makes the differences between template distances noisy, and an emission sharpened for a
+  //    clean sensor turns each noisy frame into strong, wrong evidence: the maximum flickers to
+  //    look-alike places. At 4 degrees per axis (noise about 0.009) the emission's variance
+  //    goes from 0.01 to 0.034: 30hz-noisy went from 93.2% to 99.4% within 100 ms and from 136
+  //    to 8.4 false jumps a minute. sigma was chosen with 3 degrees RMS of noise, which reads
+  //    0.0015 on the library's rig and up to 0.002 on others; widened from 0.001 on, 30hz-noisy
+  //    on the handshake rig lost 1.5 points and noise on the ASF rig 2.6, so the allowance is
+  //    0.003 (input with up to 3 degrees is unchanged on every rig).
+  // lost_residual_per_dim = +inf and pause_noise_factor = emission_noise_factor = 0 give the
+  // fixed levels (paper).
   double sensor_noise_time_constant_s = 1.0;
   float pause_noise_factor = 3.0f;
   float pause_noise_allowance = 0.001f;
   float lost_residual_per_dim = 0.0015f;
   float lost_noise_factor = 3.5f;
   float lost_residual_factor = 5.0f;
+  float emission_noise_factor = 4.0f;
+  float emission_noise_allowance = 0.003f;
+  // Smoothing of the input's posture features by the noise (noise_filter.h): the spectral
+  // density of the dance's acceleration that its Kalman filter assumes, in standardised feature
+  // units^2 / s^3 (lower smooths more; 0, the default, turns it off), and the noise it lets
+  // through unfiltered. Off because it did not hold up (docs/follower.md): at 4 degrees per axis
+  // density 1000 took false jumps down on some performances and up on others, cost `noise` 3
+  // points on two seeds of four, and made beam mode fall 0.6 points behind the exact step at
+  // 30 Hz. Kept for experiments (`duet eval --noise-filter-density`).
+  float noise_filter_density = 0.0f;
+  float noise_filter_allowance = 0.004f;
 
   // Confidence: posterior mass within +/- this many template frames of the estimate (same take),
   // mapped to the probability of being within 100 ms (confidence_calibration.h) when

@@ -18,6 +18,7 @@
 #include "duet/follow/follow_params.h"
 #include "duet/follow/explained_residual.h"
 #include "duet/follow/jump_gate.h"
+#include "duet/follow/noise_filter.h"
 #include "duet/follow/noise_scaled_levels.h"
 #include "duet/follow/sensor_noise.h"
 #include "duet/follow/tempo_band.h"
@@ -51,6 +52,8 @@ class ForwardContext {
   // The input's noise level (sized by HmmFollower::create; a context without it reports 0).
   SensorNoiseEstimator& sensor_noise() { return sensor_noise_; }
   const SensorNoiseEstimator& sensor_noise() const { return sensor_noise_; }
+  // The input's smoothing (sized by HmmFollower::create; a context without it passes the input).
+  NoiseFilter& noise_filter() { return noise_filter_; }
 
  private:
   friend class HmmForward;
@@ -66,6 +69,7 @@ class ForwardContext {
   TempoEstimator tempo_;
   JumpGate jump_gate_;
   SensorNoiseEstimator sensor_noise_;
+  NoiseFilter noise_filter_;
   ExplainedResidual explained_residual_;
 };
 
@@ -114,8 +118,7 @@ class HmmForward {
   TempoLimits tempo_limits_;
   float pause_stay_ = 0.0f;
   std::vector<float> resume_;  // R_i, normalised; empty = uniform 1/M
-  float inv_two_sigma_sq_ = 0.0f;
-  NoiseScaledLevels noise_levels_;
+  NoiseScaledLevels noise_levels_;  // the emission scale, pause level and lost distance
 };
 
 // HmmForward + ForwardContext behind the Tracker interface. FollowParams::left_to_right() gives

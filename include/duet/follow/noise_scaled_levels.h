@@ -1,5 +1,6 @@
-// The HMM's pause level and lost distance, scaled to the sensor's noise (FollowParams, issue 11):
-// the constants come from the parameters once, the noise estimate each frame.
+// The HMM's emission scale, pause level and lost distance, scaled to the sensor's noise
+// (FollowParams, issue 11): the constants come from the parameters once, the noise estimate each
+// frame.
 #pragma once
 
 #include "duet/follow/follow_params.h"
@@ -9,12 +10,15 @@ namespace duet {
 class NoiseScaledLevels {
  public:
   NoiseScaledLevels() = default;
-  // num_dims: D of the model; inv_two_sigma_sq: 1 / (2 emission_sigma^2).
-  NoiseScaledLevels(const FollowParams& params, int num_dims, double inv_two_sigma_sq);
+  // num_dims: D of the model.
+  NoiseScaledLevels(const FollowParams& params, int num_dims);
 
+  // 1 / (2 s^2) of the emission (eq. 7) for this sensor noise: s^2 = emission_sigma^2 +
+  // emission_noise_factor * noise, the template's own spread plus what the sensor adds.
+  float inv_two_sigma_sq(float noise) const noexcept;
   // log b_N: the flat emission of a frame at pause_distance_per_dim + pause_noise_factor *
   // max(0, noise - pause_noise_allowance) per dimension. noise:
-  // SensorNoiseEstimator::variance_per_dim().
+  // SensorNoiseEstimator::variance_per_dim(); weighed with inv_two_sigma_sq(noise).
   float log_pause_emission(float noise) const noexcept;
   // Squared distance (over all D dimensions) beyond which no template frame explains the input:
   // the larger of lost_residual_per_dim + lost_noise_factor * noise and lost_residual_factor *
@@ -25,7 +29,9 @@ class NoiseScaledLevels {
 
  private:
   double dims_ = 0.0;
-  double inv_two_sigma_sq_ = 0.0;
+  double sigma_sq_ = 0.0;
+  double emission_noise_factor_ = 0.0;
+  double emission_noise_allowance_ = 0.0;
   double pause_distance_per_dim_ = 0.0;
   double pause_noise_factor_ = 0.0;
   double pause_noise_allowance_ = 0.0;
