@@ -92,16 +92,8 @@ void BeamContext::reset() noexcept {
   next_.clear();
   background_ = 0.0f;
   full_next_ = true;
-  total_log_likelihood_ = 0.0;
-  frames_ = 0;
   full_steps_ = 0;
-  previous_state_ = -1;
-  previous_lost_ = false;
-  tempo_.reset();
-  jump_gate_.reset();
-  sensor_noise_.reset();
-  noise_filter_.reset();
-  explained_residual_.reset();
+  history_.reset();
   frame_noise_ = 0.0f;
 }
 
@@ -227,7 +219,7 @@ bool BeamForward::sparse_emission(const float* phi, int wanted, BeamContext& con
   const float lost_sq = exact_.noise_levels_.lost_ceiling_sq();
   if (found == wanted && best > lost_sq && bound <= lost_sq) return false;
   const float unexplained_sq = exact_.noise_levels_.lost_distance_sq(
-      context.frame_noise_, context.explained_residual_.level());
+      context.frame_noise_, context.history_.explained_residual.level());
   if (found == wanted && best > unexplained_sq && bound <= unexplained_sq) return false;
 
   const float log_pause = exact_.noise_levels_.log_pause_emission(context.frame_noise_);
@@ -376,7 +368,7 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   result.missing = features.size() != static_cast<std::size_t>(model.num_dims()) ||
                    !follow_detail::all_finite(features);
   result.steps = exact_.steps_for(dt_s);
-  const BandProbabilities band = exact_.band_for(context.tempo_.tempo());
+  const BandProbabilities band = exact_.band_for(context.history_.tempo.tempo());
 
   bool dense = context.full_next_;
   if (dense) {
@@ -389,13 +381,13 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
     for (int s = 0; s < result.steps; ++s) sparse_transition(band, context);
   }
 
-  context.sensor_noise_.update(features, dt_s, !result.missing);
-  result.sensor_noise_per_dim = context.sensor_noise_.variance_per_dim();
+  context.history_.sensor_noise.update(features, dt_s, !result.missing);
+  result.sensor_noise_per_dim = context.history_.sensor_noise.variance_per_dim();
   context.frame_noise_ = result.sensor_noise_per_dim;
-  if (result.missing) context.noise_filter_.miss(dt_s);
+  if (result.missing) context.history_.noise_filter.miss(dt_s);
   if (!result.missing) {
     const std::span<const float> phi =
-        context.noise_filter_.apply(features, dt_s, context.frame_noise_);
+        context.history_.noise_filter.apply(features, dt_s, context.frame_noise_);
     // Uncertain with the usual candidates: widen the search; still uncertain, the beam may have
     // lost the dancer: finish the frame with the full step.
     if (!dense && !sparse_emission(phi.data(), beam_.jump_candidates, context, result) &&
@@ -427,40 +419,40 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   const float* alpha = context.alpha_.data();
   if (dense) {
     ++context.full_steps_;
-    follow_detail::decide(model, alpha, 1.0f, alpha[num_states], context.previous_state_,
+    follow_detail::decide(model, alpha, 1.0f, alpha[num_states], context.history_.previous_state,
                           result.steps, params.confidence_window_frames, result);
   } else {
     follow_detail::describe_state(model, alpha, 1.0f, sparse_argmax(context),
                                   params.confidence_window_frames, result);
     result.in_pause = alpha[num_states] > 0.5f;
     result.jumped =
-        follow_detail::is_jump(model, context.previous_state_, result.state, result.steps);
+        follow_detail::is_jump(model, context.history_.previous_state, result.state, result.steps);
   }
-  context.jump_gate_.apply(model, params, alpha, 1.0f, context.previous_state_,
-                           context.previous_lost_, result);
+  context.history_.jump_gate.apply(model, params, alpha, 1.0f, context.history_.previous_state,
+                           context.history_.previous_lost, result);
   if (dense && !result.missing) rebuild_beam(context);
 
-  result.lost = result.missing ? context.previous_lost_ : (result.lost || result.in_pause);
+  result.lost = result.missing ? context.history_.previous_lost : (result.lost || result.in_pause);
   if (params.calibrate_confidence) {
     result.confidence =
         ConfidenceCalibration::apply(result.window_mass, result.sensor_noise_per_dim);
   }
   if (params.tempo_adaptive) {
     const bool band_move = !result.missing && !result.lost && !result.jumped;
-    context.tempo_.update(context.previous_state_, result.state, result.steps, dt_s, band_move,
+    context.history_.tempo.update(context.history_.previous_state, result.state, result.steps, dt_s, band_move,
                           exact_.tempo_limits_);
   }
-  result.tempo = context.tempo_.tempo();
-  context.total_log_likelihood_ += result.log_likelihood;
-  ++context.frames_;
-  context.previous_state_ = result.state;
-  context.previous_lost_ = result.lost;
+  result.tempo = context.history_.tempo.tempo();
+  context.history_.total_log_likelihood += result.log_likelihood;
+  ++context.history_.frames;
+  context.history_.previous_state = result.state;
+  context.history_.previous_lost = result.lost;
   const bool unexplained =
       !result.missing &&
       result.best_distance_per_dim * static_cast<float>(model.num_dims()) >
           exact_.noise_levels_.lost_distance_sq(context.frame_noise_,
-                                                context.explained_residual_.level());
-  context.explained_residual_.update(result.best_distance_per_dim,
+                                                context.history_.explained_residual.level());
+  context.history_.explained_residual.update(result.best_distance_per_dim,
                                      !result.missing && !result.in_pause && !result.jumped, dt_s);
   result.lost = result.lost || unexplained;
   return result;
@@ -474,12 +466,7 @@ namespace {
 BeamContext make_context(const TemplateModel& model, const FollowParams& params,
                          const BeamParams& beam) {
   BeamContext context(model.num_states(), beam, params.max_steps_per_frame);
-  context.sensor_noise() = SensorNoiseEstimator(model.num_dims() - model.velocity_dims(),
-                                                params.sensor_noise_time_constant_s,
-                                                model.frame_rate_hz());
-  context.noise_filter() = NoiseFilter(model.num_dims(), model.num_dims() - model.velocity_dims(),
-                                       params.noise_filter_density,
-                                       params.noise_filter_allowance, model.frame_rate_hz());
+  context.history() = FollowerHistory(model, params);
   return context;
 }
 

@@ -28,15 +28,7 @@ void ForwardContext::reset() noexcept {
   if (num_states_ == 0) return;
   std::fill(alpha_.begin(), alpha_.end() - 1, 1.0f / static_cast<float>(num_states_));
   alpha_.back() = 0.0f;
-  total_log_likelihood_ = 0.0;
-  frames_ = 0;
-  previous_state_ = -1;
-  previous_lost_ = false;
-  tempo_.reset();
-  jump_gate_.reset();
-  sensor_noise_.reset();
-  noise_filter_.reset();
-  explained_residual_.reset();
+  history_.reset();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -189,18 +181,18 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
 
   // Input slower than the template (or late): the HMM runs at the template rate, so the band is
   // applied once per elapsed template frame before the emission.
-  const BandProbabilities band = band_for(context.tempo_.tempo());
+  const BandProbabilities band = band_for(context.history_.tempo.tempo());
   for (int s = 0; s < result.steps; ++s) {
     transition(context.alpha_.data(), band, context.scratch_.data());
     context.alpha_.swap(context.scratch_);
   }
 
-  context.sensor_noise_.update(features, dt_s, !result.missing);
-  result.sensor_noise_per_dim = context.sensor_noise_.variance_per_dim();
+  context.history_.sensor_noise.update(features, dt_s, !result.missing);
+  result.sensor_noise_per_dim = context.history_.sensor_noise.variance_per_dim();
   bool unexplained = false;  // past the noise-scaled lost distance
   if (!result.missing) {
     const std::span<const float> phi =
-        context.noise_filter_.apply(features, dt_s, result.sensor_noise_per_dim);
+        context.history_.noise_filter.apply(features, dt_s, result.sensor_noise_per_dim);
     const float best = follow_detail::emission_distances(
         model, phi.data(), params_.velocity_distance_cap, context.distance_sq_.data());
     const float noise = result.sensor_noise_per_dim;
@@ -215,35 +207,35 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
     // on clean input at 1.4x (100% -> 98.8% within 100 ms).
     result.lost = best > noise_levels_.lost_ceiling_sq();
     unexplained =
-        best > noise_levels_.lost_distance_sq(noise, context.explained_residual_.level());
+        best > noise_levels_.lost_distance_sq(noise, context.history_.explained_residual.level());
   } else {
-    context.noise_filter_.miss(dt_s);
+    context.history_.noise_filter.miss(dt_s);
     // No evidence: the transitions conserve mass; renormalise only to stop float drift.
     follow_detail::normalise(context.alpha_.data(), num_states + 1, num_states);
     result.best_distance_per_dim = -1.0f;
   }
 
   const float* alpha = context.alpha_.data();
-  follow_detail::decide(model, alpha, 1.0f, alpha[num_states], context.previous_state_,
+  follow_detail::decide(model, alpha, 1.0f, alpha[num_states], context.history_.previous_state,
                         result.steps, params_.confidence_window_frames, result);
-  context.jump_gate_.apply(model, params_, alpha, 1.0f, context.previous_state_,
-                           context.previous_lost_, result);
-  result.lost = result.missing ? context.previous_lost_ : (result.lost || result.in_pause);
+  context.history_.jump_gate.apply(model, params_, alpha, 1.0f, context.history_.previous_state,
+                           context.history_.previous_lost, result);
+  result.lost = result.missing ? context.history_.previous_lost : (result.lost || result.in_pause);
   if (params_.calibrate_confidence) {
     result.confidence = ConfidenceCalibration::apply(result.window_mass, result.sensor_noise_per_dim);
   }
   if (params_.tempo_adaptive) {
     const bool band_move = !result.missing && !result.lost && !result.jumped;
-    context.tempo_.update(context.previous_state_, result.state, result.steps, dt_s, band_move,
+    context.history_.tempo.update(context.history_.previous_state, result.state, result.steps, dt_s, band_move,
                           tempo_limits_);
   }
-  result.tempo = context.tempo_.tempo();
+  result.tempo = context.history_.tempo.tempo();
 
-  context.total_log_likelihood_ += result.log_likelihood;
-  ++context.frames_;
-  context.previous_state_ = result.state;
-  context.previous_lost_ = result.lost;
-  context.explained_residual_.update(result.best_distance_per_dim,
+  context.history_.total_log_likelihood += result.log_likelihood;
+  ++context.history_.frames;
+  context.history_.previous_state = result.state;
+  context.history_.previous_lost = result.lost;
+  context.history_.explained_residual.update(result.best_distance_per_dim,
                                      !result.missing && !result.in_pause && !result.jumped, dt_s);
   result.lost = result.lost || unexplained;
   return result;
@@ -256,12 +248,7 @@ Result<HmmFollower> HmmFollower::create(const TemplateModel& model, const Follow
   Result<HmmForward> forward = HmmForward::create(model, params);
   if (!forward.ok()) return forward.error();
   ForwardContext context(model.num_states());
-  context.sensor_noise() = SensorNoiseEstimator(model.num_dims() - model.velocity_dims(),
-                                                params.sensor_noise_time_constant_s,
-                                                model.frame_rate_hz());
-  context.noise_filter() = NoiseFilter(model.num_dims(), model.num_dims() - model.velocity_dims(),
-                                       params.noise_filter_density,
-                                       params.noise_filter_allowance, model.frame_rate_hz());
+  context.history() = FollowerHistory(model, params);
   return HmmFollower(std::move(forward).value(), std::move(context));
 }
 

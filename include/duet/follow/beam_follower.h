@@ -32,6 +32,7 @@
 
 #include "duet/base/result.h"
 #include "duet/follow/follow_params.h"
+#include "duet/follow/follower_history.h"
 #include "duet/follow/hmm_follower.h"
 #include "duet/follow/jump_candidates.h"
 #include "duet/follow/jump_gate.h"
@@ -84,11 +85,12 @@ class BeamContext {
   int beam_size() const { return full_next_ ? 0 : static_cast<int>(beam_.size()); }
   // Frames that took the full step (the first one, and every fallback).
   long long full_steps() const { return full_steps_; }
-  SensorNoiseEstimator& sensor_noise() { return sensor_noise_; }
-  NoiseFilter& noise_filter() { return noise_filter_; }
-  long long frames() const { return frames_; }
-  double total_log_likelihood() const { return total_log_likelihood_; }
-  float tempo() const { return tempo_.tempo(); }
+  FollowerHistory& history() { return history_; }
+  SensorNoiseEstimator& sensor_noise() { return history_.sensor_noise; }
+  NoiseFilter& noise_filter() { return history_.noise_filter; }
+  long long frames() const { return history_.frames; }
+  double total_log_likelihood() const { return history_.total_log_likelihood; }
+  float tempo() const { return history_.tempo.tempo(); }
 
  private:
   friend class BeamForward;
@@ -104,17 +106,10 @@ class BeamContext {
   std::vector<float> candidate_d2_;
   float background_ = 0.0f;  // resumed mass per unit of R_i, not yet in alpha_
   bool full_next_ = true;
-  double total_log_likelihood_ = 0.0;
-  long long frames_ = 0;
   long long full_steps_ = 0;
-  int previous_state_ = -1;
-  bool previous_lost_ = false;
-  TempoEstimator tempo_;
-  JumpGate jump_gate_;
-  // The noise-scaled pause level and lost distance, as HmmForward's (noise_scaled_levels.h).
-  SensorNoiseEstimator sensor_noise_;
-  NoiseFilter noise_filter_;  // the input's smoothing, as HmmForward's (noise_filter.h)
-  ExplainedResidual explained_residual_;
+  // Tempo, jump gate, sensor noise (which scales the pause level and lost distance), input
+  // filter and explained residual, as HmmForward's.
+  FollowerHistory history_;
   float frame_noise_ = 0.0f;  // the sensor noise estimated at the current frame
 };
 

@@ -16,11 +16,8 @@
 
 #include "duet/base/result.h"
 #include "duet/follow/follow_params.h"
-#include "duet/follow/explained_residual.h"
-#include "duet/follow/jump_gate.h"
-#include "duet/follow/noise_filter.h"
+#include "duet/follow/follower_history.h"
 #include "duet/follow/noise_scaled_levels.h"
-#include "duet/follow/sensor_noise.h"
 #include "duet/follow/tempo_band.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tracker.h"
@@ -45,15 +42,16 @@ class ForwardContext {
   int num_states() const { return num_states_; }
   // The normalised forward variable after the last step (posterior over M + 1 states).
   std::span<const float> alpha() const { return alpha_; }
-  double total_log_likelihood() const { return total_log_likelihood_; }
+  double total_log_likelihood() const { return history_.total_log_likelihood; }
   // The tempo the band is centred on (1 until the dancer has shown another one).
-  float tempo() const { return tempo_.tempo(); }
-  long long frames() const { return frames_; }
-  // The input's noise level (sized by HmmFollower::create; a context without it reports 0).
-  SensorNoiseEstimator& sensor_noise() { return sensor_noise_; }
-  const SensorNoiseEstimator& sensor_noise() const { return sensor_noise_; }
-  // The input's smoothing (sized by HmmFollower::create; a context without it passes the input).
-  NoiseFilter& noise_filter() { return noise_filter_; }
+  float tempo() const { return history_.tempo.tempo(); }
+  long long frames() const { return history_.frames; }
+  // The estimators kept between frames (sized by HmmFollower::create; a context without them
+  // reports no sensor noise and passes the input unfiltered).
+  FollowerHistory& history() { return history_; }
+  SensorNoiseEstimator& sensor_noise() { return history_.sensor_noise; }
+  const SensorNoiseEstimator& sensor_noise() const { return history_.sensor_noise; }
+  NoiseFilter& noise_filter() { return history_.noise_filter; }
 
  private:
   friend class HmmForward;
@@ -62,15 +60,7 @@ class ForwardContext {
   std::vector<float> alpha_;        // M + 1
   std::vector<float> scratch_;      // M + 1, the next alpha while a transition is applied
   std::vector<float> distance_sq_;  // M, ||phi_t - phi_i||^2 of the current frame
-  double total_log_likelihood_ = 0.0;
-  long long frames_ = 0;
-  int previous_state_ = -1;
-  bool previous_lost_ = false;
-  TempoEstimator tempo_;
-  JumpGate jump_gate_;
-  SensorNoiseEstimator sensor_noise_;
-  NoiseFilter noise_filter_;
-  ExplainedResidual explained_residual_;
+  FollowerHistory history_;
 };
 
 class HmmForward {

@@ -1,0 +1,38 @@
+// What the exact forward step (hmm_follower.h) and the beam step (beam_follower.h) both carry
+// from frame to frame beside the forward variable: the running likelihood, the previous decision
+// and the per-input estimators (tempo, jump gate, sensor noise, input filter, explained
+// residual). One struct, so both followers configure and reset the same state.
+#pragma once
+
+#include "duet/follow/explained_residual.h"
+#include "duet/follow/follow_params.h"
+#include "duet/follow/jump_gate.h"
+#include "duet/follow/noise_filter.h"
+#include "duet/follow/sensor_noise.h"
+#include "duet/follow/tempo_band.h"
+#include "duet/follow/template_model.h"
+
+namespace duet {
+
+struct FollowerHistory {
+  // Without a model: the sensor noise reads 0 and the input filter passes the input.
+  FollowerHistory() = default;
+  // The sensor noise estimator and the input filter sized for the model's posture dimensions and
+  // rate, with the parameters' time constant, density and allowance. Allocates.
+  FollowerHistory(const TemplateModel& model, const FollowParams& params);
+
+  // Back to the first frame (the estimators keep their sizes). Allocates nothing.
+  void reset() noexcept;
+
+  double total_log_likelihood = 0.0;  // a sum over the whole performance, hence double
+  long long frames = 0;
+  int previous_state = -1;
+  bool previous_lost = false;
+  TempoEstimator tempo;
+  JumpGate jump_gate;
+  SensorNoiseEstimator sensor_noise;
+  NoiseFilter noise_filter;
+  ExplainedResidual explained_residual;
+};
+
+}  // namespace duet
