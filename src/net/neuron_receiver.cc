@@ -6,6 +6,8 @@
 #include <boost/asio/ip/udp.hpp>
 #include <boost/asio/steady_timer.hpp>
 
+#include "listen_address.h"
+
 namespace duet::net {
 
 namespace asio = boost::asio;
@@ -168,18 +170,15 @@ Result<std::unique_ptr<NeuronReceiver>> NeuronReceiver::bind_udp(asio::io_contex
                                                                  NeuronSource& source,
                                                                  OnInput on_input, Log log) {
   const std::string where = address + ":" + std::to_string(port);
-  error_code ec;
-  const asio::ip::address ip =
-      asio::ip::make_address(address == "localhost" ? std::string("127.0.0.1") : address, ec);
-  if (ec) return Error{"neuron-udp: " + where + ": not an IP address"};
+  const std::optional<asio::ip::address> ip = listen_address(address);
+  if (!ip) return Error{"neuron-udp: " + where + ": not an IP address"};
   auto state = std::make_shared<UdpReceiver::State>(io);
   state->source = &source;
   state->on_input = std::move(on_input);
   state->log = std::move(log);
-  const asio::ip::udp::endpoint endpoint(ip, port);
-  state->socket.open(endpoint.protocol(), ec);
-  if (!ec) state->socket.bind(endpoint, ec);
-  if (ec) return Error{"neuron-udp: cannot bind " + where + ": " + ec.message()};
+  if (const error_code ec = open_udp_socket(state->socket, *ip, port); ec) {
+    return Error{"neuron-udp: cannot bind " + where + ": " + ec.message()};
+  }
   state->log("neuron-udp: listening on " + where);
   state->receive();
   return std::unique_ptr<NeuronReceiver>(std::make_unique<UdpReceiver>(std::move(state)));

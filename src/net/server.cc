@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "duet/net/static_files.h"
+#include "listen_address.h"
 
 namespace duet::net {
 
@@ -545,10 +546,9 @@ Status Server::start() {
   Impl& s = *impl_;
   const std::string where = s.options.address + ":" + std::to_string(s.options.port);
   beast::error_code ec;
-  asio::ip::address address = asio::ip::make_address(
-      s.options.address == "localhost" ? std::string("127.0.0.1") : s.options.address, ec);
-  if (ec) return Error{"--http " + where + ": not an IP address"};
-  const tcp::endpoint endpoint(address, s.options.port);
+  const std::optional<asio::ip::address> address = listen_address(s.options.address);
+  if (!address) return Error{"--http " + where + ": not an IP address"};
+  const tcp::endpoint endpoint(*address, s.options.port);
   auto fail = [&](const char* what) {
     // The reason first: closing the acceptor resets `ec` ("cannot bind: Success").
     std::string reason = ec.message();

@@ -4,6 +4,7 @@
 #include <boost/asio/ip/udp.hpp>
 
 #include "duet/net/vmc_decoder.h"
+#include "listen_address.h"
 
 namespace duet::net {
 
@@ -50,17 +51,13 @@ Result<std::unique_ptr<VmcReceiver>> VmcReceiver::bind(asio::io_context& io,
                                                        std::uint16_t port, VmcSource& source,
                                                        OnInput on_input, Log log) {
   const std::string where = address + ":" + std::to_string(port);
-  error_code ec;
-  const asio::ip::address ip =
-      asio::ip::make_address(address == "localhost" ? std::string("127.0.0.1") : address, ec);
-  if (ec) return Error{"vmc: " + where + ": not an IP address"};
+  const std::optional<asio::ip::address> ip = listen_address(address);
+  if (!ip) return Error{"vmc: " + where + ": not an IP address"};
   auto state = std::make_shared<State>(io);
   state->source = &source;
   state->on_input = std::move(on_input);
   state->log = std::move(log);
-  const asio::ip::udp::endpoint endpoint(ip, port);
-  state->socket.open(endpoint.protocol(), ec);
-  if (!ec) state->socket.bind(endpoint, ec);
+  error_code ec = open_udp_socket(state->socket, *ip, port);
   if (ec) return Error{"vmc: cannot bind UDP " + where + ": " + ec.message()};
   // A frame of VMC is ~60 datagram-sized messages; a larger receive buffer rides out a stall.
   state->socket.set_option(asio::socket_base::receive_buffer_size(1 << 20), ec);
