@@ -11,22 +11,11 @@ import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 import { startMockServer } from './mock-server.mjs';
+import { kChromium, kLaunchArgs } from './chromium.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const kDist = path.resolve(here, '..', 'dist');
 const kResults = path.resolve(here, '..', 'test-results');
-const kChromium = process.env.DUET_CHROMIUM || '/usr/bin/chromium';
-const kLaunchArgs = [
-  '--headless',
-  '--no-sandbox',
-  '--disable-gpu',
-  '--disable-quic',
-  '--no-first-run',
-  '--disable-background-networking',
-  '--disable-component-update',
-  '--disable-sync',
-  '--enable-unsafe-swiftshader', // WebGL on SwiftShader without a GPU
-];
 const kViewport = { width: 1280, height: 720 };
 const kLeaderBlue = '#2f6fff';
 const kPartnerPink = '#ff4fa3';

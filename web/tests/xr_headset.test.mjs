@@ -16,21 +16,10 @@ import * as THREE from 'three';
 import { metaQuest3 } from 'iwer';
 import { chromium } from 'playwright-core';
 import WebSocket from 'ws';
+import { kChromium, kLaunchArgs } from './chromium.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const kResults = path.resolve(here, '..', 'test-results');
-const kChromium = process.env.DUET_CHROMIUM || '/usr/bin/chromium';
-const kLaunchArgs = [
-  '--headless',
-  '--no-sandbox',
-  '--disable-gpu',
-  '--disable-quic',
-  '--no-first-run',
-  '--disable-background-networking',
-  '--disable-component-update',
-  '--disable-sync',
-  '--enable-unsafe-swiftshader',
-];
 const kUrl = process.env.DUET_VIEWER_URL || '';
 const kRecording = process.env.DUET_XR_RECORDING || '';
 const kTakeIndex = 6; // 60_07 in libraries/cmu-salsa.toml
