@@ -48,6 +48,7 @@ struct EvalArgs {
   // Tuning of the "hmm" tracker (FollowParams fields); unset keeps the follower's defaults.
   std::optional<float> jump_hold;
   std::optional<int> jump_tolerance;
+  std::optional<float> jump_settle;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
       pause_distance, lost_distance, velocity_cap, pause_noise_factor, lost_residual,
       lost_noise_factor, lost_residual_factor, emission_noise_factor, emission_noise_allowance, noise_filter_density,
@@ -215,6 +216,7 @@ int run_eval(EvalArgs& args) {
   if (args.fixed_band) hmm.tempo_adaptive = false;
   if (args.jump_hold) hmm.jump_hold_s = *args.jump_hold;
   if (args.jump_tolerance) hmm.jump_tolerance_frames = *args.jump_tolerance;
+  if (args.jump_settle) hmm.jump_settle_s = *args.jump_settle;
   if (Status s = hmm.validate(1); !s) return usage_error(s.error().message);
   if (args.dtw_back) options.dtw.window_back = *args.dtw_back;
   if (args.dtw_ahead) options.dtw.window_ahead = *args.dtw_ahead;
@@ -308,7 +310,7 @@ int run_eval(EvalArgs& args) {
   fmt::print(
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
-      "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {}\n"
+      "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
       "lost_residual_factor {} emission_noise_factor {} emission_noise_allowance {} "
       "noise_filter_density {} noise_filter_allowance {}\n\n",
@@ -317,7 +319,7 @@ int run_eval(EvalArgs& args) {
       hmm.leave_prob, hmm.pause_stay_prob, hmm.emission_sigma, hmm.pause_distance_per_dim,
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
-      hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.pause_noise_factor,
+      hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.pause_noise_factor,
       hmm.lost_residual_per_dim, hmm.lost_noise_factor, hmm.lost_residual_factor,
       hmm.emission_noise_factor, hmm.emission_noise_allowance, hmm.noise_filter_density,
       hmm.noise_filter_allowance);
@@ -511,6 +513,12 @@ Command register_eval(CLI::App& app) {
       ->add_option("--jump-tolerance", args->jump_tolerance,
                    "jump_tolerance_frames: a move back by up to this many frames is no jump")
       ->check(CLI::Range(0, 1000));
+  tuning
+      ->add_option("--jump-settle", args->jump_settle,
+                   "jump_settle_s: after the start, moves of the estimate are the first placement "
+                   "being refined, not jumps, until it has held one place this long (template "
+                   "seconds; 0 for none)")
+      ->check(number_between(0.0, 10.0));
   tuning->add_option("--dtw-back", args->dtw_back, "online DTW window behind the estimate")
       ->check(non_negative_check());
   tuning->add_option("--dtw-ahead", args->dtw_ahead, "online DTW window ahead of the estimate")

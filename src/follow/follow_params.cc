@@ -23,6 +23,7 @@ FollowParams FollowParams::paper() {
   params.tempo_adaptive = false;
   params.jump_hold_s = 0.0f;
   params.jump_tolerance_frames = 0;
+  params.jump_settle_s = 0.0f;
   params.pause_noise_factor = 0.0f;
   params.emission_noise_factor = 0.0f;
   params.emission_noise_allowance = 0.0f;
@@ -102,6 +103,9 @@ Status FollowParams::validate(int num_states) const {
   }
   if (!(jump_hold_s >= 0.0f && jump_hold_s <= 10.0f)) {
     return params_error("jump_hold_s must be in [0, 10] s, got " + std::to_string(jump_hold_s));
+  }
+  if (!(jump_settle_s >= 0.0f && jump_settle_s <= 10.0f)) {
+    return params_error("jump_settle_s must be in [0, 10] s, got " + std::to_string(jump_settle_s));
   }
   if (jump_tolerance_frames < 0 || jump_tolerance_frames > 1000) {
     return params_error("jump_tolerance_frames must be in [0, 1000], got " +

@@ -14,21 +14,29 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
   // restart at the refined place (else it plays on from the poor one).
   const int tolerance = previous_lost ? 0 : params.jump_tolerance_frames;
   const int steps = std::max(result.steps, 1);
+  const double step_s = static_cast<double>(steps) / model.frame_rate_hz();
   if (previous_state < 0 || result.missing || result.state < 0 ||
       !follow_detail::is_jump(model, previous_state, result.state, steps, tolerance)) {
     // Within reach of the old place: no jump, whatever the raw maximum's step was.
     result.jumped = false;
-    reset();
+    if (previous_state >= 0 && result.state >= 0) settled_s_ += step_s;
+    forget_candidate();
+    return;
+  }
+  if (settled_s_ + 1e-6 < params.jump_settle_s) {
+    // Still finding the first place: take the new one and start settling there.
+    result.jumped = false;
+    settled_s_ = 0.0;
+    forget_candidate();
     return;
   }
   if (previous_lost || result.in_pause || params.jump_hold_s <= 0.0f) {
     result.jumped = true;  // nothing to hold on to, or no delay asked for
-    reset();
+    forget_candidate();
     return;
   }
   // The maximum is far from the old place. The same far place (moving along its take) holds on;
   // another one starts over.
-  const double step_s = static_cast<double>(steps) / model.frame_rate_hz();
   const bool same_candidate =
       candidate_state_ >= 0 &&
       !follow_detail::is_jump(model, candidate_state_, result.state, steps, tolerance);
@@ -36,7 +44,7 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
   candidate_state_ = result.state;
   if (held_s_ + 1e-6 >= params.jump_hold_s) {  // (3 frames of 1/60 s make 0.05 s)
     result.jumped = true;
-    reset();
+    forget_candidate();
     return;
   }
   // Not yet: report the best state within reach of the old place.

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 namespace duet {
@@ -38,6 +39,7 @@ TEST(JumpGate, SmallStepsBackAreJitterLargerOnesAndOtherTakesAreJumps) {
   FollowParams params;
   params.jump_hold_s = 0.0f;
   params.jump_tolerance_frames = 6;
+  params.jump_settle_s = 0.0f;  // a follower that has settled (tested below)
   JumpGate gate;
   for (const auto& [from, to, jump] : {std::tuple{50, 47, false},
                                        {50, 44, false},
@@ -59,6 +61,7 @@ TEST(JumpGate, AFarPlaceIsReportedOnlyOnceItHolds) {
   const TemplateModel model = two_takes();
   FollowParams params;
   params.jump_hold_s = 0.05f;  // 3 template frames
+  params.jump_settle_s = 0.0f;
   JumpGate gate;
   // One frame's excursion to take 1 and back: never reported; the old place goes on.
   std::vector<float> p = posterior(150, 41);
@@ -91,6 +94,7 @@ TEST(JumpGate, AfterALostFrameEveryMovePastTheBandIsAJump) {
   const TemplateModel model = two_takes();
   FollowParams params;
   params.jump_tolerance_frames = 6;
+  params.jump_settle_s = 0.0f;
   JumpGate gate;
   const std::vector<float> p = posterior(53);
   FollowResult r = maximum_at(model, p, 53);
@@ -105,12 +109,58 @@ TEST(JumpGate, AfterALostFrameTheNewPlaceIsTakenAtOnce) {
   const TemplateModel model = two_takes();
   FollowParams params;
   params.jump_hold_s = 0.5f;
+  params.jump_settle_s = 0.0f;
   JumpGate gate;
   const std::vector<float> p = posterior(150, 41);
   FollowResult r = maximum_at(model, p, 150);
   gate.apply(model, params, p.data(), 1.0f, 40, /*previous_lost=*/true, r);
   EXPECT_TRUE(r.jumped);
   EXPECT_EQ(r.state, 150);
+}
+
+TEST(JumpGate, TheFirstPlacementIsRefinedWithoutJumpsUntilItHasSettled) {
+  const TemplateModel model = two_takes();
+  FollowParams params;
+  params.jump_settle_s = 0.1f;  // 6 template frames
+  JumpGate gate;
+  // The first frames move between look-alike places: no jump is reported, the place is taken.
+  int previous = -1;
+  for (const int to : {10, 150, 151, 60}) {
+    const std::vector<float> p = posterior(to);
+    FollowResult r = maximum_at(model, p, to);
+    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+    EXPECT_FALSE(r.jumped) << to;
+    EXPECT_EQ(r.state, to);
+    previous = r.state;
+  }
+  // Six frames along one place settle it (0.1 s); a far move is then a jump again.
+  for (int k = 1; k <= 6; ++k) {
+    const std::vector<float> p = posterior(60 + k);
+    FollowResult r = maximum_at(model, p, 60 + k);
+    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+    EXPECT_FALSE(r.jumped);
+    previous = r.state;
+  }
+  std::vector<float> p = posterior(140);
+  FollowResult r = maximum_at(model, p, 140);
+  gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+  EXPECT_TRUE(r.jumped);
+  // reset() starts the first placement over.
+  gate.reset();
+  p = posterior(20);
+  r = maximum_at(model, p, 20);
+  gate.apply(model, params, p.data(), 1.0f, 140, false, r);
+  EXPECT_FALSE(r.jumped);
+}
+
+TEST(FollowParams, ASettlePeriodOutsideZeroToTenSecondsIsRejected) {
+  FollowParams params;
+  params.jump_settle_s = -0.1f;
+  EXPECT_FALSE(params.validate(200));
+  params.jump_settle_s = std::nanf("");
+  EXPECT_FALSE(params.validate(200));
+  params.jump_settle_s = 0.0f;
+  EXPECT_TRUE(params.validate(200));
 }
 
 }  // namespace

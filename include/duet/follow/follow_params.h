@@ -136,6 +136,11 @@ struct FollowParams {
   // is off by default. 0 and 0: every move of the maximum out of the band is a jump (paper).
   float jump_hold_s = 0.0f;
   int jump_tolerance_frames = 6;
+  // The first placement: after a start (or reset) the estimate's first moves are the follower
+  // finding where the dancer is, not the dancer jumping. Until the estimate has stayed within
+  // reach of its place from frame to frame for jump_settle_s (template time), a far move takes
+  // the new place without reporting a jump. 0: every far move is a jump from the first frame on.
+  float jump_settle_s = 0.1f;
 
   // Input at another rate: each input frame applies n = clamp(round(dt_s * template_fps), 1,
   // max_steps_per_frame) template-rate transitions before its emission.
