@@ -12,6 +12,15 @@ const char* PlayheadParams::validate() const noexcept {
   if (!(max_offset_frames >= 0.0) || !std::isfinite(max_offset_frames)) {
     return "max_offset_frames must be finite and >= 0";
   }
+  if (!(jitter_offset_factor >= 0.0) || !std::isfinite(jitter_offset_factor)) {
+    return "jitter_offset_factor must be finite and >= 0";
+  }
+  if (!(max_jitter_offset_frames >= 0.0) || !std::isfinite(max_jitter_offset_frames)) {
+    return "max_jitter_offset_frames must be finite and >= 0";
+  }
+  if (!(jitter_time_constant_s > 0.0) || !std::isfinite(jitter_time_constant_s)) {
+    return "jitter_time_constant_s must be finite and > 0";
+  }
   return "";
 }
 
@@ -23,15 +32,33 @@ double ResponsePlayhead::advance(int estimate, bool restart, double tempo, doubl
   if (!primed_ || restart || !timed) {
     position_ = target;
     primed_ = true;
+    previous_estimate_ = target;
+    history_ = 1;
     return position_;
   }
   const double rate = tempo > 0.0 && std::isfinite(tempo) ? tempo : 1.0;
   const double predicted = position_ + rate * dt_s * frame_rate;
-  const double pull =
-      params.pull_half_life_s > 0.0 ? 1.0 - std::exp2(-dt_s / params.pull_half_life_s) : 1.0;
+  // The estimate's jitter: white jitter e on a steady estimate gives second differences of
+  // variance 6 var(e), while a steady advance, a constant tempo or a pause give none (the
+  // difference to the prediction would also count every tempo change and pause as jitter).
+  // A second difference beyond twice the widest band is a move (a far correction), not jitter.
+  const double second = (target - previous_estimate_) - (previous_estimate_ - before_previous_);
+  if (history_ >= 2 && std::abs(second) <= 2.0 * params.max_jitter_offset_frames) {
+    jitter_ms_ += (1.0 - std::exp(-dt_s / params.jitter_time_constant_s)) *
+                  (second * second / 6.0 - jitter_ms_);
+  }
+  before_previous_ = previous_estimate_;
+  previous_estimate_ = target;
+  history_ = std::min(history_ + 1, 2);
+  const double band = std::max(
+      params.max_offset_frames,
+      std::min(params.jitter_offset_factor * jitter_frames(), params.max_jitter_offset_frames));
+  const double half_life = params.max_offset_frames > 0.0
+                               ? params.pull_half_life_s * band / params.max_offset_frames
+                               : params.pull_half_life_s;
+  const double pull = half_life > 0.0 ? 1.0 - std::exp2(-dt_s / half_life) : 1.0;
   position_ = predicted + pull * (target - predicted);
-  position_ =
-      std::clamp(position_, target - params.max_offset_frames, target + params.max_offset_frames);
+  position_ = std::clamp(position_, target - band, target + band);
   return position_;
 }
 

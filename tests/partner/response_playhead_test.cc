@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -24,7 +25,11 @@ TEST(ResponsePlayhead, TurnsAStaircaseEstimateIntoSteadyMotion) {
   for (int f = 0; f < 240; ++f) {
     const int estimate = static_cast<int>(std::lround(0.7 * f));
     shown.push_back(playhead.advance(estimate, false, 0.7, kDt, kFps, params));
-    EXPECT_LE(std::abs(shown.back() - estimate), params.max_offset_frames + 1e-12);
+    // The staircase's steps count as a little jitter: the band widens a little.
+    const double band =
+        std::max(params.max_offset_frames, params.jitter_offset_factor * playhead.jitter_frames());
+    EXPECT_LE(band, 1.5);
+    EXPECT_LE(std::abs(shown.back() - estimate), band + 1e-12);
     if (f > 0) {
       largest_raw_step = std::max(largest_raw_step,
                                   1.0 * (estimate - static_cast<int>(std::lround(0.7 * (f - 1)))));
@@ -59,6 +64,62 @@ TEST(ResponsePlayhead, RestartsOnTheEstimateAtAJumpAndWithoutTime) {
   EXPECT_EQ(playhead.advance(3, false, 1.0, kDt, kFps, params), 3.0);
 }
 
+TEST(ResponsePlayhead, RidesThroughAJitteringEstimateButNotThroughAPause) {
+  // A noisy sensor: the estimate advances at tempo 1 with white jitter of RMS 1 frame (-1, 0 or
+  // +1 with equal odds would be 0.82; here a deterministic pseudo-random +-1.22).
+  const PlayheadParams params;
+  ResponsePlayhead playhead;
+  unsigned state = 12345u;
+  const auto jitter = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return (state >> 31) != 0u ? 1.22 : -1.22;
+  };
+  std::vector<double> estimates, shown;
+  for (int f = 0; f < 600; ++f) {
+    const int estimate = static_cast<int>(std::lround(f + jitter()));
+    estimates.push_back(estimate);
+    shown.push_back(playhead.advance(estimate, false, 1.0, kDt, kFps, params));
+  }
+  // The measured jitter is the estimate's (rounded to whole frames: about 1.1).
+  EXPECT_NEAR(playhead.jitter_frames(), 1.1, 0.3);
+  // The shown frame's second differences are a fraction of the estimate's.
+  const auto rms_second = [](const std::vector<double>& x) {
+    double sum = 0.0;
+    for (std::size_t f = 300; f + 1 < x.size(); ++f) {
+      const double d = x[f + 1] - 2.0 * x[f] + x[f - 1];
+      sum += d * d;
+    }
+    return std::sqrt(sum / static_cast<double>(x.size() - 301));
+  };
+  EXPECT_LT(rms_second(shown), 0.25 * rms_second(estimates));
+  for (std::size_t f = 0; f < shown.size(); ++f) {
+    EXPECT_LE(std::abs(shown[f] - estimates[f]), params.max_jitter_offset_frames + 1e-9);
+  }
+
+  // A dancer who pauses: the estimate stops (one second difference), then stands; no jitter.
+  ResponsePlayhead paused;
+  for (int f = 0; f < 600; ++f) {
+    paused.advance(std::min(f, 300), false, 1.0, kDt, kFps, params);
+  }
+  EXPECT_LT(paused.jitter_frames(), 0.1);
+  // A far correction without a jump is a move, not jitter.
+  ResponsePlayhead moved;
+  for (int f = 0; f < 120; ++f) moved.advance(f, false, 1.0, kDt, kFps, params);
+  EXPECT_NEAR(moved.advance(400, false, 1.0, kDt, kFps, params), 400.0 - params.max_offset_frames,
+              1e-9);
+  EXPECT_LT(moved.jitter_frames(), 0.1);
+  // With the widening off, the band is max_offset_frames whatever the jitter.
+  PlayheadParams fixed;
+  fixed.jitter_offset_factor = 0.0;
+  ResponsePlayhead narrow;
+  for (int f = 0; f < 600; ++f) {
+    const double estimate = estimates[static_cast<std::size_t>(f)];
+    EXPECT_LE(std::abs(narrow.advance(static_cast<int>(estimate), false, 1.0, kDt, kFps, fixed) -
+                       estimate),
+              fixed.max_offset_frames + 1e-9);
+  }
+}
+
 TEST(PlayheadParams, Validate) {
   PlayheadParams p;
   EXPECT_STREQ(p.validate(), "");
@@ -67,6 +128,15 @@ TEST(PlayheadParams, Validate) {
   p = PlayheadParams{};
   p.max_offset_frames = std::nan("");
   EXPECT_NE(std::string(p.validate()).find("max_offset_frames"), std::string::npos);
+  p = PlayheadParams{};
+  p.jitter_offset_factor = -1.0;
+  EXPECT_NE(std::string(p.validate()).find("jitter_offset_factor"), std::string::npos);
+  p = PlayheadParams{};
+  p.max_jitter_offset_frames = std::nan("");
+  EXPECT_NE(std::string(p.validate()).find("max_jitter_offset_frames"), std::string::npos);
+  p = PlayheadParams{};
+  p.jitter_time_constant_s = 0.0;
+  EXPECT_NE(std::string(p.validate()).find("jitter_time_constant_s"), std::string::npos);
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 // starts on the estimate. The pose is then sampled at that real frame (Clip::sample).
 #pragma once
 
+#include <cmath>
+
 namespace duet {
 
 // Chosen with `duet eval` (docs/evaluation.md, partner metrics): half-life / max offset 0.05 s /
@@ -18,13 +20,28 @@ namespace duet {
 struct PlayheadParams {
   double pull_half_life_s = 0.03;  // how fast a difference to the estimate is closed
   double max_offset_frames = 0.5;  // the playhead stays within this of the estimate
+  // Under a noisy sensor the estimate jitters by frames, and within half a frame of it the
+  // partner's whole body jitters along (issue 11: at 4 degrees per axis the partner's p99 joint
+  // speed was 1.34x the captured, most of it the hips in turns). The playhead measures that
+  // jitter (from the estimate's second differences, over jitter_time_constant_s) and widens its
+  // band to jitter_offset_factor times its RMS (at most max_jitter_offset_frames), with the
+  // half-life grown in proportion, so it rides through the jitter; on a steady, a slowly
+  // changing or a paused estimate the band stays max_offset_frames. 0: no widening. Measured in
+  // docs/evaluation.md ("Partner steadiness", factors 1-3).
+  double jitter_offset_factor = 3.0;
+  double max_jitter_offset_frames = 3.0;
+  double jitter_time_constant_s = 1.0;
   // Empty when valid, else which value is wrong.
   const char* validate() const noexcept;
 };
 
 class ResponsePlayhead {
  public:
-  void reset() noexcept { primed_ = false; }
+  // A new performance: also forgets the measured jitter (a jump keeps it: it is the sensor's).
+  void reset() noexcept {
+    primed_ = false;
+    jitter_ms_ = 0.0;
+  }
   // estimate: the follower's frame; restart: a jump or another take (start on the estimate);
   // tempo: template frames per template frame of input time (non-finite or <= 0: 1); dt_s: time
   // since the previous call (<= 0 or non-finite: restart); frame_rate: the template's. Returns
@@ -33,10 +50,16 @@ class ResponsePlayhead {
   double advance(int estimate, bool restart, double tempo, double dt_s, double frame_rate,
                  const PlayheadParams& params) noexcept;
   double position() const noexcept { return position_; }
+  // The estimate's jitter RMS (frames) the band is widened by.
+  double jitter_frames() const noexcept { return std::sqrt(jitter_ms_); }
 
  private:
   bool primed_ = false;
   double position_ = 0.0;
+  double jitter_ms_ = 0.0;  // mean square of the estimate's jitter, frames^2
+  double previous_estimate_ = 0.0;
+  double before_previous_ = 0.0;
+  int history_ = 0;  // estimates since the last restart (at most 2 counted)
 };
 
 }  // namespace duet
