@@ -49,6 +49,7 @@ struct EvalArgs {
   std::optional<float> jump_hold;
   std::optional<int> jump_tolerance;
   std::optional<float> jump_settle;
+  std::optional<float> noisy_jump_hold;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
       pause_distance, lost_distance, velocity_cap, pause_noise_factor, lost_residual,
       lost_noise_factor, lost_residual_factor, emission_noise_factor, emission_noise_allowance, noise_filter_density,
@@ -217,6 +218,7 @@ int run_eval(EvalArgs& args) {
   if (args.jump_hold) hmm.jump_hold_s = *args.jump_hold;
   if (args.jump_tolerance) hmm.jump_tolerance_frames = *args.jump_tolerance;
   if (args.jump_settle) hmm.jump_settle_s = *args.jump_settle;
+  if (args.noisy_jump_hold) hmm.noisy_jump_hold_s = *args.noisy_jump_hold;
   if (Status s = hmm.validate(1); !s) return usage_error(s.error().message);
   if (args.dtw_back) options.dtw.window_back = *args.dtw_back;
   if (args.dtw_ahead) options.dtw.window_ahead = *args.dtw_ahead;
@@ -310,7 +312,7 @@ int run_eval(EvalArgs& args) {
   fmt::print(
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
-      "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s\n"
+      "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s noisy_jump_hold {} s\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
       "lost_residual_factor {} emission_noise_factor {} emission_noise_allowance {} "
       "noise_filter_density {} noise_filter_allowance {}\n\n",
@@ -319,7 +321,8 @@ int run_eval(EvalArgs& args) {
       hmm.leave_prob, hmm.pause_stay_prob, hmm.emission_sigma, hmm.pause_distance_per_dim,
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
-      hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.pause_noise_factor,
+      hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.noisy_jump_hold_s,
+      hmm.pause_noise_factor,
       hmm.lost_residual_per_dim, hmm.lost_noise_factor, hmm.lost_residual_factor,
       hmm.emission_noise_factor, hmm.emission_noise_allowance, hmm.noise_filter_density,
       hmm.noise_filter_allowance);
@@ -513,6 +516,11 @@ Command register_eval(CLI::App& app) {
       ->add_option("--jump-tolerance", args->jump_tolerance,
                    "jump_tolerance_frames: a move back by up to this many frames is no jump")
       ->check(CLI::Range(0, 1000));
+  tuning
+      ->add_option("--noisy-jump-hold", args->noisy_jump_hold,
+                   "noisy_jump_hold_s: the jump hold under a noisy sensor, reached at "
+                   "noisy_jump_hold_level of estimated noise (template seconds; 0 for none)")
+      ->check(number_between(0.0, 10.0));
   tuning
       ->add_option("--jump-settle", args->jump_settle,
                    "jump_settle_s: after the start, moves of the estimate are the first placement "

@@ -1,10 +1,19 @@
 #include "duet/follow/jump_gate.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "forward_common.h"
 
 namespace duet {
+
+float JumpGate::hold_s(const FollowParams& params, float sensor_noise_per_dim) noexcept {
+  const float level = params.noisy_jump_hold_level;
+  const float ramp = std::isfinite(sensor_noise_per_dim)
+                         ? std::clamp((sensor_noise_per_dim - 0.5f * level) / (0.5f * level), 0.0f, 1.0f)
+                         : 0.0f;
+  return std::max(params.jump_hold_s, ramp * params.noisy_jump_hold_s);
+}
 
 void JumpGate::apply(const TemplateModel& model, const FollowParams& params, const float* posterior,
                      float total, int previous_state, bool previous_lost,
@@ -30,7 +39,8 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
     forget_candidate();
     return;
   }
-  if (previous_lost || result.in_pause || params.jump_hold_s <= 0.0f) {
+  const float hold = hold_s(params, result.sensor_noise_per_dim);
+  if (previous_lost || result.in_pause || hold <= 0.0f) {
     result.jumped = true;  // nothing to hold on to, or no delay asked for
     forget_candidate();
     return;
@@ -42,7 +52,7 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
       !follow_detail::is_jump(model, candidate_state_, result.state, steps, tolerance);
   held_s_ = same_candidate ? held_s_ + step_s : step_s;
   candidate_state_ = result.state;
-  if (held_s_ + 1e-6 >= params.jump_hold_s) {  // (3 frames of 1/60 s make 0.05 s)
+  if (held_s_ + 1e-6 >= hold) {  // (3 frames of 1/60 s make 0.05 s)
     result.jumped = true;
     forget_candidate();
     return;

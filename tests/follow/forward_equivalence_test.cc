@@ -98,6 +98,7 @@ TEST(ForwardEquivalence, SameAlphaAndEstimatesOverJumpsRatesAndMissingFrames) {
     s.params.pause_noise_factor = 0.0f;
     s.params.emission_noise_factor = 0.0f;
     s.params.noise_filter_density = 0.0f;
+    s.params.noisy_jump_hold_s = 0.0f;
     s.params.calibrate_confidence = false;
     const TemplateModel model = test::make_model(s.takes, 16, 11, 60.0, s.velocity_dims);
     HmmFollower fast = HmmFollower::create(model, s.params).value();

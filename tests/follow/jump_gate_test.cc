@@ -153,7 +153,58 @@ TEST(JumpGate, TheFirstPlacementIsRefinedWithoutJumpsUntilItHasSettled) {
   EXPECT_FALSE(r.jumped);
 }
 
-TEST(FollowParams, ASettlePeriodOutsideZeroToTenSecondsIsRejected) {
+TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
+  FollowParams params;
+  // The hold grows with the estimated sensor noise: none on a clean sensor, all of it from the
+  // level on, the larger of it and jump_hold_s.
+  EXPECT_EQ(JumpGate::hold_s(params, 0.0f), 0.0f);
+  EXPECT_EQ(JumpGate::hold_s(params, 0.5f * params.noisy_jump_hold_level), 0.0f);
+  EXPECT_NEAR(JumpGate::hold_s(params, 0.75f * params.noisy_jump_hold_level),
+              0.5f * params.noisy_jump_hold_s, 1e-6f);
+  EXPECT_EQ(JumpGate::hold_s(params, 10.0f * params.noisy_jump_hold_level),
+            params.noisy_jump_hold_s);
+  EXPECT_EQ(JumpGate::hold_s(params, std::nanf("")), 0.0f);
+  params.jump_hold_s = 0.5f;
+  EXPECT_EQ(JumpGate::hold_s(params, 1.0f), 0.5f);
+  params.jump_hold_s = 0.0f;
+  params.jump_settle_s = 0.0f;
+
+  const TemplateModel model = two_takes();
+  const auto noisy = [&](int state) {
+    FollowResult r = maximum_at(model, {}, state);
+    r.sensor_noise_per_dim = 2.0f * params.noisy_jump_hold_level;
+    return r;
+  };
+  // One frame at take 1 and back: the old place goes on, no jump either way.
+  JumpGate gate;
+  std::vector<float> p = posterior(150, 41);
+  FollowResult r = noisy(150);
+  gate.apply(model, params, p.data(), 1.0f, 40, false, r);
+  EXPECT_FALSE(r.jumped);
+  EXPECT_EQ(r.state, 41);
+  p = posterior(42);
+  r = noisy(42);
+  r.jumped = false;
+  gate.apply(model, params, p.data(), 1.0f, 41, false, r);
+  EXPECT_FALSE(r.jumped);
+  // A real jump holds: reported on its third frame at 60 Hz (0.05 s >= 0.04 s).
+  int previous = 42;
+  for (int k = 0; k < 3; ++k) {
+    p = posterior(150 + k, previous + 1);
+    r = noisy(150 + k);
+    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+    EXPECT_EQ(r.jumped, k == 2) << k;
+    previous = r.state;
+  }
+  // The same excursion on a clean sensor is a jump at once.
+  JumpGate clean;
+  p = posterior(150, 41);
+  r = maximum_at(model, p, 150);
+  clean.apply(model, params, p.data(), 1.0f, 40, false, r);
+  EXPECT_TRUE(r.jumped);
+}
+
+TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
   FollowParams params;
   params.jump_settle_s = -0.1f;
   EXPECT_FALSE(params.validate(200));
@@ -161,6 +212,11 @@ TEST(FollowParams, ASettlePeriodOutsideZeroToTenSecondsIsRejected) {
   EXPECT_FALSE(params.validate(200));
   params.jump_settle_s = 0.0f;
   EXPECT_TRUE(params.validate(200));
+  params.noisy_jump_hold_s = -1.0f;
+  EXPECT_FALSE(params.validate(200));
+  params.noisy_jump_hold_s = 0.04f;
+  params.noisy_jump_hold_level = 0.0f;
+  EXPECT_FALSE(params.validate(200));
 }
 
 }  // namespace

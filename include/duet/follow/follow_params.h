@@ -135,6 +135,13 @@ struct FollowParams {
   // at 4 degrees of noise (a wrong place held on while the maximum moved between others), so it
   // is off by default. 0 and 0: every move of the maximum out of the band is a jump (paper).
   float jump_hold_s = 0.0f;
+  // Under a noisy sensor the maximum makes one-frame excursions to a look-alike place and back
+  // (two false jumps each). The hold then grows with the estimated sensor noise: from 0 at half
+  // noisy_jump_hold_level to noisy_jump_hold_s at it and above (the larger of this and
+  // jump_hold_s applies). About 1.5 and 3.5 degrees per axis; on a clean sensor jumps are taken
+  // at once. Measured in docs/follower.md ("Jump decisions").
+  float noisy_jump_hold_s = 0.04f;
+  float noisy_jump_hold_level = 0.006f;
   int jump_tolerance_frames = 6;
   // The first placement: after a start (or reset) the estimate's first moves are the follower
   // finding where the dancer is, not the dancer jumping. Until the estimate has stayed within

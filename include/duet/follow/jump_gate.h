@@ -3,9 +3,10 @@
 // back, and every such excursion would be reported as a jump (the partner restarts its playhead
 // and blends: 67 false jumps a minute at 3 degrees of noise, nearly all of them the maximum
 // stepping back a frame or two). A small move backwards (up to jump_tolerance_frames) is jitter,
-// not a jump. Optionally (FollowParams::jump_hold_s > 0) a move out of the band's reach is
-// reported only once the new place has held the maximum for that long in template time (a
-// bounded decision delay); until then the best state near the old place is reported.
+// not a jump. A move out of the band's reach is reported only once the new place has held the
+// maximum for the hold in template time (a bounded decision delay; until then the best state near
+// the old place is reported): FollowParams::jump_hold_s, or under a noisy sensor the hold that
+// grows with the estimated noise (noisy_jump_hold_s).
 // After a lost frame (or in the pause state) the new place is taken at once. Until the estimate
 // has first settled (FollowParams::jump_settle_s) a far move is the first placement being
 // refined: no jump is reported (half the false jumps left at 4 degrees per axis were those).
@@ -32,6 +33,8 @@ class JumpGate {
   // maximum is taken at once. Allocates nothing.
   void apply(const TemplateModel& model, const FollowParams& params, const float* posterior,
              float total, int previous_state, bool previous_lost, FollowResult& result) noexcept;
+  // The hold (template seconds) at this sensor noise (FollowResult::sensor_noise_per_dim).
+  static float hold_s(const FollowParams& params, float sensor_noise_per_dim) noexcept;
 
  private:
   void forget_candidate() noexcept {
