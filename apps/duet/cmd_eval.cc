@@ -52,8 +52,8 @@ struct EvalArgs {
   std::optional<float> noisy_jump_hold;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
       pause_distance, lost_distance, velocity_cap, pause_noise_factor, lost_residual,
-      lost_noise_factor, lost_residual_factor, emission_noise_factor, emission_noise_allowance, noise_filter_density,
-      noise_filter_allowance;
+      lost_noise_factor, lost_residual_factor, emission_noise_factor, emission_noise_allowance,
+      noise_filter_density, noise_filter_allowance;
   std::optional<double> tempo_time_constant;
   bool fixed_band = false;
   std::optional<int> dtw_back, dtw_ahead;
@@ -229,7 +229,8 @@ int run_eval(EvalArgs& args) {
   if (args.effector_speed_weight) features.effector_speed_weight = *args.effector_speed_weight;
   if (args.velocity_window) features.velocity_window_s = *args.velocity_window;
   if (!parse_input_points(args.input_points, features.input_points)) {
-    return usage_error("--input-points: '" + args.input_points + "' is neither full nor head,hands");
+    return usage_error("--input-points: '" + args.input_points +
+                       "' is neither full nor head,hands");
   }
 
   std::string gnuplot;
@@ -312,7 +313,8 @@ int run_eval(EvalArgs& args) {
   fmt::print(
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
-      "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s noisy_jump_hold {} s\n"
+      "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s "
+      "noisy_jump_hold {} s\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
       "lost_residual_factor {} emission_noise_factor {} emission_noise_allowance {} "
       "noise_filter_density {} noise_filter_allowance {}\n\n",
@@ -322,10 +324,9 @@ int run_eval(EvalArgs& args) {
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
       hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.noisy_jump_hold_s,
-      hmm.pause_noise_factor,
-      hmm.lost_residual_per_dim, hmm.lost_noise_factor, hmm.lost_residual_factor,
-      hmm.emission_noise_factor, hmm.emission_noise_allowance, hmm.noise_filter_density,
-      hmm.noise_filter_allowance);
+      hmm.pause_noise_factor, hmm.lost_residual_per_dim, hmm.lost_noise_factor,
+      hmm.lost_residual_factor, hmm.emission_noise_factor, hmm.emission_noise_allowance,
+      hmm.noise_filter_density, hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
   std::fflush(stdout);
 

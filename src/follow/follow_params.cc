@@ -134,8 +134,9 @@ Status FollowParams::validate(int num_states) const {
                           std::to_string(min_tempo) + ", " + std::to_string(max_tempo) + "]");
     }
     if (!(self_prob > 0.0f && skip_prob > 0.0f)) {
-      return params_error("tempo_adaptive needs self_prob > 0 and skip_prob > 0 (slower and "
-                          "faster moves to tilt the band towards)");
+      return params_error(
+          "tempo_adaptive needs self_prob > 0 and skip_prob > 0 (slower and "
+          "faster moves to tilt the band towards)");
     }
   }
   if (!resume_weights.empty()) {

@@ -9,9 +9,10 @@ namespace duet {
 
 float JumpGate::hold_s(const FollowParams& params, float sensor_noise_per_dim) noexcept {
   const float level = params.noisy_jump_hold_level;
-  const float ramp = std::isfinite(sensor_noise_per_dim)
-                         ? std::clamp((sensor_noise_per_dim - 0.5f * level) / (0.5f * level), 0.0f, 1.0f)
-                         : 0.0f;
+  const float ramp =
+      std::isfinite(sensor_noise_per_dim)
+          ? std::clamp((sensor_noise_per_dim - 0.5f * level) / (0.5f * level), 0.0f, 1.0f)
+          : 0.0f;
   return std::max(params.jump_hold_s, ramp * params.noisy_jump_hold_s);
 }
 

@@ -48,13 +48,11 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
   // A far move the follower does not call a jump (the first placement being refined) says the
   // previous frames' match was elsewhere: the frame teaches nothing either.
   constexpr int kFarFrames = 12;
-  const bool moved_unreported =
-      previous_state_ >= 0 && !result.jumped &&
-      (library_->model().take_of(previous_state_) != result.take ||
-       std::abs(result.state - previous_state_) > kFarFrames);
+  const bool moved_unreported = previous_state_ >= 0 && !result.jumped &&
+                                (library_->model().take_of(previous_state_) != result.take ||
+                                 std::abs(result.state - previous_state_) > kFarFrames);
   previous_state_ = result.state;
-  if (!result.jumped && !stepped_back && !moved_unreported && !result.missing &&
-      !result.in_pause &&
+  if (!result.jumped && !stepped_back && !moved_unreported && !result.missing && !result.in_pause &&
       result.best_distance_per_dim <= bias_.params().max_learn_distance_per_dim &&
       result.state >= 0 && result.state < library_->model().num_states()) {
     const auto& rows = library_->model().features();

@@ -42,7 +42,7 @@ struct Scenario {
   const char* name;
   std::vector<int> takes;
   FollowParams params;
-  int velocity_dims = 0;  // trailing dimensions whose distance is capped
+  int velocity_dims = 0;     // trailing dimensions whose distance is capped
   bool tempo_moves = false;  // the replay must move the tempo-centred band away from 1
 };
 
