@@ -1,12 +1,11 @@
 #include "duet/partner/partner_synthesis.h"
 
-#include "duet/motion/body_space.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "duet/math/rotation.h"
+#include "duet/motion/body_space.h"
 #include "duet/motion/forward_kinematics.h"
 #include "duet/partner/ik_two_bone_job.h"
 
@@ -168,8 +167,10 @@ Result<PartnerModel> PartnerModel::build(const Clip& template_clip,
   model.response_roles_ = response_roles;
   model.alignment_ = std::move(alignment).value();
   model.contacts_ = std::move(contacts).value();
-  model.template_height_m_ = measure_body(template_clip.skeleton(), template_roles).standing_height_m;
-  model.response_height_m_ = measure_body(response_clip.skeleton(), response_roles).standing_height_m;
+  model.template_height_m_ =
+      measure_body(template_clip.skeleton(), template_roles).standing_height_m;
+  model.response_height_m_ =
+      measure_body(response_clip.skeleton(), response_roles).standing_height_m;
   model.has_legs_ = legs_are_chains(response_clip.skeleton(), response_roles);
 
   // Ground height per foot: a low quantile of the toe's height over the clip.
@@ -256,6 +257,11 @@ std::string PartnerParams::validate() const {
   if (const std::string_view problem = user_filter.validate(); !problem.empty()) {
     return "user_filter: " + std::string(problem);
   }
+  if (!(user_facing_jitter_reference_rad >= 0.0) ||
+      !std::isfinite(user_facing_jitter_reference_rad)) {
+    return "user_facing_jitter_reference_rad must be finite and >= 0 (0: no adaptation; got " +
+           std::to_string(user_facing_jitter_reference_rad) + ")";
+  }
   if (const std::string_view problem = ik_correction_filter.validate(); !problem.empty()) {
     return "ik_correction_filter: " + std::string(problem);
   }
@@ -331,8 +337,7 @@ UserPose user_pose_from_world(std::span<const Vec3> positions_ws,
   user.root_rotation_ws = rotations_ws[0];
   const auto n = static_cast<int>(positions_ws.size());
   const int left_hip = roles[Role::kLeftHip], right_hip = roles[Role::kRightHip];
-  if (left_hip >= 0 && left_hip < n && right_hip >= 0 && right_hip < n &&
-      left_hip != right_hip) {
+  if (left_hip >= 0 && left_hip < n && right_hip >= 0 && right_hip < n && left_hip != right_hip) {
     user.body_heading = body_heading_frame(positions_ws, roles);
     user.body_heading_valid = user.body_heading.translation.allFinite() &&
                               user.body_heading.rotation.coeffs().allFinite();
@@ -359,6 +364,22 @@ void PartnerContext::resize(int joint_count) {
   reset();
 }
 
+// The jitter (radians) of the user's raw facing yaw, unwrapped so a turn through +-pi is no step.
+double PartnerContext::facing_jitter(const Vec3& facing, double dt) noexcept {
+  const double yaw = std::atan2(facing.x(), facing.z());
+  if (!std::isfinite(yaw)) return user_facing_jitter_.rms();
+  if (user_facing_yaw_valid_) {
+    user_facing_yaw_ += wrap_angle(yaw - wrap_angle(user_facing_yaw_));
+  } else {
+    user_facing_yaw_ = yaw;
+    user_facing_yaw_valid_ = true;
+  }
+  // A second difference over 0.5 rad (30 degrees in a frame) is a new user, not jitter.
+  constexpr double kJitterTimeConstantS = 1.0, kMoveRad = 0.5;
+  user_facing_jitter_.add(user_facing_yaw_, dt, kJitterTimeConstantS, kMoveRad);
+  return user_facing_jitter_.rms();
+}
+
 void PartnerContext::reset() noexcept {
   primed_ = false;
   inertializer_.reset();
@@ -368,6 +389,8 @@ void PartnerContext::reset() noexcept {
   user_heading_ = Transform();
   user_root_filter_.reset();
   user_facing_filter_.reset();
+  user_facing_jitter_.reset();
+  user_facing_yaw_valid_ = false;
   for (auto& arm : ik_correction_filter_) {
     for (OneEuroFilter3& filter : arm) filter.reset();
   }
@@ -435,7 +458,13 @@ bool PartnerSynthesisJob::run() const noexcept {
                        : heading_frame(user->root_position_ws, user->root_rotation_ws.normalized());
     if (p.smooth) {
       const Vec3 facing = user_heading.rotation * Vec3::UnitZ();
-      const Vec3 smooth_facing = ctx.user_facing_filter_.filter(facing, dt, p.user_filter);
+      OneEuroParams facing_filter = p.user_filter;
+      if (p.user_facing_jitter_reference_rad > 0.0) {
+        const double jitter = ctx.facing_jitter(facing, dt);
+        const double ratio = jitter / p.user_facing_jitter_reference_rad;
+        facing_filter.beta /= 1.0 + ratio * ratio;
+      }
+      const Vec3 smooth_facing = ctx.user_facing_filter_.filter(facing, dt, facing_filter);
       const Vec3 smooth_position =
           ctx.user_root_filter_.filter(user_heading.translation, dt, p.user_filter);
       if (smooth_facing.norm() > 1e-6) {
@@ -605,8 +634,8 @@ bool PartnerSynthesisJob::run() const noexcept {
         std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
         const auto correct = [&](std::size_t k, const Quat& captured, const Quat& solved) {
           const bool primed = filters[k].primed();
-          Vec3 c = filters[k].filter(log_map(captured.conjugate() * solved), dt,
-                                     p.ik_correction_filter);
+          Vec3 c =
+              filters[k].filter(log_map(captured.conjugate() * solved), dt, p.ik_correction_filter);
           const double most = p.ik_correction_max_speed_rad_s * dt;
           if (primed && (c - shown[k]).norm() > most) {
             c = shown[k] + (c - shown[k]) * (most / (c - shown[k]).norm());
@@ -618,8 +647,8 @@ bool PartnerSynthesisJob::run() const noexcept {
         const Vec3 mid_correction = correct(1, captured_mid, ik_mid);
         ik_start = (captured_start * exp_map(start_correction)).normalized();
         ik_mid = (captured_mid * exp_map(mid_correction)).normalized();
-        reached_at = arm_end_position(start, mid, end, captured_start, captured_mid, ik_start,
-                                      ik_mid);
+        reached_at =
+            arm_end_position(start, mid, end, captured_start, captured_mid, ik_start, ik_mid);
       }
       out_r[js] = ik_start;
       out_r[jm] = ik_mid;
@@ -652,12 +681,12 @@ bool PartnerSynthesisJob::run() const noexcept {
       ctx.blend_half_life_ =
           p.blend_speed_limited
               ? p.blend_half_life_s
-              : std::max(capped_half_life(p.blend_half_life_s,
-                                          ctx.inertializer_.max_rotation_offset(),
-                                          p.blend_max_speed_rad_s),
-                         capped_half_life(p.blend_half_life_s,
-                                          ctx.inertializer_.max_translation_offset(),
-                                          p.blend_max_root_speed_mps));
+              : std::max(
+                    capped_half_life(p.blend_half_life_s, ctx.inertializer_.max_rotation_offset(),
+                                     p.blend_max_speed_rad_s),
+                    capped_half_life(p.blend_half_life_s,
+                                     ctx.inertializer_.max_translation_offset(),
+                                     p.blend_max_root_speed_mps));
     }
     constexpr double kNoLimit = std::numeric_limits<double>::infinity();
     ctx.inertializer_.update(out_t, out_r, std::max(ctx.blend_half_life_, p.blend_half_life_s), dt,
@@ -729,8 +758,7 @@ bool PartnerSynthesisJob::run() const noexcept {
         if (!target.active) continue;
         const auto ja = static_cast<std::size_t>(roles[kLegs[side].ankle]);
         const auto parent = static_cast<std::size_t>(skeleton.joints[ja].parent);
-        out_r[ja] = (ctx.rotations_ws_[parent].conjugate() * target.turn_ws *
-                     ankle_rotations[side])
+        out_r[ja] = (ctx.rotations_ws_[parent].conjugate() * target.turn_ws * ankle_rotations[side])
                         .normalized();
       }
     }

@@ -32,24 +32,15 @@ double ResponsePlayhead::advance(int estimate, bool restart, double tempo, doubl
   if (!primed_ || restart || !timed) {
     position_ = target;
     primed_ = true;
-    previous_estimate_ = target;
-    history_ = 1;
+    jitter_.restart();
+    jitter_.add(target, dt_s, params.jitter_time_constant_s, 2.0 * params.max_jitter_offset_frames);
     return position_;
   }
   const double rate = tempo > 0.0 && std::isfinite(tempo) ? tempo : 1.0;
   const double predicted = position_ + rate * dt_s * frame_rate;
-  // The estimate's jitter: white jitter e on a steady estimate gives second differences of
-  // variance 6 var(e), while a steady advance, a constant tempo or a pause give none (the
-  // difference to the prediction would also count every tempo change and pause as jitter).
-  // A second difference beyond twice the widest band is a move (a far correction), not jitter.
-  const double second = (target - previous_estimate_) - (previous_estimate_ - before_previous_);
-  if (history_ >= 2 && std::abs(second) <= 2.0 * params.max_jitter_offset_frames) {
-    jitter_ms_ += (1.0 - std::exp(-dt_s / params.jitter_time_constant_s)) *
-                  (second * second / 6.0 - jitter_ms_);
-  }
-  before_previous_ = previous_estimate_;
-  previous_estimate_ = target;
-  history_ = std::min(history_ + 1, 2);
+  // The estimate's jitter (jitter_meter.h); a second difference beyond twice the widest band is
+  // a move (a far correction), not jitter.
+  jitter_.add(target, dt_s, params.jitter_time_constant_s, 2.0 * params.max_jitter_offset_frames);
   const double band = std::max(
       params.max_offset_frames,
       std::min(params.jitter_offset_factor * jitter_frames(), params.max_jitter_offset_frames));

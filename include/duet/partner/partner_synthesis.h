@@ -30,6 +30,7 @@
 #include "duet/partner/foot_hold.h"
 #include "duet/partner/foot_lock.h"
 #include "duet/partner/hand_contacts.h"
+#include "duet/partner/jitter_meter.h"
 #include "duet/partner/one_euro_filter.h"
 #include "duet/partner/response_playhead.h"
 #include "duet/partner/smoothing.h"
@@ -140,6 +141,14 @@ struct PartnerParams {
   // 11 Hz, about 15 ms of lag. Measured (docs/evaluation.md, partner metrics): toe speed near the
   // ground 86 -> 58 cm/s on `improv-30hz-noisy`, 29 -> 31 cm/s on noise-free `improv-pause`.
   OneEuroParams user_filter;
+  // smooth: under a noisy sensor the facing's jitter inflates the 1-euro filter's speed estimate,
+  // and with it the cutoff, so the noise passes into the partner's hips (issue 11). The facing's
+  // jitter is measured (jitter_meter.h, on its yaw) and the facing filter's beta divided by
+  // 1 + (jitter / user_facing_jitter_reference_rad)^2: a clean capture's facing jitters by
+  // 0.001-0.005 rad and keeps its responsiveness (beta 9.4-10), one with 4 degrees per axis of
+  // noise by about 0.04 rad and is smoothed hard (beta 2). 0: no adaptation. Measured in
+  // docs/evaluation.md ("Partner steadiness").
+  double user_facing_jitter_reference_rad = 0.02;
   // smooth: the correction the contact IK adds to the captured arm (per arm joint, the rotation
   // from the captured local rotation to the IK's, as a rotation vector) goes through a 1-euro
   // filter: 1 Hz still, +1 Hz per rad/s the correction changes at. The IK otherwise carries every
@@ -270,6 +279,11 @@ class PartnerContext {
   // facing direction (a unit horizontal vector, so the yaw never wraps).
   OneEuroFilter3 user_root_filter_;
   OneEuroFilter3 user_facing_filter_;
+  // The jitter (radians) of the user's raw facing yaw, after adding this frame's facing.
+  double facing_jitter(const Vec3& facing, double dt) noexcept;
+  JitterMeter user_facing_jitter_;  // of the raw facing's yaw, radians
+  double user_facing_yaw_ = 0.0;    // the raw facing's yaw, unwrapped
+  bool user_facing_yaw_valid_ = false;
   // Per response hand, per arm joint (shoulder, elbow): the IK's correction (smooth).
   std::array<std::array<OneEuroFilter3, 2>, 2> ik_correction_filter_;
   std::array<std::array<Vec3, 2>, 2> ik_correction_{};  // their outputs last frame

@@ -8,7 +8,7 @@
 // starts on the estimate. The pose is then sampled at that real frame (Clip::sample).
 #pragma once
 
-#include <cmath>
+#include "duet/partner/jitter_meter.h"
 
 namespace duet {
 
@@ -40,7 +40,7 @@ class ResponsePlayhead {
   // A new performance: also forgets the measured jitter (a jump keeps it: it is the sensor's).
   void reset() noexcept {
     primed_ = false;
-    jitter_ms_ = 0.0;
+    jitter_.reset();
   }
   // estimate: the follower's frame; restart: a jump or another take (start on the estimate);
   // tempo: template frames per template frame of input time (non-finite or <= 0: 1); dt_s: time
@@ -51,15 +51,12 @@ class ResponsePlayhead {
                  const PlayheadParams& params) noexcept;
   double position() const noexcept { return position_; }
   // The estimate's jitter RMS (frames) the band is widened by.
-  double jitter_frames() const noexcept { return std::sqrt(jitter_ms_); }
+  double jitter_frames() const noexcept { return jitter_.rms(); }
 
  private:
   bool primed_ = false;
   double position_ = 0.0;
-  double jitter_ms_ = 0.0;  // mean square of the estimate's jitter, frames^2
-  double previous_estimate_ = 0.0;
-  double before_previous_ = 0.0;
-  int history_ = 0;  // estimates since the last restart (at most 2 counted)
+  JitterMeter jitter_;  // of the estimate, in frames
 };
 
 }  // namespace duet
