@@ -43,14 +43,15 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
   // two in the direction of motion: it teaches nothing either. The distance test is the
   // session's own, not the tracker's lost flag: the HMM's noise-scaled lost level is below it on
   // a clean sensor, and learning from fewer frames cost 0.3 points at 0.7x tempo.
-  const bool stepped_back = previous_state_ >= 0 && result.state < previous_state_ &&
-                            library_->model().take_of(previous_state_) == result.take;
+  const bool same_take =
+      previous_state_ >= 0 && library_->model().take_of(previous_state_) == result.take;
+  const bool stepped_back = same_take && result.state < previous_state_;
   // A far move the follower does not call a jump (the first placement being refined) says the
   // previous frames' match was elsewhere: the frame teaches nothing either.
   constexpr int kFarFrames = 12;
-  const bool moved_unreported = previous_state_ >= 0 && !result.jumped &&
-                                (library_->model().take_of(previous_state_) != result.take ||
-                                 std::abs(result.state - previous_state_) > kFarFrames);
+  const bool moved_unreported =
+      previous_state_ >= 0 && !result.jumped &&
+      (!same_take || std::abs(result.state - previous_state_) > kFarFrames);
   previous_state_ = result.state;
   if (!result.jumped && !stepped_back && !moved_unreported && !result.missing && !result.in_pause &&
       result.best_distance_per_dim <= bias_.params().max_learn_distance_per_dim &&

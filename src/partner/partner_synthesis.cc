@@ -12,6 +12,40 @@
 namespace duet {
 namespace {
 
+// A two-bone chain of the pose (shoulder, elbow, wrist or hip, knee, ankle): its joints and their
+// world frames, as IkTwoBoneJob takes them.
+struct TwoBoneChain {
+  std::size_t start, mid, end;
+  Transform start_ws, mid_ws, end_ws;
+};
+
+TwoBoneChain chain_of(const JointRoles& roles, Role start, Role mid, Role end,
+                      std::span<const Vec3> positions_ws, std::span<const Quat> rotations_ws) {
+  const auto s = static_cast<std::size_t>(roles[start]);
+  const auto m = static_cast<std::size_t>(roles[mid]);
+  const auto e = static_cast<std::size_t>(roles[end]);
+  return {s,
+          m,
+          e,
+          {rotations_ws[s], positions_ws[s]},
+          {rotations_ws[m], positions_ws[m]},
+          {rotations_ws[e], positions_ws[e]}};
+}
+
+// The IK job for `chain` from these local rotations of its first two joints towards target_ws;
+// the caller sets the weight and the outputs. The chain and rotations must outlive the job.
+IkTwoBoneJob chain_job(const TwoBoneChain& chain, const Quat& start_ls, const Quat& mid_ls,
+                       const Vec3& target_ws) {
+  IkTwoBoneJob ik;
+  ik.start_joint_ws = &chain.start_ws;
+  ik.mid_joint_ws = &chain.mid_ws;
+  ik.end_joint_ws = &chain.end_ws;
+  ik.start_rotation_ls = &start_ls;
+  ik.mid_rotation_ls = &mid_ls;
+  ik.target_ws = target_ws;
+  return ik;
+}
+
 struct ArmRoles {
   Role shoulder, elbow, wrist;
 };
@@ -602,22 +636,12 @@ bool PartnerSynthesisJob::run() const noexcept {
       ctx.ik_raw_target_[r] = raw_target;
       ctx.ik_shown_target_[r] = target;
       const ArmRoles& arm = kArms[r];
-      const auto js = static_cast<std::size_t>(roles[arm.shoulder]);
-      const auto jm = static_cast<std::size_t>(roles[arm.elbow]);
-      const auto je = static_cast<std::size_t>(roles[arm.wrist]);
-      const Transform start{ctx.rotations_ws_[js], ctx.positions_ws_[js]};
-      const Transform mid{ctx.rotations_ws_[jm], ctx.positions_ws_[jm]};
-      const Transform end{ctx.rotations_ws_[je], ctx.positions_ws_[je]};
-      const Quat captured_start = out_r[js], captured_mid = out_r[jm];
+      const TwoBoneChain chain =
+          chain_of(roles, arm.shoulder, arm.elbow, arm.wrist, ctx.positions_ws_, ctx.rotations_ws_);
+      const Quat captured_start = out_r[chain.start], captured_mid = out_r[chain.mid];
       Quat ik_start = captured_start, ik_mid = captured_mid;
       Vec3 reached_at = Vec3::Zero();
-      IkTwoBoneJob ik;
-      ik.start_joint_ws = &start;
-      ik.mid_joint_ws = &mid;
-      ik.end_joint_ws = &end;
-      ik.start_rotation_ls = &captured_start;
-      ik.mid_rotation_ls = &captured_mid;
-      ik.target_ws = target;
+      IkTwoBoneJob ik = chain_job(chain, captured_start, captured_mid, target);
       ik.weight = weight;
       ik.start_rotation_ls_out = &ik_start;
       ik.mid_rotation_ls_out = &ik_mid;
@@ -647,11 +671,11 @@ bool PartnerSynthesisJob::run() const noexcept {
         const Vec3 mid_correction = correct(1, captured_mid, ik_mid);
         ik_start = (captured_start * exp_map(start_correction)).normalized();
         ik_mid = (captured_mid * exp_map(mid_correction)).normalized();
-        reached_at =
-            arm_end_position(start, mid, end, captured_start, captured_mid, ik_start, ik_mid);
+        reached_at = arm_end_position(chain.start_ws, chain.mid_ws, chain.end_ws, captured_start,
+                                      captured_mid, ik_start, ik_mid);
       }
-      out_r[js] = ik_start;
-      out_r[jm] = ik_mid;
+      out_r[chain.start] = ik_start;
+      out_r[chain.mid] = ik_mid;
       diagnostics.ik_weight[r] = weight;
       diagnostics.ik_target_ws[r] = target;
       diagnostics.ik_error_m[r] = (reached_at - target).norm();
@@ -732,22 +756,12 @@ bool PartnerSynthesisJob::run() const noexcept {
       const FootHoldTarget& target = ctx.foot_hold_.target(static_cast<int>(side));
       if (!target.active) continue;
       const LegRoles& leg = kLegs[side];
-      const auto jh = static_cast<std::size_t>(roles[leg.hip]);
-      const auto jk = static_cast<std::size_t>(roles[leg.knee]);
-      const auto ja = static_cast<std::size_t>(roles[leg.ankle]);
-      const Transform start{ctx.rotations_ws_[jh], ctx.positions_ws_[jh]};
-      const Transform mid{ctx.rotations_ws_[jk], ctx.positions_ws_[jk]};
-      const Transform end{ctx.rotations_ws_[ja], ctx.positions_ws_[ja]};
-      const Quat hip_before = out_r[jh], knee_before = out_r[jk];
-      IkTwoBoneJob ik;
-      ik.start_joint_ws = &start;
-      ik.mid_joint_ws = &mid;
-      ik.end_joint_ws = &end;
-      ik.start_rotation_ls = &hip_before;
-      ik.mid_rotation_ls = &knee_before;
-      ik.target_ws = target.position_ws;
-      ik.start_rotation_ls_out = &out_r[jh];
-      ik.mid_rotation_ls_out = &out_r[jk];
+      const TwoBoneChain chain =
+          chain_of(roles, leg.hip, leg.knee, leg.ankle, ctx.positions_ws_, ctx.rotations_ws_);
+      const Quat hip_before = out_r[chain.start], knee_before = out_r[chain.mid];
+      IkTwoBoneJob ik = chain_job(chain, hip_before, knee_before, target.position_ws);
+      ik.start_rotation_ls_out = &out_r[chain.start];
+      ik.mid_rotation_ls_out = &out_r[chain.mid];
       any = ik.run() || any;
     }
     if (any) {
