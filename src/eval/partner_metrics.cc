@@ -234,6 +234,7 @@ void PartnerMetricsAccumulator::add(const Performance& performance,
     for (int pair = 0; pair < kHandPairCount; ++pair) {
       if ((r.hand_pairs & (1u << pair)) != 0) {
         hand_errors_m_.push_back(r.hand_error_m[static_cast<std::size_t>(pair)]);
+        sensed_hand_errors_m_.push_back(r.sensed_hand_error_m[static_cast<std::size_t>(pair)]);
       }
     }
     if (r.jerk_mps3 >= 0.0) {
@@ -257,9 +258,8 @@ void PartnerMetricsAccumulator::add(const Performance& performance,
   // Rejoined at frame f: hands and spacing within the tolerance from f for rejoin_hold_s (or to
   // the end of the performance).
   const auto rejoined_from = [&](std::size_t f) {
-    for (std::size_t g = f; g < n && performance.times_s[g] < performance.times_s[f] +
-                                                                   options_.rejoin_hold_s;
-         ++g) {
+    for (std::size_t g = f;
+         g < n && performance.times_s[g] < performance.times_s[f] + options_.rejoin_hold_s; ++g) {
       if (!records[g].hands_joined || records[g].spacing_error_m > options_.rejoin_tolerance_m) {
         return false;
       }
@@ -330,6 +330,8 @@ void PartnerMetricsAccumulator::merge(const PartnerMetricsAccumulator& other) {
   true_jerk_frames_ += other.true_jerk_frames_;
   hand_errors_m_.insert(hand_errors_m_.end(), other.hand_errors_m_.begin(),
                         other.hand_errors_m_.end());
+  sensed_hand_errors_m_.insert(sensed_hand_errors_m_.end(), other.sensed_hand_errors_m_.begin(),
+                               other.sensed_hand_errors_m_.end());
   jump_max_rad_s_.insert(jump_max_rad_s_.end(), other.jump_max_rad_s_.begin(),
                          other.jump_max_rad_s_.end());
   jump_true_max_rad_s_.insert(jump_true_max_rad_s_.end(), other.jump_true_max_rad_s_.begin(),
@@ -361,6 +363,7 @@ PartnerMetrics PartnerMetricsAccumulator::summary() const {
   m.hand_samples = static_cast<long long>(hand_errors_m_.size());
   if (!hand_errors_m_.empty()) {
     m.median_hand_error_cm = 100.0 * median(hand_errors_m_);
+    m.median_sensed_hand_error_cm = 100.0 * median(sensed_hand_errors_m_);
     double sum = 0.0;
     for (const double e : hand_errors_m_) sum += e;
     m.mean_hand_error_cm = 100.0 * sum / static_cast<double>(hand_errors_m_.size());
@@ -415,8 +418,8 @@ PartnerMetrics PartnerMetricsAccumulator::summary() const {
     m.median_spacing_error_cm = 100.0 * median(jump_spacing_m_);
     m.max_spacing_error_cm = 100.0 * *std::ranges::max_element(jump_spacing_m_);
     m.max_jump_slide_mps = *std::ranges::max_element(jump_slide_mps_);
-    m.jumps_sliding = std::ranges::count_if(
-        jump_slide_mps_, [&](double s) { return s > options_.slide_limit_mps; });
+    m.jumps_sliding = std::ranges::count_if(jump_slide_mps_,
+                                            [&](double s) { return s > options_.slide_limit_mps; });
   }
   m.frame_speed_deg_s = rad_to_deg(quantile(frame_max_rad_s_, options_.reference_percentile));
   m.captured_frame_speed_deg_s =

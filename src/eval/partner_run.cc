@@ -1,7 +1,5 @@
 #include "duet/eval/partner_run.h"
 
-#include "duet/partner/alignment.h"
-
 #include <algorithm>
 #include <cassert>
 #include <chrono>
@@ -9,6 +7,7 @@
 #include <map>
 
 #include "duet/live/live_loop.h"
+#include "duet/partner/alignment.h"
 
 namespace duet {
 
@@ -180,10 +179,9 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
       CapturedDuetSampler& sampler = samplers.at(truth.take);
       const Transform user_heading = body_heading_frame(out.user_positions_ws, performance.roles);
       sampler.compute(truth.template_frame, user_heading);
-      r.spacing_error_m =
-          std::abs(horizontal_distance_m(out.partner_positions_ws[0], user_heading.translation) -
-                   horizontal_distance_m(sampler.placed_positions_ws()[0],
-                                         user_heading.translation));
+      r.spacing_error_m = std::abs(
+          horizontal_distance_m(out.partner_positions_ws[0], user_heading.translation) -
+          horizontal_distance_m(sampler.placed_positions_ws()[0], user_heading.translation));
       r.joint_error_m =
           mean_joint_distance_m(out.partner_positions_ws, sampler.placed_positions_ws());
 
@@ -197,11 +195,17 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
         const int pw = partner_roles[kWrists[static_cast<std::size_t>(response_side(pair))]];
         const int uw = performance.roles[kWrists[static_cast<std::size_t>(template_side(pair))]];
         if (pw < 0 || uw < 0) continue;
-        const double output = (out.partner_positions_ws[static_cast<std::size_t>(pw)] -
-                               out.user_positions_ws[static_cast<std::size_t>(uw)])
-                                  .norm();
+        const Vec3& partner_wrist = out.partner_positions_ws[static_cast<std::size_t>(pw)];
+        const Vec3& sensed_wrist = out.user_positions_ws[static_cast<std::size_t>(uw)];
+        const Vec3& real_wrist =
+            performance.true_wrists_ws.empty()
+                ? sensed_wrist
+                : performance.true_wrists_ws[fs][static_cast<std::size_t>(template_side(pair))];
+        const double captured = sampler.captured_wrist_distance_m(pair);
         r.hand_error_m[static_cast<std::size_t>(pair)] =
-            std::abs(output - sampler.captured_wrist_distance_m(pair));
+            std::abs((partner_wrist - real_wrist).norm() - captured);
+        r.sensed_hand_error_m[static_cast<std::size_t>(pair)] =
+            std::abs((partner_wrist - sensed_wrist).norm() - captured);
         r.hand_pairs |= static_cast<std::uint8_t>(1u << pair);
         r.hands_joined = r.hands_joined && r.hand_error_m[static_cast<std::size_t>(pair)] <=
                                                options.rejoin_tolerance_m;

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "duet/math/rotation.h"
+#include "duet/motion/forward_kinematics.h"
 #include "duet/motion/head_hands.h"
 #include "duet/motion/limits.h"
 #include "duet/motion/retarget.h"
@@ -337,6 +338,25 @@ Result<Performance> improvise(std::span<const SourceTake> sources,
                         {options.sway_m, options.sway_deg});
 }
 
+void record_true_wrists(Performance& performance) {
+  const Clip& motion = performance.motion;
+  const Skeleton& skeleton = motion.skeleton();
+  const auto joints = static_cast<std::size_t>(skeleton.joint_count());
+  const int left = performance.roles[Role::kLeftWrist],
+            right = performance.roles[Role::kRightWrist];
+  performance.true_wrists_ws.clear();
+  if (left < 0 || right < 0) return;
+  std::vector<Vec3> positions(joints);
+  std::vector<Quat> rotations(joints);
+  performance.true_wrists_ws.reserve(static_cast<std::size_t>(motion.frame_count()));
+  for (int f = 0; f < motion.frame_count(); ++f) {
+    forward_kinematics(skeleton, motion.translations_ls(f), motion.rotations_ls(f), positions,
+                       rotations);
+    performance.true_wrists_ws.push_back(
+        {positions[static_cast<std::size_t>(left)], positions[static_cast<std::size_t>(right)]});
+  }
+}
+
 Performance with_sensor_noise(Performance performance, const SensorNoiseOptions& options) {
   Rng rng(derive_seed(options.seed, 3));
   // RMS angle of a rotation vector with three N(0, s^2) components is s * sqrt(3).
@@ -425,6 +445,9 @@ Performance with_frame_loss(Performance performance, const FrameLossOptions& opt
       continue;
     }
     const int o = static_cast<int>(next_kept++);
+    // A repeated frame is the sensor sending its last frame again; the real wrists moved on.
+    if (!performance.true_wrists_ws.empty())
+      out.true_wrists_ws.push_back(performance.true_wrists_ws[ks]);
     // Drawn only when asked for: performances without repeats stay what they were.
     const bool repeat =
         options.repeat_fraction > 0.0 && o > 0 && uniform(rng, 0.0, 1.0) < options.repeat_fraction;
@@ -515,6 +538,7 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     if (!moved) return moved.error();
     performance = std::move(moved).value();
   }
+  if (recipe.noise.active() || recipe.head_hands) record_true_wrists(performance);
   if (recipe.noise.active()) {
     SensorNoiseOptions options = recipe.noise;
     options.seed = derive_seed(seed, 12);

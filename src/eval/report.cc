@@ -102,15 +102,15 @@ void append_steadiness_table(std::string& out, const EvalReport& report) {
   const PartnerMetricsOptions& o = report.partner_options;
   out += "\npartner steadiness and transitions after jumps (issue 11; docs/evaluation.md):\n";
   constexpr const char* kHeader =
-      "{:<18} {:<12} {:>8} {:>8} {:>6} {:>8} {:>7} {:>8} {:>8} {:>7} {:>8} {:>8} {:>8} {:>6} "
-      "{:>8} {:>7}\n";
+      "{:<18} {:<12} {:>8} {:>8} {:>6} {:>8} {:>8} {:>7} {:>8} {:>8} {:>7} {:>8} {:>8} {:>8} "
+      "{:>6} {:>8} {:>7}\n";
   fmt::format_to(std::back_inserter(out), kHeader, "case", "corrections", "speed", "captured",
-                 "ratio", "hand med", ">win99", "rejoin", "rejoin", "in time", "spacing",
+                 "ratio", "hand med", "sensed", ">win99", "rejoin", "rejoin", "in time", "spacing",
                  "spacing", "slide", ">limit", "slide", ">limit");
   fmt::format_to(std::back_inserter(out), kHeader, "", "",
-                 fmt::format("p{:g}", 100.0 * o.reference_percentile), "deg/s", "", "cm", "jumps",
-                 "med s", "max s", "jumps", "med cm", "max cm", "jump m/s", "jumps", "all m/s",
-                 "frames");
+                 fmt::format("p{:g}", 100.0 * o.reference_percentile), "deg/s", "", "cm", "cm",
+                 "jumps", "med s", "max s", "jumps", "med cm", "max cm", "jump m/s", "jumps",
+                 "all m/s", "frames");
   for (const PartnerRow& row : report.partner_rows) {
     const PartnerMetrics& m = row.metrics;
     const bool hands = row.aligned && m.hand_samples > 0;
@@ -123,12 +123,13 @@ void append_steadiness_table(std::string& out, const EvalReport& report) {
         partner_cell(m.captured_frame_speed_deg_s > 0.0,
                      m.frame_speed_deg_s / std::max(m.captured_frame_speed_deg_s, 1e-9), 2),
         partner_cell(hands, m.median_hand_error_cm, 2),
+        partner_cell(hands, m.median_sensed_hand_error_cm, 2),
         jumps ? fmt::format("{}/{}", m.jumps_over_window_reference, m.jumps) : "-",
-        placed ? seconds_cell(m.median_rejoin_s) : "-",
-        placed ? seconds_cell(m.max_rejoin_s) : "-",
+        placed ? seconds_cell(m.median_rejoin_s) : "-", placed ? seconds_cell(m.max_rejoin_s) : "-",
         placed ? fmt::format("{}/{}", m.jumps_rejoined_in_time, m.jumps) : "-",
         partner_cell(placed, m.median_spacing_error_cm, 1),
-        partner_cell(placed, m.max_spacing_error_cm, 1), partner_cell(jumps, m.max_jump_slide_mps, 2),
+        partner_cell(placed, m.max_spacing_error_cm, 1),
+        partner_cell(jumps, m.max_jump_slide_mps, 2),
         jumps ? fmt::format("{}/{}", m.jumps_sliding, m.jumps) : "-",
         fmt::format("{:.2f}", m.max_slide_mps), m.sliding_frames);
   }
@@ -140,6 +141,9 @@ void append_steadiness_table(std::string& out, const EvalReport& report) {
        fmt::format("p{:g} of the per-frame largest joint angular speed: the partner's, the "
                    "captured partner's over the same takes; ratio = speed / captured",
                    100.0 * o.reference_percentile));
+  line("hand med, sensed",
+       "median over contact frames of |partner wrist to user wrist - captured|, the user's real "
+       "wrist (before the sensor's noise) and the wrist the sensor reports");
   line("rejoin s", fmt::format("after each true jump, until the held hands are within {:g} cm of "
                                "the captured grip and the spacing within {:g} cm of the true "
                                "response's, for {:g} s (never: not within {:g} s)",
@@ -226,7 +230,7 @@ void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::
                  "{},{},{},{},{},{},{:.4f},{},{:.4f},{:.4f},{:.5f},{:.5f},{:.3f},{:.3f},{},{:.2f},"
                  "{:.2f},{},"
                  "{:.2f},{},{:.2f},{:.5f},{:.3f},{:.2f},{:.2f},{},{},{:.2f},{:.2f},{:.2f},{:.2f},"
-                 "{:.3f},{:.3f},{},{:.2f},{:.2f},{:.3f},{},{:.3f},{}\n",
+                 "{:.3f},{:.3f},{},{:.2f},{:.2f},{:.3f},{},{:.3f},{},{:.4f}\n",
                  row.case_name, row.config, take, take_name, row.aligned ? 1 : 0, m.frames,
                  m.mean_joint_error_cm, m.hand_samples, m.median_hand_error_cm,
                  m.mean_hand_error_cm, m.slip_rate, m.captured_slip_rate, m.ground_speed_cm_s,
@@ -238,7 +242,8 @@ void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::
                  m.mean_jerk_mps3, m.true_mean_jerk_mps3, m.frame_speed_deg_s,
                  m.captured_frame_speed_deg_s, m.median_rejoin_s, m.max_rejoin_s,
                  m.jumps_rejoined_in_time, m.median_spacing_error_cm, m.max_spacing_error_cm,
-                 m.max_jump_slide_mps, m.jumps_sliding, m.max_slide_mps, m.sliding_frames);
+                 m.max_jump_slide_mps, m.jumps_sliding, m.max_slide_mps, m.sliding_frames,
+                 m.median_sensed_hand_error_cm);
 }
 
 // reliability.dat and its plot: per case, the 10 confidence bins of the first tracker (hmm when
@@ -262,8 +267,8 @@ void append_reliability_plot(const EvalReport& report, const std::vector<std::st
                      bin.accuracy, bin.frames);
     }
     data += "\n\n";
-    titles.push_back(fmt::format("{} (ECE {:.1f}%)", row.case_name,
-                                 100.0 * row.metrics.confidence_ece));
+    titles.push_back(
+        fmt::format("{} (ECE {:.1f}%)", row.case_name, 100.0 * row.metrics.confidence_ece));
   }
   files.push_back({"reliability.dat", data});
   script += fmt::format(
@@ -302,7 +307,7 @@ std::string format_partner_csv(const EvalReport& report) {
       "jumps_over_window_reference,jumps_over_window_reference_and_truth,mean_jerk_mps3,"
       "true_mean_jerk_mps3,frame_speed_deg_s,captured_frame_speed_deg_s,median_rejoin_s,"
       "max_rejoin_s,jumps_rejoined_in_time,median_spacing_error_cm,max_spacing_error_cm,"
-      "max_jump_slide_mps,jumps_sliding,max_slide_mps,sliding_frames\n";
+      "max_jump_slide_mps,jumps_sliding,max_slide_mps,sliding_frames,median_sensed_hand_error_cm\n";
   for (const PartnerRow& row : report.partner_rows) {
     for (const auto& [take, metrics] : row.per_take) {
       append_partner_csv_row(out, row, std::to_string(take), take_name(report, take), metrics);
@@ -378,8 +383,9 @@ std::string format_frames_csv(const EvalReport& report) {
   for (const EvalRow& row : report.rows) {
     for (const ScoredFrame& f : row.frames) {
       const FrameEstimate& e = f.estimate;
-      fmt::format_to(std::back_inserter(out), "{},{},{},{:.1f},{:.5f},{:.5f},{:.6f},{:.7f},{},{},{}\n",
-                     row.case_name, row.tracker, f.take, f.error_ms, e.confidence, e.window_mass,
+      fmt::format_to(std::back_inserter(out),
+                     "{},{},{},{:.1f},{:.5f},{:.5f},{:.6f},{:.7f},{},{},{}\n", row.case_name,
+                     row.tracker, f.take, f.error_ms, e.confidence, e.window_mass,
                      e.best_distance_per_dim, e.sensor_noise_per_dim, e.lost ? 1 : 0,
                      e.in_pause ? 1 : 0, e.jumped ? 1 : 0);
     }

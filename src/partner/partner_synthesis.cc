@@ -291,10 +291,14 @@ std::string PartnerParams::validate() const {
   if (const std::string_view problem = user_filter.validate(); !problem.empty()) {
     return "user_filter: " + std::string(problem);
   }
-  if (!(user_facing_jitter_reference_rad >= 0.0) ||
-      !std::isfinite(user_facing_jitter_reference_rad)) {
-    return "user_facing_jitter_reference_rad must be finite and >= 0 (0: no adaptation; got " +
-           std::to_string(user_facing_jitter_reference_rad) + ")";
+  const std::pair<const char*, double> references[] = {
+      {"user_facing_jitter_reference_rad", user_facing_jitter_reference_rad},
+      {"ik_target_jitter_reference_m", ik_target_jitter_reference_m}};
+  for (const auto& [name, value] : references) {
+    if (!(value >= 0.0) || !std::isfinite(value)) {
+      return std::string(name) + " must be finite and >= 0 (0: no adaptation; got " +
+             std::to_string(value) + ")";
+    }
   }
   if (const std::string_view problem = ik_correction_filter.validate(); !problem.empty()) {
     return "ik_correction_filter: " + std::string(problem);
@@ -414,6 +418,20 @@ double PartnerContext::facing_jitter(const Vec3& facing, double dt) noexcept {
   return user_facing_jitter_.rms();
 }
 
+double PartnerContext::ik_target_jitter(std::size_t hand, const Vec3& target, double dt,
+                                        bool restart) noexcept {
+  // A second difference over 0.3 m in a frame is the target moving on, not jitter.
+  constexpr double kJitterTimeConstantS = 1.0, kMoveM = 0.3;
+  double variance = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    JitterMeter& meter = ik_target_jitter_[hand][static_cast<std::size_t>(axis)];
+    if (restart) meter.restart();
+    meter.add(target[axis], dt, kJitterTimeConstantS, kMoveM);
+    variance += meter.rms() * meter.rms();
+  }
+  return std::sqrt(variance);
+}
+
 void PartnerContext::reset() noexcept {
   primed_ = false;
   inertializer_.reset();
@@ -425,6 +443,9 @@ void PartnerContext::reset() noexcept {
   user_facing_filter_.reset();
   user_facing_jitter_.reset();
   user_facing_yaw_valid_ = false;
+  for (auto& hand : ik_target_jitter_) {
+    for (JitterMeter& meter : hand) meter.reset();
+  }
   for (auto& arm : ik_correction_filter_) {
     for (OneEuroFilter3& filter : arm) filter.reset();
   }
@@ -631,6 +652,8 @@ bool PartnerSynthesisJob::run() const noexcept {
         ctx.ik_target_offset_[r] = Vec3::Zero();
         ctx.ik_target_offset_velocity_[r] = Vec3::Zero();
       }
+      const double target_jitter =
+          ctx.ik_target_jitter(r, raw_target, dt, jumped || ctx.ik_pair_[r] != previous_pair);
       const Vec3 target = raw_target + ctx.ik_target_offset_[r];
       ctx.ik_target_valid_[r] = true;
       ctx.ik_raw_target_[r] = raw_target;
@@ -655,12 +678,32 @@ bool PartnerSynthesisJob::run() const noexcept {
         // The correction (captured -> IK, in the joint's own frame) through the 1-euro filter,
         // then put back on the captured rotation; the wrist lands where that arm reaches.
         // At most ik_correction_max_speed_rad_s: the IK adds at most that to a joint's speed.
+        // Under a jittering target, smoothed harder (PartnerParams::ik_target_jitter_reference_m).
+        OneEuroParams filter_params = p.ik_correction_filter;
+        double max_speed = p.ik_correction_max_speed_rad_s;
+        if (p.ik_target_jitter_reference_m > 0.0) {
+          const double ratio = target_jitter / p.ik_target_jitter_reference_m;
+          const double calm = 1.0 / (1.0 + ratio * ratio * ratio * ratio);
+          filter_params.min_cutoff_hz *= calm;
+          filter_params.beta *= calm;
+          max_speed *= calm;
+        }
+        // A restarted filter holds its first sample, noise and all, for as long as its time
+        // constant: until then the cutoff is at least 1 / (2 pi t), t seconds after the restart,
+        // which makes it the running mean of what it has seen.
+        double& age = ctx.ik_correction_age_s_[r];
+        age = filters[0].primed() ? age + dt : 0.0;
+        filter_params.min_cutoff_hz =
+            std::max(filter_params.min_cutoff_hz, 1.0 / (2.0 * kPi * std::max(age, dt)));
         std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
         const auto correct = [&](std::size_t k, const Quat& captured, const Quat& solved) {
+          if (!filters[k].primed()) {  // from no correction: a first sample may be all noise
+            filters[k].filter(Vec3::Zero(), 0.0, filter_params);
+            shown[k] = Vec3::Zero();
+          }
           const bool primed = filters[k].primed();
-          Vec3 c =
-              filters[k].filter(log_map(captured.conjugate() * solved), dt, p.ik_correction_filter);
-          const double most = p.ik_correction_max_speed_rad_s * dt;
+          Vec3 c = filters[k].filter(log_map(captured.conjugate() * solved), dt, filter_params);
+          const double most = max_speed * dt;
           if (primed && (c - shown[k]).norm() > most) {
             c = shown[k] + (c - shown[k]) * (most / (c - shown[k]).norm());
           }

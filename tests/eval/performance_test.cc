@@ -1,14 +1,15 @@
 #include "duet/eval/performance.h"
-#include "duet/eval/runner.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 
+#include "duet/eval/runner.h"
 #include "duet/features/feature_extractor.h"
 #include "duet/io/motion_file.h"
 #include "duet/math/rotation.h"
+#include "duet/motion/forward_kinematics.h"
 #include "features/synthetic_dancer.h"
 
 namespace duet {
@@ -395,8 +396,9 @@ TEST(EvalCases, HarshCaseAndNoiseSweepHaveIssue11sMagnitudes) {
   CaseSettings gentle;
   gentle.noise_rotation_deg = 0.5;
   const std::vector<EvalCase> other = standard_cases(gentle);
-  EXPECT_EQ(std::ranges::find(other, std::string("harsh"), &EvalCase::name)->recipe.noise.rotation_deg,
-            harsh->recipe.noise.rotation_deg);
+  EXPECT_EQ(
+      std::ranges::find(other, std::string("harsh"), &EvalCase::name)->recipe.noise.rotation_deg,
+      harsh->recipe.noise.rotation_deg);
 
   const std::vector<EvalCase> sweep = noise_sweep_cases();
   ASSERT_EQ(sweep.size(), 6u);
@@ -454,6 +456,56 @@ TEST(MakePerformance, ComposesImprovisationNoiseAndALowRate) {
   Result<Performance> again = make_performance(std::span(&source, 1), recipe, 42);
   ASSERT_TRUE(again);
   EXPECT_EQ(again.value().times_s, p.value().times_s);
+}
+
+TEST(MakePerformance, RecordsTheRealWristsBeforeTheNoise) {
+  // The partner metrics score the partner's hands against the user's real hands: the wrists as
+  // they were before the sensor's noise, kept in step with dropped and repeated frames.
+  const Fixture f = make_fixture(1800);
+  const SourceTake source = f.source();
+  PerformanceRecipe recipe;
+  recipe.improvise = true;
+  recipe.improvise_options = improv_options(1.0);
+  recipe.loss.drop_fraction = 0.1;
+  Result<Performance> clean = make_performance(std::span(&source, 1), recipe, 7);
+  ASSERT_TRUE(clean) << clean.error().message;
+  EXPECT_TRUE(clean.value().true_wrists_ws.empty());  // no noise: the sensed wrists are real
+
+  recipe.noise = {4.0, 0.01, 0};
+  Result<Performance> noisy = make_performance(std::span(&source, 1), recipe, 7);
+  ASSERT_TRUE(noisy) << noisy.error().message;
+  const Performance& p = noisy.value();
+  ASSERT_EQ(p.frame_count(), clean.value().frame_count());  // the same frames dropped
+  ASSERT_EQ(p.true_wrists_ws.size(), static_cast<std::size_t>(p.frame_count()));
+  const std::vector<Vec3> real = world_positions(clean.value().motion);
+  const std::vector<Vec3> sensed = world_positions(p.motion);
+  const auto joints = static_cast<std::size_t>(p.motion.joint_count());
+  double sensed_off = 0.0;
+  for (std::size_t k = 0; k < p.true_wrists_ws.size(); ++k) {
+    for (const auto& [side, role] : {std::pair{0, Role::kLeftWrist}, {1, Role::kRightWrist}}) {
+      const std::size_t at = k * joints + static_cast<std::size_t>(f.roles[role]);
+      EXPECT_LT((p.true_wrists_ws[k][static_cast<std::size_t>(side)] - real[at]).norm(), 1e-9)
+          << "frame " << k;
+      sensed_off += (sensed[at] - real[at]).norm();
+    }
+  }
+  EXPECT_GT(sensed_off / (2.0 * static_cast<double>(p.true_wrists_ws.size())), 0.01);
+
+  recipe.loss.repeat_fraction = 0.1;  // a repeated frame: the real wrist moved on
+  Result<Performance> repeated = make_performance(std::span(&source, 1), recipe, 7);
+  ASSERT_TRUE(repeated);
+  ASSERT_EQ(repeated.value().true_wrists_ws.size(),
+            static_cast<std::size_t>(repeated.value().frame_count()));
+  int moved_on = 0;
+  for (std::size_t k = 1; k < repeated.value().true_wrists_ws.size(); ++k) {
+    const bool same_pose = repeated.value().motion.rotations_ls(static_cast<int>(k))[1].isApprox(
+        repeated.value().motion.rotations_ls(static_cast<int>(k) - 1)[1], 0.0);
+    if (same_pose &&
+        repeated.value().true_wrists_ws[k][0] != repeated.value().true_wrists_ws[k - 1][0]) {
+      ++moved_on;
+    }
+  }
+  EXPECT_GT(moved_on, 0);
 }
 
 TEST(Improvise, RealTakeKeepsTheRootPathContinuous) {

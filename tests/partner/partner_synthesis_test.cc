@@ -294,7 +294,9 @@ TEST(PartnerSynthesis, SmoothFiltersTheContactTargetsJitter) {
       ASSERT_TRUE(now.allFinite());
     }
     settled[smooth ? 0 : 1] = previous;
-    EXPECT_LT(run.info.ik_error_m[1], 1e-6);
+    // Within a tenth of a millimetre: the measured jitter fades over about a second, and the
+    // filter, smoothing hard until then, is still converging.
+    EXPECT_LT(run.info.ik_error_m[1], 1e-4);
   }
   EXPECT_GT(path[1], 1.0);  // ~1.6 cm per frame unfiltered
   EXPECT_LT(path[0], 0.5 * path[1]);
@@ -335,6 +337,43 @@ TEST(PartnerSynthesis, TheIkAddsAtMostItsSpeedLimitToTheArmUnderJitter) {
   // The standing pose's own smoothing adds nothing (it does not move); 1e-6 for rounding.
   EXPECT_LE(largest[0], 4.0 * dt + 1e-6);
   EXPECT_GT(largest[1], 2.0 * largest[0]);
+}
+
+TEST(PartnerSynthesis, AHeavilyJitteringWristLeavesTheHandAtTheRealOne) {
+  // Hands held throughout, standing; the sensor puts the user's wrist 4 cm per axis off its real
+  // place every frame at 30 Hz (4 degrees per joint and axis do that to a salsa dancer's wrist).
+  // The target's jitter is measured and the IK's correction all but frozen: the partner's hand
+  // stays near where it is with a clean sensor. Without the adaptation it wanders with the noise.
+  const Vec3 grip(0.0, 0.0, 0.04);
+  Duet duet(240, 0, 240, grip);
+  const std::size_t wrist = duet.wrist(Role::kRightWrist);
+  const double dt = 1.0 / 30.0;
+  const auto run_with = [&](double reference_m, double noise_m) {
+    PartnerParams params = only(true, true, true, false, false);
+    params.ik_target_jitter_reference_m = reference_m;
+    Runner run(duet.model, params);
+    std::mt19937 rng(11);
+    std::normal_distribution<double> jitter(0.0, noise_m);
+    std::vector<Vec3> hands;
+    for (int f = 0; f < 120; ++f) {
+      UserPose user = user_from(duet.leader, 2 * f, duet.roles);
+      user.wrist_positions_ws[0] += Vec3(jitter(rng), jitter(rng), jitter(rng));
+      run.step(2 * f, duet.follower.translations_ls(2 * f), duet.follower.rotations_ls(2 * f), user,
+               false, dt);
+      hands.push_back(run.world().positions[wrist]);
+    }
+    return hands;
+  };
+  const std::vector<Vec3> clean = run_with(PartnerParams{}.ik_target_jitter_reference_m, 0.0);
+  const std::vector<Vec3> adapted = run_with(PartnerParams{}.ik_target_jitter_reference_m, 0.04);
+  const std::vector<Vec3> plain = run_with(0.0, 0.04);
+  double adapted_off = 0.0, plain_off = 0.0;
+  for (std::size_t f = 30; f < clean.size(); ++f) {  // after the jitter has been measured
+    adapted_off += (adapted[f] - clean[f]).norm() / 90.0;
+    plain_off += (plain[f] - clean[f]).norm() / 90.0;
+  }
+  EXPECT_LT(adapted_off, 0.015);  // measured 1.1 cm; 3.2 cm without the adaptation
+  EXPECT_GT(plain_off, 2.5 * adapted_off);
 }
 
 TEST(PartnerSynthesis, SmoothDampsJitter) {
@@ -436,7 +475,8 @@ TEST(PartnerSynthesis, BlendHidesAJump) {
     const Quat expected = duet.follower.rotations_ls(70 + 139)[shoulder];
     if (blend) {
       EXPECT_LT(largest_turn, 0.15);  // instead of 0.9 rad in one frame
-      EXPECT_LT(largest_move, 0.06);  // instead of 0.36 m
+      // Instead of 0.36 m: at most the root's blend speed.
+      EXPECT_LE(largest_move, PartnerParams{}.blend_max_root_speed_mps * kDt + 1e-9);
       EXPECT_LT(run.r[shoulder].angularDistance(expected), 1e-4);  // converged
       EXPECT_LT(run.info.blend_offset_rad, 1e-4);
     } else {
@@ -523,10 +563,11 @@ TEST(PartnerSynthesis, AJumpOutOfAContactDropsTheIkAndTheBlendTakesIt) {
     EXPECT_EQ(weights[49], 1.0);
     if (blend) {
       EXPECT_EQ(weights[50], 0.0);
-      // The 2 m move is blended: crossed at blend_max_root_speed_mps (3 m/s, 5 cm a frame) at
-      // most, where a snap would move the wrist 2 m in one frame.
-      EXPECT_LE(fastest, 3.0 * kDt + 1e-6);
-      EXPECT_GT(fastest, 0.5 * 3.0 * kDt);  // and at about that speed: no long tail
+      // The 2 m move is blended: crossed at blend_max_root_speed_mps at most, where a snap
+      // would move the wrist 2 m in one frame.
+      const double cap = PartnerParams{}.blend_max_root_speed_mps;
+      EXPECT_LE(fastest, cap * kDt + 1e-6);
+      EXPECT_GT(fastest, 0.5 * cap * kDt);  // and at about that speed: no long tail
     } else {
       EXPECT_GT(weights[50], 0.9);  // fading out
       EXPECT_GT(weights[60], 0.0);

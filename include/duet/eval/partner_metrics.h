@@ -151,8 +151,13 @@ class CapturedDuetSampler {
 // What the metrics keep of one frame of the synthesis.
 struct PartnerFrameRecord {
   double joint_error_m = 0.0;
-  // Hand error per pair, only for pairs in contact at the true template frame.
+  // Hand error per pair, only for pairs in contact at the true template frame: against the
+  // user's real wrist (Performance::true_wrists_ws, the sensed one when the sensor adds no
+  // noise), and against the wrist the sensor reports. Under a noisy sensor a partner hand that
+  // stays steady at the real hand is off the sensed one by the noise; one that chases the sensed
+  // hand shakes.
   std::array<double, kHandPairCount> hand_error_m{};
+  std::array<double, kHandPairCount> sensed_hand_error_m{};
   std::uint8_t hand_pairs = 0;  // bit p: hand_error_m[p] is set
   bool slip = false;            // a foot slipped since the previous frame (false on frame 0)
   // Horizontal speeds of the toes that stayed near the ground since the previous frame, summed,
@@ -201,11 +206,12 @@ void add_captured_reference(const Clip& response, const JointRoles& roles,
 struct PartnerMetrics {
   long long frames = 0;
   double mean_joint_error_cm = 0.0;
-  long long hand_samples = 0;  // (frame, contacting pair) samples
-  double median_hand_error_cm = 0.0;
+  long long hand_samples = 0;         // (frame, contacting pair) samples
+  double median_hand_error_cm = 0.0;  // against the real wrists (PartnerFrameRecord)
   double mean_hand_error_cm = 0.0;
-  double slip_rate = 0.0;          // slipping frames / frames from the second
-  double ground_speed_cm_s = 0.0;  // mean horizontal speed of toes near the ground
+  double median_sensed_hand_error_cm = 0.0;  // against the sensed wrists
+  double slip_rate = 0.0;                    // slipping frames / frames from the second
+  double ground_speed_cm_s = 0.0;            // mean horizontal speed of toes near the ground
   long long jumps = 0;  // true jumps whose window holds at least one frame after the first
   double max_jump_speed_deg_s = 0.0;     // largest over every jump window
   double median_jump_speed_deg_s = 0.0;  // median over jumps of each window's largest
@@ -276,13 +282,13 @@ class PartnerMetricsAccumulator {
   double joint_error_sum_m_ = 0.0, step_us_sum_ = 0.0;
   double jerk_sum_ = 0.0, true_jerk_sum_ = 0.0;
   long long jerk_frames_ = 0, true_jerk_frames_ = 0;
-  std::vector<double> hand_errors_m_;
+  std::vector<double> hand_errors_m_, sensed_hand_errors_m_;
   std::vector<double> jump_max_rad_s_;  // one per jump window
   std::vector<double> jump_true_max_rad_s_;
-  std::vector<double> frame_max_rad_s_;    // output, frames from the second
-  std::vector<double> jump_rejoin_s_;      // per jump window; infinity: not rejoined
-  std::vector<double> jump_spacing_m_;     // per jump, rejoin_deadline_s after it
-  std::vector<double> jump_slide_mps_;     // per jump, largest planted slide in the window
+  std::vector<double> frame_max_rad_s_;  // output, frames from the second
+  std::vector<double> jump_rejoin_s_;    // per jump window; infinity: not rejoined
+  std::vector<double> jump_spacing_m_;   // per jump, rejoin_deadline_s after it
+  std::vector<double> jump_slide_mps_;   // per jump, largest planted slide in the window
   double max_slide_mps_ = 0.0;
   long long sliding_frames_ = 0;
   CapturedReference reference_;

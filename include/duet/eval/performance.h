@@ -17,6 +17,7 @@
 // never on the per-frame path.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -46,6 +47,11 @@ struct Performance {
   std::vector<double> times_s;    // sensor timestamp of each frame, strictly increasing, seconds
   std::vector<TruthFrame> truth;  // one per frame
   double template_rate_hz = 0.0;  // rate of the template frames that truth refers to
+  // Where the user's wrists really are (world, Side order), one per frame: recorded before the
+  // sensor's noise is added, so the partner's hands can be scored against the real hands as
+  // well as against the sensed ones. Empty when the sensor adds no noise (the sensed wrists are
+  // the real ones).
+  std::vector<std::array<Vec3, 2>> true_wrists_ws;
 
   int frame_count() const { return motion.frame_count(); }
 };
@@ -117,6 +123,9 @@ struct SensorNoiseOptions {
   bool active() const { return rotation_deg > 0.0 || position_m > 0.0; }
 };
 Performance with_sensor_noise(Performance performance, const SensorNoiseOptions& options);
+// Records the wrists' world positions of the performance as it is now in true_wrists_ws (left
+// empty when the roles name no wrists): make_performance calls it before any noise is added.
+void record_true_wrists(Performance& performance);
 
 // A network or sensor that drops and delays frames. Frames are dropped in bursts of 1..3 (about
 // drop_fraction of all frames; the first frame is kept); late_fraction of the kept frames carry a
@@ -166,7 +175,8 @@ struct PointNoiseOptions {
 Result<Performance> with_head_hands(Performance performance, const PointNoiseOptions& noise);
 
 // A composition of the above, applied in this order: play or improvise (at rate_hz), body scale,
-// room placement, another rig, sensor noise, head and hands, frame loss. Each stage's seed is derived from `seed`.
+// room placement, another rig, sensor noise, head and hands, frame loss. Each stage's seed is
+// derived from `seed`.
 struct PerformanceRecipe {
   bool improvise = false;
   PlayOptions play;                    // when !improvise (seed ignored)
@@ -181,7 +191,7 @@ struct PerformanceRecipe {
   // Delivered as three points (head and hands) with point_noise (seed ignored).
   bool head_hands = false;
   PointNoiseOptions point_noise;
-  FrameLossOptions loss;     // seed ignored
+  FrameLossOptions loss;  // seed ignored
 };
 
 // sources[0] is the performed take (play); improvise draws from all of them. A recipe that
