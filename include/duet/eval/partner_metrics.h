@@ -7,7 +7,8 @@
 //                 by the same alignment (5.1) relative to the user's current root: compared in the
 //                 user's frame;
 //   hand error    at frames whose true template frame has a hand contact (5.2), per contacting
-//                 pair: | output wrist-to-user-wrist distance - captured wrist-to-wrist distance |;
+//                 pair: | output wrist-to-user-wrist distance - captured wrist-to-wrist distance |
+//                 (the user's real wrist, before the sensor's noise; and the sensed one);
 //   foot slip     frames in which a toe near its ground height (FootSlipThresholds, the
 //                 PartnerModel's ground heights) moves horizontally faster than a threshold
 //                 (5.3); also for the captured response over its own takes;

@@ -185,16 +185,17 @@ struct PartnerParams {
   // blend: half-life of the inertialization offset recorded at a jump, and the caps on how fast
   // an offset may change (the paper's velocity-based blending, 5.3): per joint rotation, and the
   // root's place relative to the user (e.g. from holding hands to 2 m apart; without a cap a 2 m
-  // change crossed the room at 10 m/s). 8 rad/s (458 deg/s) is below the 99th percentile of the
-  // captured salsa partners' per-frame largest joint speed (626 deg/s over the eval's takes);
+  // change crossed the room at 10 m/s). 6 rad/s (344 deg/s) is well below the 99th percentile of
+  // the captured salsa partners' per-frame largest joint speed (626 deg/s over the eval's takes);
   // 4 m/s is above their 99th percentile root speed (3.1 m/s over 61_*), as a partner that
   // jumped has ground to make up. Issue 11 (the partner back in place within 0.3 s of a jump),
   // measured with `duet eval` (docs/evaluation.md, "Partner steadiness"): from 0.1 s, 4 rad/s,
-  // 3 m/s the median time to rejoin hands and spacing on `improv` went 0.43 -> 0.22 s (jumps
-  // rejoined within 0.3 s 9 -> 17 of 23) and the mean joint error 5.6 -> 4.2 cm, for a p99
-  // largest joint speed of 1.00 -> 1.07x the captured partner's (10 rad/s: 1.12x).
+  // 3 m/s the median time to rejoin hands and spacing on `improv` went 0.43 -> 0.23 s (jumps
+  // rejoined within 0.3 s 9 -> 13 of 23) and the mean joint error 5.6 -> 4.5 cm, for a p99
+  // largest joint speed of 1.00 -> 1.02x the captured partner's. 8 rad/s rejoined 17 of 23 in
+  // time but took `noise-sweep-1` to 1.13x.
   double blend_half_life_s = 0.05;
-  double blend_max_speed_rad_s = 8.0;
+  double blend_max_speed_rad_s = 6.0;
   double blend_max_root_speed_mps = 4.0;
   // How the caps hold. true: the offsets decay with blend_half_life_s but none moves faster
   // than its cap (PoseInertializer::update's limits): a far jump crosses at the cap and arrives
