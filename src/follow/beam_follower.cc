@@ -18,17 +18,28 @@ namespace {
 // Below this the kept mass has lost too many bits to be normalised (as forward_common.cc).
 constexpr double kMinNormaliser = 1e-30;
 
-// ||phi - phi_i||^2 with the velocity part capped (as follow_detail::emission_distances).
+// ||phi - phi_i||^2 with the velocity part capped (as follow_detail::emission_distances). Read
+// from the blocked features, which the full step keeps resident anyway: the row-major ones may be
+// a memory-mapped cache's (TemplateModel::build_shared), whose pages a beam's scattered jump
+// candidates would otherwise bring in one by one (at 1M states, 150 MB in the first seconds).
 float emission_distance(const TemplateModel& model, const float* phi, int i,
                         float velocity_cap) noexcept {
-  const auto row = model.features().row(i);
-  const Eigen::Index dims = model.num_dims();
-  const Eigen::Index velocity = model.velocity_dims();
-  const Eigen::Index posture = dims - velocity;
-  const Eigen::Map<const Eigen::RowVectorXf> query(phi, dims);
-  const float posture_d2 = (row.head(posture) - query.head(posture)).squaredNorm();
-  const float velocity_d2 =
-      velocity > 0 ? (row.tail(velocity) - query.tail(velocity)).squaredNorm() : 0.0f;
+  constexpr int kBlock = TemplateModel::kStateBlock;
+  const int dims = model.num_dims();
+  const int posture = dims - model.velocity_dims();
+  const float* lane =
+      model.blocked_features().data() +
+      static_cast<std::size_t>(i / kBlock) * static_cast<std::size_t>(dims) * kBlock +
+      static_cast<std::size_t>(i % kBlock);
+  float posture_d2 = 0.0f, velocity_d2 = 0.0f;
+  for (int d = 0; d < posture; ++d) {
+    const float diff = lane[static_cast<std::size_t>(d) * kBlock] - phi[d];
+    posture_d2 += diff * diff;
+  }
+  for (int d = posture; d < dims; ++d) {
+    const float diff = lane[static_cast<std::size_t>(d) * kBlock] - phi[d];
+    velocity_d2 += diff * diff;
+  }
   return std::min(posture_d2 + std::min(velocity_d2, velocity_cap), FLT_MAX);
 }
 
@@ -71,10 +82,10 @@ BeamContext::BeamContext(int num_states, const BeamParams& beam, int max_steps_p
   scratch_.assign(size + 1, 0.0f);
   distance_sq_.assign(size, 0.0f);
   // Each transition grows a run of the beam by at most 2 states; then come the candidates.
-  const std::size_t list = std::min(
-      size, static_cast<std::size_t>(beam.max_states) *
-                    (1 + 2 * static_cast<std::size_t>(std::max(1, max_steps_per_frame))) +
-                static_cast<std::size_t>(beam.wide_jump_candidates));
+  const std::size_t list =
+      std::min(size, static_cast<std::size_t>(beam.max_states) *
+                             (1 + 2 * static_cast<std::size_t>(std::max(1, max_steps_per_frame))) +
+                         static_cast<std::size_t>(beam.wide_jump_candidates));
   beam_.reserve(list);
   next_.reserve(list);
   weighted_.assign(list, 0.0f);
@@ -149,7 +160,8 @@ void BeamForward::sparse_transition(const BandProbabilities& band,
   for (const int j : context.beam_) beam_mass += alpha[j];
   float into_pause = 0.0f;
   if (jump) {
-    into_pause = exact_.leave_ * (beam_mass + context.background_) + exact_.pause_stay_ * pause_mass;
+    into_pause =
+        exact_.leave_ * (beam_mass + context.background_) + exact_.pause_stay_ * pause_mass;
   }
   // The band moves each state's mass to j, j + 1, j + 2 of its take. The beam is sorted, so the
   // targets come in order and a target at or below the last one added is already in next_.
@@ -189,8 +201,8 @@ bool BeamForward::sparse_emission(const float* phi, int wanted, BeamContext& con
 
   // The jump candidates, merged into the beam (both sorted) in next_.
   float bound = 0.0f;
-  const int found = index_->nearest(phi, wanted, context.candidates_.data(),
-                                   context.candidate_d2_.data(), bound);
+  const int found =
+      index_->nearest(phi, wanted, context.candidates_.data(), context.candidate_d2_.data(), bound);
   std::uint32_t* candidates = context.candidates_.data();
   std::sort(candidates, candidates + found);
   context.next_.clear();
@@ -297,9 +309,9 @@ void BeamForward::full_emission(const float* phi, BeamContext& context,
                                                        context.distance_sq_.data());
   result.log_likelihood = follow_detail::weigh_and_normalise(
       context.alpha_.data(), context.distance_sq_.data(), best,
-      exact_.noise_levels_.inv_two_sigma_sq(context.frame_noise_),
-      model.num_states(), exact_.noise_levels_.log_pause_emission(context.frame_noise_),
-      params.jump_enabled, context.scratch_.data());
+      exact_.noise_levels_.inv_two_sigma_sq(context.frame_noise_), model.num_states(),
+      exact_.noise_levels_.log_pause_emission(context.frame_noise_), params.jump_enabled,
+      context.scratch_.data());
   context.alpha_.swap(context.scratch_);
   result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
   result.lost = best > exact_.noise_levels_.lost_ceiling_sq();
@@ -429,7 +441,7 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
         follow_detail::is_jump(model, context.history_.previous_state, result.state, result.steps);
   }
   context.history_.jump_gate.apply(model, params, alpha, 1.0f, context.history_.previous_state,
-                           context.history_.previous_lost, result);
+                                   context.history_.previous_lost, result);
   if (dense && !result.missing) rebuild_beam(context);
 
   result.lost = result.missing ? context.history_.previous_lost : (result.lost || result.in_pause);
@@ -439,8 +451,8 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   }
   if (params.tempo_adaptive) {
     const bool band_move = !result.missing && !result.lost && !result.jumped;
-    context.history_.tempo.update(context.history_.previous_state, result.state, result.steps, dt_s, band_move,
-                          exact_.tempo_limits_);
+    context.history_.tempo.update(context.history_.previous_state, result.state, result.steps, dt_s,
+                                  band_move, exact_.tempo_limits_);
   }
   result.tempo = context.history_.tempo.tempo();
   context.history_.total_log_likelihood += result.log_likelihood;
@@ -448,12 +460,11 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   context.history_.previous_state = result.state;
   context.history_.previous_lost = result.lost;
   const bool unexplained =
-      !result.missing &&
-      result.best_distance_per_dim * static_cast<float>(model.num_dims()) >
-          exact_.noise_levels_.lost_distance_sq(context.frame_noise_,
-                                                context.history_.explained_residual.level());
-  context.history_.explained_residual.update(result.best_distance_per_dim,
-                                     !result.missing && !result.in_pause && !result.jumped, dt_s);
+      !result.missing && result.best_distance_per_dim * static_cast<float>(model.num_dims()) >
+                             exact_.noise_levels_.lost_distance_sq(
+                                 context.frame_noise_, context.history_.explained_residual.level());
+  context.history_.explained_residual.update(
+      result.best_distance_per_dim, !result.missing && !result.in_pause && !result.jumped, dt_s);
   result.lost = result.lost || unexplained;
   return result;
 }

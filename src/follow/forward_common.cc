@@ -36,7 +36,7 @@ int steps_for(double dt_s, double template_fps, int max_steps) noexcept {
   return static_cast<int>(n);
 }
 
-float squared_distances(const FeatureMatrix& features, const float* phi, int begin, int end,
+float squared_distances(const FeatureView& features, const float* phi, int begin, int end,
                         float* out) noexcept {
   const Eigen::Index dims = features.cols();
   const Eigen::Map<const Eigen::RowVectorXf> query(phi, dims);
@@ -53,7 +53,7 @@ float squared_distances(const FeatureMatrix& features, const float* phi, int beg
 
 float emission_distances(const TemplateModel& model, const float* phi, float velocity_cap,
                          float* out) noexcept {
-  const FeatureMatrix& features = model.features();
+  const FeatureView features = model.features();
   const int num_states = model.num_states();
   const Eigen::Index velocity = model.velocity_dims();
   const bool capped = velocity > 0 && velocity_cap < FLT_MAX;

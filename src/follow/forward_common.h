@@ -43,7 +43,7 @@ int steps_for(double dt_s, double template_fps, int max_steps) noexcept;
 
 // out[i - begin] = ||phi - phi_i||^2 for template rows i in [begin, end), saturated at FLT_MAX.
 // Returns the minimum. phi has model.num_dims() finite values.
-float squared_distances(const FeatureMatrix& features, const float* phi, int begin, int end,
+float squared_distances(const FeatureView& features, const float* phi, int begin, int end,
                         float* out) noexcept;
 
 // The same with the distance over the last model.velocity_dims() dimensions capped at

@@ -68,7 +68,7 @@ class MappedFile {
     }
     size_ = static_cast<std::size_t>(st.st_size);
     if (size_ > 0) {
-      void* p = mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+      void* p = mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
       if (p == MAP_FAILED) {
         const std::string reason = std::strerror(errno);
         ::close(fd);
@@ -82,6 +82,11 @@ class MappedFile {
   }
   const unsigned char* data() const { return static_cast<const unsigned char*>(data_); }
   std::size_t size() const { return size_; }
+  // Lets the kernel drop the pages read so far: they come back from the file when next read.
+  // (Loading reads every byte once, for the checksum and the blocked copy; serving reads few.)
+  void release_pages() const {
+    if (data_ != nullptr) madvise(data_, size_, MADV_DONTNEED);
+  }
 
  private:
   void* data_ = nullptr;
@@ -116,8 +121,7 @@ Status write_model_cache(const std::string& path, const TemplateModel& model,
   header.takes_offset = sizeof(Header);
   header.takes_bytes = takes.size() * sizeof(std::int32_t);
   header.features_offset = header.takes_offset + header.takes_bytes;
-  header.features_bytes =
-      static_cast<std::uint64_t>(model.features().size()) * sizeof(float);
+  header.features_bytes = static_cast<std::uint64_t>(model.features().size()) * sizeof(float);
   header.index_offset = header.features_offset + header.features_bytes;
   header.index_bytes = index_blob.size();
   header.file_bytes = header.index_offset + header.index_bytes;
@@ -153,8 +157,10 @@ Status write_model_cache(const std::string& path, const TemplateModel& model,
 
 Result<CachedModel> read_model_cache(const std::string& path, std::uint64_t feature_spec_hash) {
   auto fail = [&](const std::string& what) { return make_error(path, 0, what); };
-  MappedFile file;
-  if (const std::string reason = file.open(path); !reason.empty()) {
+  // Shared with the model, which keeps its row-major features in the map (build_shared).
+  const auto mapped = std::make_shared<MappedFile>();
+  const MappedFile& file = *mapped;
+  if (const std::string reason = mapped->open(path); !reason.empty()) {
     return fail("cannot open the model cache: " + reason);
   }
   if (file.size() < sizeof(Header)) {
@@ -193,10 +199,9 @@ Result<CachedModel> read_model_cache(const std::string& path, std::uint64_t feat
       !section_fits(header.features_offset, header.features_bytes, size) ||
       !section_fits(header.index_offset, header.index_bytes, size)) {
     return fail("model cache header inconsistent with its sizes (" +
-                std::to_string(header.num_states) + " states x " +
-                std::to_string(header.num_dims) + " dimensions, " +
-                std::to_string(header.num_takes) + " takes in " + std::to_string(size) +
-                " bytes)");
+                std::to_string(header.num_states) + " states x " + std::to_string(header.num_dims) +
+                " dimensions, " + std::to_string(header.num_takes) + " takes in " +
+                std::to_string(size) + " bytes)");
   }
   if (content_hash(file.data() + sizeof(Header), size - sizeof(Header)) != header.checksum) {
     return fail("model cache damaged (checksum mismatch)");
@@ -204,17 +209,19 @@ Result<CachedModel> read_model_cache(const std::string& path, std::uint64_t feat
 
   std::vector<int> takes(static_cast<std::size_t>(header.num_takes));
   std::memcpy(takes.data(), file.data() + header.takes_offset, header.takes_bytes);
-  // The features are copied out of the map once into the model (which owns and blocks them).
+  // The model reads its row-major features from the map (the few rows a beam needs per frame);
+  // it copies them once into the blocked layout its SIMD kernel streams through. A map whose
+  // features section is not aligned for floats (not one this build writes) is copied instead.
   const auto* features = reinterpret_cast<const float*>(file.data() + header.features_offset);
-  std::vector<float> aligned;
-  if (reinterpret_cast<std::uintptr_t>(features) % alignof(float) != 0) {
-    aligned.resize(states * dims);
-    std::memcpy(aligned.data(), features, header.features_bytes);
-    features = aligned.data();
-  }
-  Result<TemplateModel> model = TemplateModel::build(
-      std::span<const float>(features, states * dims), header.num_states, header.num_dims,
-      std::move(takes), header.frame_rate_hz, header.velocity_dims);
+  const std::span<const float> feature_values(features, states * dims);
+  Result<TemplateModel> model =
+      reinterpret_cast<std::uintptr_t>(features) % alignof(float) == 0
+          ? TemplateModel::build_shared(mapped, feature_values, header.num_states, header.num_dims,
+                                        std::move(takes), header.frame_rate_hz,
+                                        header.velocity_dims)
+          : TemplateModel::build(std::vector<float>(feature_values.begin(), feature_values.end()),
+                                 header.num_states, header.num_dims, std::move(takes),
+                                 header.frame_rate_hz, header.velocity_dims);
   if (!model) return fail("model cache holds an invalid model: " + model.error().message);
 
   MemoryBuffer buffer(reinterpret_cast<const char*>(file.data() + header.index_offset),
@@ -223,6 +230,7 @@ Result<CachedModel> read_model_cache(const std::string& path, std::uint64_t feat
   Result<JumpCandidateIndex> index =
       JumpCandidateIndex::load(in, header.num_states, header.num_dims - header.velocity_dims);
   if (!index) return fail("model cache: " + index.error().message);
+  file.release_pages();
   return CachedModel{std::move(model).value(), std::move(index).value()};
 }
 
@@ -240,11 +248,18 @@ Result<CachedModel> load_or_build_model_cache(const std::string& path,
   if (!model) return model.error();
   Result<JumpCandidateIndex> index = JumpCandidateIndex::build(model.value());
   if (!index) return index.error();
+  if (rebuilt_because != nullptr) *rebuilt_because = reason;
   if (Status written = write_model_cache(path, model.value(), index.value(), feature_spec_hash);
       !written.ok()) {
-    reason += "; and the new cache could not be written: " + written.error().message;
+    if (rebuilt_because != nullptr) {
+      *rebuilt_because += "; and the new cache could not be written: " + written.error().message;
+    }
+    return CachedModel{std::move(model).value(), std::move(index).value()};
   }
-  if (rebuilt_because != nullptr) *rebuilt_because = reason;
+  // Served from the file just written, like the next start: its row-major features then stay
+  // in the map instead of in memory (read_model_cache).
+  Result<CachedModel> written = read_model_cache(path, feature_spec_hash);
+  if (written) return written;
   return CachedModel{std::move(model).value(), std::move(index).value()};
 }
 

@@ -12,7 +12,7 @@ namespace {
 Error model_error(const std::string& reason) { return make_error("template model", 0, reason); }
 
 // The layout of TemplateModel::blocked_features().
-std::vector<float> blocked(const FeatureMatrix& features) {
+std::vector<float> blocked(const FeatureView& features) {
   constexpr Eigen::Index kBlock = TemplateModel::kStateBlock;
   const Eigen::Index rows = features.rows();
   const Eigen::Index dims = features.cols();
@@ -34,11 +34,63 @@ Result<TemplateModel> TemplateModel::build(FeatureMatrix features, std::vector<i
                                            double frame_rate_hz, int velocity_dims) {
   const Eigen::Index num_frames = features.rows();
   const Eigen::Index num_dims = features.cols();
+  if (num_frames >= (Eigen::Index{1} << 30) || num_dims >= (Eigen::Index{1} << 20)) {
+    return model_error("too many template frames or dimensions: " + std::to_string(num_frames) +
+                       " x " + std::to_string(num_dims));
+  }
+  auto owned = std::make_shared<const FeatureMatrix>(std::move(features));
+  std::shared_ptr<const float> data(owned, owned->data());
+  return finish(std::move(data), static_cast<int>(num_frames), static_cast<int>(num_dims),
+                std::move(take_start), frame_rate_hz, velocity_dims);
+}
+
+Result<TemplateModel> TemplateModel::build(std::span<const float> features_row_major,
+                                           int num_frames, int num_dims,
+                                           std::vector<int> take_start, double frame_rate_hz,
+                                           int velocity_dims) {
+  if (num_frames <= 0 || num_dims <= 0) {
+    return model_error("no template features (" + std::to_string(num_frames) + " frames x " +
+                       std::to_string(num_dims) + " dimensions)");
+  }
+  const auto expected = static_cast<std::size_t>(num_frames) * static_cast<std::size_t>(num_dims);
+  if (features_row_major.size() != expected) {
+    return model_error("feature buffer holds " + std::to_string(features_row_major.size()) +
+                       " values, expected " + std::to_string(num_frames) + " frames x " +
+                       std::to_string(num_dims) + " dimensions = " + std::to_string(expected));
+  }
+  FeatureMatrix features =
+      Eigen::Map<const FeatureMatrix>(features_row_major.data(), num_frames, num_dims);
+  return build(std::move(features), std::move(take_start), frame_rate_hz, velocity_dims);
+}
+
+Result<TemplateModel> TemplateModel::build_shared(std::shared_ptr<const void> storage,
+                                                  std::span<const float> features_row_major,
+                                                  int num_frames, int num_dims,
+                                                  std::vector<int> take_start, double frame_rate_hz,
+                                                  int velocity_dims) {
+  if (num_frames <= 0 || num_dims <= 0) {
+    return model_error("no template features (" + std::to_string(num_frames) + " frames x " +
+                       std::to_string(num_dims) + " dimensions)");
+  }
+  const auto expected = static_cast<std::size_t>(num_frames) * static_cast<std::size_t>(num_dims);
+  if (features_row_major.size() != expected) {
+    return model_error("feature buffer holds " + std::to_string(features_row_major.size()) +
+                       " values, expected " + std::to_string(num_frames) + " frames x " +
+                       std::to_string(num_dims) + " dimensions = " + std::to_string(expected));
+  }
+  std::shared_ptr<const float> data(std::move(storage), features_row_major.data());
+  return finish(std::move(data), num_frames, num_dims, std::move(take_start), frame_rate_hz,
+                velocity_dims);
+}
+
+Result<TemplateModel> TemplateModel::finish(std::shared_ptr<const float> data, int num_frames,
+                                            int num_dims, std::vector<int> take_start,
+                                            double frame_rate_hz, int velocity_dims) {
   if (num_frames == 0 || num_dims == 0) {
     return model_error("no template features (" + std::to_string(num_frames) + " frames x " +
                        std::to_string(num_dims) + " dimensions)");
   }
-  if (num_frames >= (Eigen::Index{1} << 30)) {
+  if (num_frames >= (1 << 30)) {
     return model_error("too many template frames: " + std::to_string(num_frames));
   }
   if (velocity_dims < 0 || velocity_dims > num_dims) {
@@ -48,6 +100,7 @@ Result<TemplateModel> TemplateModel::build(FeatureMatrix features, std::vector<i
   if (!std::isfinite(frame_rate_hz) || frame_rate_hz <= 0.0) {
     return model_error("frame rate must be positive, got " + std::to_string(frame_rate_hz));
   }
+  const FeatureView features(data.get(), num_frames, num_dims);
   for (Eigen::Index i = 0; i < num_frames; ++i) {
     for (Eigen::Index d = 0; d < num_dims; ++d) {
       if (!std::isfinite(features(i, d))) {
@@ -73,34 +126,17 @@ Result<TemplateModel> TemplateModel::build(FeatureMatrix features, std::vector<i
                          std::to_string(k - 1) + " at " + std::to_string(take_start[k - 1]));
     }
   }
-  take_start.push_back(static_cast<int>(num_frames));
+  take_start.push_back(num_frames);
 
   TemplateModel model;
-  model.features_ = std::move(features);
+  model.blocked_features_ = blocked(features);
+  model.features_ = std::move(data);
+  model.num_states_ = num_frames;
+  model.num_dims_ = num_dims;
   model.take_start_ = std::move(take_start);
   model.frame_rate_hz_ = frame_rate_hz;
   model.velocity_dims_ = velocity_dims;
-  model.blocked_features_ = blocked(model.features_);
   return model;
-}
-
-Result<TemplateModel> TemplateModel::build(std::span<const float> features_row_major,
-                                           int num_frames, int num_dims,
-                                           std::vector<int> take_start, double frame_rate_hz,
-                                           int velocity_dims) {
-  if (num_frames <= 0 || num_dims <= 0) {
-    return model_error("no template features (" + std::to_string(num_frames) + " frames x " +
-                       std::to_string(num_dims) + " dimensions)");
-  }
-  const auto expected = static_cast<std::size_t>(num_frames) * static_cast<std::size_t>(num_dims);
-  if (features_row_major.size() != expected) {
-    return model_error("feature buffer holds " + std::to_string(features_row_major.size()) +
-                       " values, expected " + std::to_string(num_frames) + " frames x " +
-                       std::to_string(num_dims) + " dimensions = " + std::to_string(expected));
-  }
-  FeatureMatrix features =
-      Eigen::Map<const FeatureMatrix>(features_row_major.data(), num_frames, num_dims);
-  return build(std::move(features), std::move(take_start), frame_rate_hz, velocity_dims);
 }
 
 int TemplateModel::take_of(int state) const {

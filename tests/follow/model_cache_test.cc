@@ -1,8 +1,12 @@
 // The library model cache file: what is written is read back (model and index), and a missing,
 // truncated, foreign, stale or damaged cache is rejected with a message naming the file and the
 // problem, then rebuilt by load_or_build_model_cache.
-#include <gtest/gtest.h>
+#include "duet/follow/model_cache.h"
 
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -10,10 +14,7 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
 #include "duet/follow/beam_follower.h"
-#include "duet/follow/model_cache.h"
 #include "follow/synthetic.h"
 
 namespace duet {
@@ -32,8 +33,8 @@ class ModelCacheTest : public ::testing::Test {
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
   void write() {
-    ASSERT_TRUE(write_model_cache(path_, model_, JumpCandidateIndex::build(model_).value(), kSpec)
-                    .ok());
+    ASSERT_TRUE(
+        write_model_cache(path_, model_, JumpCandidateIndex::build(model_).value(), kSpec).ok());
   }
   std::string rejected(std::uint64_t spec = kSpec) {
     Result<CachedModel> read = read_model_cache(path_, spec);
@@ -73,11 +74,24 @@ TEST_F(ModelCacheTest, ReadsBackTheModelAndAnIndexThatFindsTheSameCandidates) {
     EXPECT_EQ(bound_a, bound_b);
   }
   // A beam follower runs on what was read.
-  Result<BeamFollower> beam =
-      BeamFollower::create(
-          model, {}, {}, std::make_shared<const JumpCandidateIndex>(std::move(read).value().index));
+  Result<BeamFollower> beam = BeamFollower::create(
+      model, {}, {}, std::make_shared<const JumpCandidateIndex>(std::move(read).value().index));
   ASSERT_TRUE(beam) << beam.error().message;
   EXPECT_GE(beam.value().step(test::features_at(model, 40.0), 1.0 / 60).state, 0);
+}
+
+TEST_F(ModelCacheTest, AModelReadFromTheCacheKeepsItsMappedFeaturesAlive) {
+  // The row-major features stay in the file's map (so a 1M-state library keeps 200 MB on disk);
+  // the map lives as long as any copy of the model, also after the file is gone.
+  write();
+  Result<CachedModel> read = read_model_cache(path_, kSpec);
+  ASSERT_TRUE(read) << read.error().message;
+  const TemplateModel copy = read.value().model;
+  read = Error{"dropped"};  // the cached model and its index are gone; the copy remains
+  std::filesystem::remove(path_);
+  EXPECT_EQ(copy.features(), model_.features());
+  EXPECT_TRUE(std::equal(copy.blocked_features().begin(), copy.blocked_features().end(),
+                         model_.blocked_features().begin(), model_.blocked_features().end()));
 }
 
 TEST_F(ModelCacheTest, RejectsMissingTruncatedForeignStaleAndDamagedCaches) {

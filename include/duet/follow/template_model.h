@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -17,6 +18,8 @@ namespace duet {
 // Row i is the feature vector phi_i of template state i. Row-major float: the per-frame emission
 // streams through every row once, so rows must be contiguous and small (27k x 60 floats = 6.5 MB).
 using FeatureMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+// A read-only view of M x D row-major features, wherever they are stored.
+using FeatureView = Eigen::Map<const FeatureMatrix>;
 
 class TemplateModel {
  public:
@@ -35,15 +38,25 @@ class TemplateModel {
   static Result<TemplateModel> build(std::span<const float> features_row_major, int num_frames,
                                      int num_dims, std::vector<int> take_start,
                                      double frame_rate_hz, int velocity_dims = 0);
+  // Same, on features the model does not copy: `storage` keeps them alive (e.g. a memory-mapped
+  // model cache, model_cache.h) as long as the model or a copy of it lives. At a million states
+  // the row-major features are 200 MB that the follower reads only a few rows of per frame (the
+  // SIMD kernel reads the blocked copy), so from a mapped file they stay mostly on disk.
+  static Result<TemplateModel> build_shared(std::shared_ptr<const void> storage,
+                                            std::span<const float> features_row_major,
+                                            int num_frames, int num_dims,
+                                            std::vector<int> take_start, double frame_rate_hz,
+                                            int velocity_dims = 0);
 
-  int num_states() const { return static_cast<int>(features_.rows()); }  // M
-  int num_dims() const { return static_cast<int>(features_.cols()); }    // D
+  int num_states() const { return num_states_; }  // M
+  int num_dims() const { return num_dims_; }      // D
   int num_takes() const { return static_cast<int>(take_start_.size()) - 1; }
   double frame_rate_hz() const { return frame_rate_hz_; }
   // The last velocity_dims() of the D dimensions are velocities (see build).
   int velocity_dims() const { return velocity_dims_; }
 
-  const FeatureMatrix& features() const { return features_; }
+  // Row i is phi_i. A cheap view: copies of the model share the features.
+  FeatureView features() const { return {features_.get(), num_states_, num_dims_}; }
   // The same features blocked for the SIMD emission kernel: states in blocks of kStateBlock, and
   // within a block dimension-major, so one load gives dimension d of kStateBlock states:
   // blocked_features()[(b * D + d) * kStateBlock + l] = phi_{b * kStateBlock + l}(d). The last
@@ -59,7 +72,14 @@ class TemplateModel {
  private:
   TemplateModel() = default;
 
-  FeatureMatrix features_;
+  // Validates the features and sets up everything else; features_ points at them.
+  static Result<TemplateModel> finish(std::shared_ptr<const float> features, int num_frames,
+                                      int num_dims, std::vector<int> take_start,
+                                      double frame_rate_hz, int velocity_dims);
+
+  std::shared_ptr<const float> features_;  // M x D row-major, owned or shared (build_shared)
+  int num_states_ = 0;
+  int num_dims_ = 0;
   std::vector<float> blocked_features_;  // see blocked_features()
   std::vector<int> take_start_;          // num_takes + 1 entries; the last one is M
   double frame_rate_hz_ = 0.0;
