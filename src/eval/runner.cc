@@ -461,7 +461,7 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
             kept[k].push_back({take,
                                frame_error_ms(truth, estimates.value()[f],
                                               performance.template_rate_hz, options.metrics),
-                               estimates.value()[f]});
+                               estimates.value()[f], truth});
           }
         }
         per_take[k].emplace_back(take, one.summary());

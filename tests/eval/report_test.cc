@@ -176,14 +176,19 @@ TEST(EvalReportCsv, HasTheCalibrationErrorAndTheFramesCsvItsRows) {
   e.confidence = 0.5f;
   e.window_mass = 0.75f;
   e.sensor_noise_per_dim = 0.002f;
-  report.rows[0].frames.push_back({0, 33.3, e});
+  TruthFrame truth;
+  truth.take = 0;
+  truth.template_frame = 7.0;
+  truth.jump = true;
+  report.rows[0].frames.push_back({0, 33.3, e, truth});
   const std::string csv = format_eval_csv(report);
   EXPECT_NE(csv.find(",confidence_ece\n"), std::string::npos);
   EXPECT_NE(csv.find(",0.01230\n"), std::string::npos) << csv;
   EXPECT_EQ(format_frames_csv(report),
             "case,tracker,take,error_ms,confidence,window_mass,best_distance_per_dim,"
-            "sensor_noise_per_dim,lost,in_pause,jumped\n"
-            "clean,hmm,0,33.3,0.50000,0.75000,0.000000,0.0020000,1,0,1\n");
+            "sensor_noise_per_dim,lost,in_pause,jumped,true_take,true_frame,estimated_take,"
+            "estimated_frame,true_jump\n"
+            "clean,hmm,0,33.3,0.50000,0.75000,0.000000,0.0020000,1,0,1,0,7.0,0,5,1\n");
 }
 
 }  // namespace

@@ -105,6 +105,7 @@ struct ScoredFrame {
   int take = 0;
   double error_ms = 0.0;  // frame_error_ms
   FrameEstimate estimate;
+  TruthFrame truth;  // where the dancer really was
 };
 
 // A case x tracker, pooled over the performed takes, and per take.
