@@ -13,9 +13,12 @@
 #include <set>
 
 #include "commands.h"
+#include "duet/eval/non_dance.h"
 #include "duet/eval/report.h"
 #include "duet/eval/runner.h"
+#include "duet/follow/hmm_follower.h"
 #include "duet/io/atomic_write.h"
+#include "eval_non_dance.h"
 #include "eval_rigs.h"
 #include "library_options.h"
 #include "number_checks.h"
@@ -31,6 +34,7 @@ struct EvalArgs {
   std::vector<std::string> cases;
   std::vector<std::string> trackers;
   std::vector<std::string> rigs = {"native"};
+  std::vector<std::string> non_dance;  // empty: the Bandai clips when the data folder has them
   std::uint64_t seed = 1;
   std::string csv_path;
   std::string frames_csv_path;
@@ -282,6 +286,12 @@ int run_eval(EvalArgs& args) {
     return kExitFailure;
   }
   options.cases = cases_on_rigs(options.cases, rigs.value());
+  // Loaded before the long run, so a wrong file fails at once.
+  Result<std::vector<NonDanceClip>> non_dance = load_non_dance_clips(args.non_dance, data_dir);
+  if (!non_dance) {
+    fmt::print(stderr, "duet eval: {}\n", non_dance.error().message);
+    return kExitFailure;
+  }
   // Three points: every case's performance is delivered as a headset's head and hands with the
   // headset's tracking noise. A suit's per-joint noise is no headset's: the noisy cases get twice
   // the point noise instead.
@@ -328,6 +338,26 @@ int run_eval(EvalArgs& args) {
       hmm.lost_residual_factor, hmm.emission_noise_factor, hmm.emission_noise_allowance,
       hmm.noise_filter_density, hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
+  if (!non_dance.value().empty()) {
+    fmt::print(
+        "\nnon-dance input (motion no part of the library explains; hmm, exact step): lost\n");
+    for (const NonDanceClip& clip : non_dance.value()) {
+      Result<HmmFollower> follower = HmmFollower::create(library->model(), options.hmm);
+      if (!follower) {
+        fmt::print(stderr, "duet eval: {}\n", follower.error().message);
+        return kExitFailure;
+      }
+      Result<NonDanceResult> result =
+          follow_non_dance(*library, clip.motion, clip.name,
+                           std::make_unique<HmmFollower>(std::move(follower).value()));
+      if (!result) {
+        fmt::print(stderr, "duet eval: --non-dance {}\n", result.error().message);
+        return kExitFailure;
+      }
+      fmt::print("  {:<18} {:6.1f}% of {} frames\n", clip.name,
+                 100.0 * result.value().lost_fraction(), result.value().frames);
+    }
+  }
   std::fflush(stdout);
 
   if (!args.csv_path.empty()) {
@@ -369,6 +399,12 @@ Command register_eval(CLI::App& app) {
                  "(cmu-salsa 60.asf), handshake (cmu-handshake 18_01.bvh), bandai (a third-party "
                  "rig), all, or a motion file whose skeleton to use. A case on another rig is "
                  "reported as CASE@RIG: the same performance, retargeted (docs/retarget.md)")
+      ->delimiter(',');
+  app.add_option("--non-dance", args->non_dance,
+                 "Motion no part of the library explains, comma-separated, followed after the "
+                 "cases and reported as the share of frames lost (issue 11: near 100%): bandai "
+                 "(the data folder's walk, dance and wave on a third-party rig), none, or motion "
+                 "files (default: bandai when the data folder has it)")
       ->delimiter(',');
   app.add_option("--cases", args->cases,
                  "Cases to run, comma-separated (default all): clean, tempo-slow, tempo-fast "

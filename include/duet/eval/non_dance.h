@@ -1,0 +1,32 @@
+// Lost on non-dance input (issue 11): motion that no part of the library explains (a walk, a
+// wave, another style of dance, on any rig) must be reported lost, not followed. `duet eval
+// --non-dance` runs such clips through the follower and reports the share of lost frames.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "duet/base/result.h"
+#include "duet/follow/tracker.h"
+#include "duet/io/motion_file.h"
+#include "duet/live/duet_library.h"
+
+namespace duet {
+
+struct NonDanceResult {
+  std::string name;  // the clip's name (its file's stem)
+  long long frames = 0;
+  long long lost = 0;  // frames the follower reported lost
+
+  double lost_fraction() const {
+    return frames > 0 ? static_cast<double>(lost) / static_cast<double>(frames) : 0.0;
+  }
+};
+
+// Every frame of `input` (any rig whose body roles are known) through a follow session of
+// `library` with `tracker`, at the clip's own timing. An error when the session cannot be made
+// (the rig lacks roles the features need).
+Result<NonDanceResult> follow_non_dance(const DuetLibrary& library, const LoadedMotion& input,
+                                        std::string name, std::unique_ptr<Tracker> tracker);
+
+}  // namespace duet
