@@ -293,11 +293,12 @@ std::string PartnerParams::validate() const {
   }
   const std::pair<const char*, double> references[] = {
       {"user_facing_jitter_reference_rad", user_facing_jitter_reference_rad},
-      {"ik_target_jitter_reference_m", ik_target_jitter_reference_m}};
+      {"ik_target_jitter_reference_m", ik_target_jitter_reference_m},
+      {"ik_difference_time_constant_s", ik_difference_time_constant_s}};
   for (const auto& [name, value] : references) {
     if (!(value >= 0.0) || !std::isfinite(value)) {
-      return std::string(name) + " must be finite and >= 0 (0: no adaptation; got " +
-             std::to_string(value) + ")";
+      return std::string(name) + " must be finite and >= 0 (0: none; got " + std::to_string(value) +
+             ")";
     }
   }
   if (const std::string_view problem = ik_correction_filter.validate(); !problem.empty()) {
@@ -432,6 +433,33 @@ double PartnerContext::ik_target_jitter(std::size_t hand, const Vec3& target, do
   return std::sqrt(variance);
 }
 
+Vec3 PartnerContext::steady_ik_target(std::size_t hand, const Vec3& target,
+                                      const Vec3& captured_wrist, const Quat& body_rotation,
+                                      const PartnerParams& p, double dt, bool restart) noexcept {
+  const double jitter = ik_target_jitter(hand, target, dt, restart);
+  const auto pair = static_cast<std::size_t>(ik_pair_[hand]);
+  if (!target.allFinite() || !captured_wrist.allFinite() || pair >= ik_difference_hs_.size()) {
+    return target;
+  }
+  const Quat to_body = body_rotation.normalized().conjugate();
+  const Vec3 difference_hs = to_body * (target - captured_wrist);
+  // The averaging time: none on a clean sensor, up to ik_difference_time_constant_s under noise.
+  const double ratio = jitter / p.ik_target_jitter_reference_m;
+  const double noisy = ratio * ratio * ratio * ratio;
+  const double tau = p.ik_difference_time_constant_s * noisy / (1.0 + noisy);
+  double& seen = ik_difference_seen_s_[pair];
+  seen += dt > 0.0 && std::isfinite(dt) ? dt : 0.0;
+  // A running mean until the average has seen tau (its first sample may be all noise).
+  const double alpha = tau > 0.0 && dt > 0.0 && std::isfinite(dt)
+                           ? std::max(1.0 - std::exp(-dt / tau), std::min(1.0, dt / seen))
+                           : 1.0;
+  Vec3& average = ik_difference_hs_[pair];
+  average = ik_difference_valid_[pair] ? Vec3(average + alpha * (difference_hs - average))
+                                       : difference_hs;
+  ik_difference_valid_[pair] = true;
+  return captured_wrist + body_rotation.normalized() * average;
+}
+
 void PartnerContext::reset() noexcept {
   primed_ = false;
   inertializer_.reset();
@@ -446,6 +474,9 @@ void PartnerContext::reset() noexcept {
   for (auto& hand : ik_target_jitter_) {
     for (JitterMeter& meter : hand) meter.reset();
   }
+  ik_difference_hs_.fill(Vec3::Zero());
+  ik_difference_valid_.fill(false);
+  ik_difference_seen_s_.fill(0.0);
   for (auto& arm : ik_correction_filter_) {
     for (OneEuroFilter3& filter : arm) filter.reset();
   }
@@ -629,6 +660,12 @@ bool PartnerSynthesisJob::run() const noexcept {
                       (has_position ? contacts.offset_ls_at(frame_position, ctx.ik_pair_[r])
                                     : contacts.offset_ls(frame, ctx.ik_pair_[r]));
       }
+      if (p.smooth && p.ik_target_jitter_reference_m > 0.0) {
+        raw_target = ctx.steady_ik_target(
+            r, raw_target, ctx.positions_ws_[static_cast<std::size_t>(roles[kArms[r].wrist])],
+            p.align ? heading.rotation : Quat::Identity(), p, dt,
+            jumped || ctx.ik_pair_[r] != previous_pair);
+      }
       // Keep the target continuous across jumps (5.3): the step of the raw target is absorbed
       // by an offset that decays like the blend. The speed test uses at least one model frame
       // as the interval, so a late frame followed by an early one is not taken for a jump.
@@ -652,8 +689,6 @@ bool PartnerSynthesisJob::run() const noexcept {
         ctx.ik_target_offset_[r] = Vec3::Zero();
         ctx.ik_target_offset_velocity_[r] = Vec3::Zero();
       }
-      const double target_jitter =
-          ctx.ik_target_jitter(r, raw_target, dt, jumped || ctx.ik_pair_[r] != previous_pair);
       const Vec3 target = raw_target + ctx.ik_target_offset_[r];
       ctx.ik_target_valid_[r] = true;
       ctx.ik_raw_target_[r] = raw_target;
@@ -678,32 +713,12 @@ bool PartnerSynthesisJob::run() const noexcept {
         // The correction (captured -> IK, in the joint's own frame) through the 1-euro filter,
         // then put back on the captured rotation; the wrist lands where that arm reaches.
         // At most ik_correction_max_speed_rad_s: the IK adds at most that to a joint's speed.
-        // Under a jittering target, smoothed harder (PartnerParams::ik_target_jitter_reference_m).
-        OneEuroParams filter_params = p.ik_correction_filter;
-        double max_speed = p.ik_correction_max_speed_rad_s;
-        if (p.ik_target_jitter_reference_m > 0.0) {
-          const double ratio = target_jitter / p.ik_target_jitter_reference_m;
-          const double calm = 1.0 / (1.0 + ratio * ratio * ratio * ratio);
-          filter_params.min_cutoff_hz *= calm;
-          filter_params.beta *= calm;
-          max_speed *= calm;
-        }
-        // A restarted filter holds its first sample, noise and all, for as long as its time
-        // constant: until then the cutoff is at least 1 / (2 pi t), t seconds after the restart,
-        // which makes it the running mean of what it has seen.
-        double& age = ctx.ik_correction_age_s_[r];
-        age = filters[0].primed() ? age + dt : 0.0;
-        filter_params.min_cutoff_hz =
-            std::max(filter_params.min_cutoff_hz, 1.0 / (2.0 * kPi * std::max(age, dt)));
         std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
         const auto correct = [&](std::size_t k, const Quat& captured, const Quat& solved) {
-          if (!filters[k].primed()) {  // from no correction: a first sample may be all noise
-            filters[k].filter(Vec3::Zero(), 0.0, filter_params);
-            shown[k] = Vec3::Zero();
-          }
           const bool primed = filters[k].primed();
-          Vec3 c = filters[k].filter(log_map(captured.conjugate() * solved), dt, filter_params);
-          const double most = max_speed * dt;
+          Vec3 c =
+              filters[k].filter(log_map(captured.conjugate() * solved), dt, p.ik_correction_filter);
+          const double most = p.ik_correction_max_speed_rad_s * dt;
           if (primed && (c - shown[k]).norm() > most) {
             c = shown[k] + (c - shown[k]) * (most / (c - shown[k]).norm());
           }

@@ -166,17 +166,18 @@ struct PartnerParams {
   // correction (`body-size`: median hand error 1.25 cm, 0.99 at 4 rad/s).
   double ik_correction_max_speed_rad_s = 4.0;
   // smooth: under a noisy sensor the user's wrist, and with it the IK target, jitters (at 4
-  // degrees per joint and axis by 6-9 cm a frame): the correction then changed at its speed
-  // limit in random directions and the partner's hand wandered around the user's real hand
-  // (issue 11: median 6.7 cm from it at 60 Hz, 1.4 cm with the IK off). The target's jitter is
-  // measured (jitter_meter.h) and the correction filter's cutoff, beta and speed limit are
-  // divided by 1 + (jitter / ik_target_jitter_reference_m)^4: the correction is the slowly
-  // varying difference between two bodies, so under heavy noise it is all but frozen (the hand
-  // is then the captured hand placed at the user), while a clean capture's target (jitter 1-3
-  // mm) keeps the filter as set. A restarted correction starts from none, not from its first,
-  // possibly noisy, sample. 0: no adaptation. Measured in docs/evaluation.md ("Partner
-  // steadiness"; 0.005 and 0.01 and the square instead of the fourth power were close).
-  double ik_target_jitter_reference_m = 0.008;
+  // degrees per joint and axis by 6-9 cm a frame), and the IK passed it into the partner's arm
+  // (issue 11: the hand 6.7 cm from the user's real hand at 60 Hz, 1.4 cm with the IK off). What
+  // the target adds to the captured partner's wrist is the difference between the two bodies:
+  // slowly varying, and per hand pair alike from one contact to the next. It is averaged in the
+  // user's body frame, per hand pair and kept across contacts, over a time that grows with the
+  // target's measured jitter (jitter_meter.h): ik_difference_time_constant_s * x / (1 + x), x =
+  // (jitter / ik_target_jitter_reference_m)^4, so a clean capture (1-3 mm) is not delayed and a
+  // noisy one is averaged over about that long; the IK aims at the captured wrist plus the
+  // average. 0: the sensed target as it is. Measured in docs/evaluation.md ("Partner
+  // steadiness").
+  double ik_target_jitter_reference_m = 0.02;
+  double ik_difference_time_constant_s = 0.1;
   // smooth: the response is shown at a real frame that advances at the dancer's tempo
   // (response_playhead.h; used by LiveLoop, which samples the pose there and passes it as
   // PartnerSynthesisJob::frame_position).
@@ -300,8 +301,15 @@ class PartnerContext {
   bool user_facing_yaw_valid_ = false;
   // Per response hand, per arm joint (shoulder, elbow): the IK's correction (smooth).
   std::array<std::array<OneEuroFilter3, 2>, 2> ik_correction_filter_;
-  std::array<std::array<Vec3, 2>, 2> ik_correction_{};   // their outputs last frame
-  std::array<double, 2> ik_correction_age_s_{0.0, 0.0};  // since they restarted
+  std::array<std::array<Vec3, 2>, 2> ik_correction_{};  // their outputs last frame
+  // The IK target under a noisy sensor: the captured wrist plus the average, in the user's body
+  // frame, of what the sensed target adds to it (PartnerParams::ik_difference_time_constant_s).
+  Vec3 steady_ik_target(std::size_t hand, const Vec3& target, const Vec3& captured_wrist,
+                        const Quat& body_rotation, const PartnerParams& p, double dt,
+                        bool restart) noexcept;
+  std::array<Vec3, kHandPairCount> ik_difference_hs_{};  // per hand pair, kept across contacts
+  std::array<bool, kHandPairCount> ik_difference_valid_{};
+  std::array<double, kHandPairCount> ik_difference_seen_s_{};
   // The jitter (metres, RMS over the axes) of each response hand's raw IK target, after adding
   // this frame's target; restart: the target moved on (a jump, another hand held).
   double ik_target_jitter(std::size_t hand, const Vec3& target, double dt, bool restart) noexcept;
