@@ -28,6 +28,21 @@ std::vector<float> blocked(const FeatureView& features) {
   return out;
 }
 
+// A row-major buffer of num_frames x num_dims features: both positive and the sizes agreeing.
+Status check_buffer(std::span<const float> features_row_major, int num_frames, int num_dims) {
+  if (num_frames <= 0 || num_dims <= 0) {
+    return model_error("no template features (" + std::to_string(num_frames) + " frames x " +
+                       std::to_string(num_dims) + " dimensions)");
+  }
+  const auto expected = static_cast<std::size_t>(num_frames) * static_cast<std::size_t>(num_dims);
+  if (features_row_major.size() != expected) {
+    return model_error("feature buffer holds " + std::to_string(features_row_major.size()) +
+                       " values, expected " + std::to_string(num_frames) + " frames x " +
+                       std::to_string(num_dims) + " dimensions = " + std::to_string(expected));
+  }
+  return Ok{};
+}
+
 }  // namespace
 
 Result<TemplateModel> TemplateModel::build(FeatureMatrix features, std::vector<int> take_start,
@@ -48,16 +63,7 @@ Result<TemplateModel> TemplateModel::build(std::span<const float> features_row_m
                                            int num_frames, int num_dims,
                                            std::vector<int> take_start, double frame_rate_hz,
                                            int velocity_dims) {
-  if (num_frames <= 0 || num_dims <= 0) {
-    return model_error("no template features (" + std::to_string(num_frames) + " frames x " +
-                       std::to_string(num_dims) + " dimensions)");
-  }
-  const auto expected = static_cast<std::size_t>(num_frames) * static_cast<std::size_t>(num_dims);
-  if (features_row_major.size() != expected) {
-    return model_error("feature buffer holds " + std::to_string(features_row_major.size()) +
-                       " values, expected " + std::to_string(num_frames) + " frames x " +
-                       std::to_string(num_dims) + " dimensions = " + std::to_string(expected));
-  }
+  if (Status s = check_buffer(features_row_major, num_frames, num_dims); !s) return s.error();
   FeatureMatrix features =
       Eigen::Map<const FeatureMatrix>(features_row_major.data(), num_frames, num_dims);
   return build(std::move(features), std::move(take_start), frame_rate_hz, velocity_dims);
@@ -68,16 +74,7 @@ Result<TemplateModel> TemplateModel::build_shared(std::shared_ptr<const void> st
                                                   int num_frames, int num_dims,
                                                   std::vector<int> take_start, double frame_rate_hz,
                                                   int velocity_dims) {
-  if (num_frames <= 0 || num_dims <= 0) {
-    return model_error("no template features (" + std::to_string(num_frames) + " frames x " +
-                       std::to_string(num_dims) + " dimensions)");
-  }
-  const auto expected = static_cast<std::size_t>(num_frames) * static_cast<std::size_t>(num_dims);
-  if (features_row_major.size() != expected) {
-    return model_error("feature buffer holds " + std::to_string(features_row_major.size()) +
-                       " values, expected " + std::to_string(num_frames) + " frames x " +
-                       std::to_string(num_dims) + " dimensions = " + std::to_string(expected));
-  }
+  if (Status s = check_buffer(features_row_major, num_frames, num_dims); !s) return s.error();
   std::shared_ptr<const float> data(std::move(storage), features_row_major.data());
   return finish(std::move(data), num_frames, num_dims, std::move(take_start), frame_rate_hz,
                 velocity_dims);
