@@ -66,24 +66,33 @@ const SalsaModel* salsa() {
 
 const TemplateModel* salsa_model() { return salsa() ? &salsa()->model : nullptr; }
 
-// The library of `states` states; one kept at a time (a 1M-state model is 450 MB). mirrored:
-// every second copy is the mirror image of its take (salsa's basic steps alternate sides, so a
-// mirrored copy looks like its take half a step later: many more look-alike places).
-const TemplateModel* library_of(int states, bool mirrored = false) {
+// How the copies of a synthetic library are made (the second benchmark argument).
+enum Copies {
+  kTimeWarped = 0,  // time-warped, noisy copies of the real takes
+  // Every second copy is also the mirror image of its take (salsa's basic steps alternate sides,
+  // so a mirrored copy looks like its take half a step later: many more look-alike places).
+  kMirrored = 1,
+  // As kMirrored, after the real takes themselves (as `--grow-library` builds a live library).
+  kMirroredAfterReal = 2,
+};
+
+// The library of `states` states; one kept at a time (a 1M-state model is 450 MB).
+const TemplateModel* library_of(int states, int copies = kTimeWarped) {
   static std::unique_ptr<TemplateModel> cached;
-  static bool cached_mirrored = false;
+  static int cached_copies = kTimeWarped;
   const TemplateModel* real = salsa_model();
   if (real == nullptr) return nullptr;
   if (states == real->num_states()) return real;
-  if (!cached || cached->num_states() != states || cached_mirrored != mirrored) {
+  if (!cached || cached->num_states() != states || cached_copies != copies) {
     cached.reset();
     SyntheticLibraryOptions options;
     options.num_states = states;
-    if (mirrored) options.mirror = salsa()->mirror;
+    if (copies != kTimeWarped) options.mirror = salsa()->mirror;
+    options.keep_real_takes = copies == kMirroredAfterReal;
     Result<TemplateModel> model = synthesize_library(*real, options);
     if (!model) return nullptr;
     cached = std::make_unique<TemplateModel>(std::move(model).value());
-    cached_mirrored = mirrored;
+    cached_copies = copies;
   }
   return cached.get();
 }
@@ -177,9 +186,10 @@ BENCHMARK(BM_ExactStepAtScale)
     ->Arg(1000000)->Iterations(200)
     ->Unit(benchmark::kMicrosecond);
 
-// Arguments: states, and 1 for a library with mirrored copies.
+// Arguments: states, and the copies (enum Copies).
 void BM_BeamStepAtScale(benchmark::State& state) {
-  const TemplateModel* model = library_of(static_cast<int>(state.range(0)), state.range(1) != 0);
+  const TemplateModel* model =
+      library_of(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   if (model == nullptr) {
     state.SkipWithError("salsa data not found");
     return;
@@ -203,8 +213,10 @@ BENCHMARK(BM_BeamStepAtScale)
     ->Args({kRealStates, 0})
     ->Args({100000, 0})
     ->Args({1000000, 0})
-    ->Args({100000, 1})
-    ->Args({1000000, 1})
+    ->Args({100000, kMirrored})
+    ->Args({1000000, kMirrored})
+    ->Args({100000, kMirroredAfterReal})
+    ->Args({1000000, kMirroredAfterReal})
     ->Iterations(6000)
     ->Unit(benchmark::kMicrosecond);
 

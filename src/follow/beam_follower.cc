@@ -57,6 +57,9 @@ Status BeamParams::validate() const {
   if (wide_jump_candidates < jump_candidates) {
     return fail("wide_jump_candidates must be >= jump_candidates");
   }
+  if (radius_candidates < wide_jump_candidates) {
+    return fail("radius_candidates must be >= wide_jump_candidates");
+  }
   if (!(prune_ratio >= 0.0f && prune_ratio < 1.0f)) return fail("prune_ratio must be in [0, 1)");
   if (max_states < 1) return fail("max_states must be >= 1");
   if (!(outside_mass_tolerance >= 0.0f && std::isfinite(outside_mass_tolerance))) {
@@ -85,12 +88,12 @@ BeamContext::BeamContext(int num_states, const BeamParams& beam, int max_steps_p
   const std::size_t list =
       std::min(size, static_cast<std::size_t>(beam.max_states) *
                              (1 + 2 * static_cast<std::size_t>(std::max(1, max_steps_per_frame))) +
-                         static_cast<std::size_t>(beam.wide_jump_candidates));
+                         static_cast<std::size_t>(beam.radius_candidates));
   beam_.reserve(list);
   next_.reserve(list);
   weighted_.assign(list, 0.0f);
-  candidates_.assign(static_cast<std::size_t>(beam.wide_jump_candidates), 0);
-  candidate_d2_.assign(static_cast<std::size_t>(beam.wide_jump_candidates), 0.0f);
+  candidates_.assign(static_cast<std::size_t>(beam.radius_candidates), 0);
+  candidate_d2_.assign(static_cast<std::size_t>(beam.radius_candidates), 0.0f);
   reset();
 }
 
@@ -191,20 +194,42 @@ void BeamForward::sparse_transition(const BandProbabilities& band,
   context.beam_.swap(context.next_);
 }
 
-bool BeamForward::sparse_emission(const float* phi, int wanted, BeamContext& context,
-                                  FollowResult& result) const noexcept {
+BeamForward::CandidateSet BeamForward::nearest_candidates(const float* phi, int k,
+                                                          BeamContext& context) const noexcept {
+  CandidateSet set;
+  set.found =
+      index_->nearest(phi, k, context.candidates_.data(), context.candidate_d2_.data(), set.bound);
+  set.bounded = set.found == k;
+  std::sort(context.candidates_.data(), context.candidates_.data() + set.found);
+  return set;
+}
+
+BeamForward::CandidateSet BeamForward::candidates_within(const float* phi, float radius_sq,
+                                                         BeamContext& context) const noexcept {
+  CandidateSet set;
+  set.found = index_->within(phi, radius_sq, beam_.radius_candidates, context.candidates_.data(),
+                             context.candidate_d2_.data());
+  set.bound = radius_sq;
+  set.bounded = set.found < exact_.model_->num_states();
+  if (set.found > 0) {
+    std::sort(context.candidates_.data(), context.candidates_.data() + set.found);
+  }
+  return set;
+}
+
+bool BeamForward::sparse_emission(const float* phi, const CandidateSet& candidates,
+                                  BeamContext& context, FollowResult& result,
+                                  float& settling_bound) const noexcept {
   const TemplateModel& model = *exact_.model_;
   const int num_states = model.num_states();
   const FollowParams& params = exact_.params_;
   const float inv_two_sigma_sq = exact_.noise_levels_.inv_two_sigma_sq(context.frame_noise_);
   float* alpha = context.alpha_.data();
+  settling_bound = FLT_MAX;
 
   // The jump candidates, merged into the beam (both sorted) in next_.
-  float bound = 0.0f;
-  const int found =
-      index_->nearest(phi, wanted, context.candidates_.data(), context.candidate_d2_.data(), bound);
-  std::uint32_t* candidates = context.candidates_.data();
-  std::sort(candidates, candidates + found);
+  const int found = candidates.found;
+  const std::uint32_t* sorted = context.candidates_.data();
   context.next_.clear();
   {
     std::size_t b = 0;
@@ -212,7 +237,7 @@ bool BeamForward::sparse_emission(const float* phi, int wanted, BeamContext& con
     const std::size_t beam_size = context.beam_.size();
     while (b < beam_size || c < found) {
       const int from_beam = b < beam_size ? context.beam_[b] : num_states;
-      const int from_index = c < found ? static_cast<int>(candidates[c]) : num_states;
+      const int from_index = c < found ? static_cast<int>(sorted[c]) : num_states;
       const int state = std::min(from_beam, from_index);
       context.next_.push_back(state);
       if (from_beam == state) ++b;
@@ -227,12 +252,18 @@ bool BeamForward::sparse_emission(const float* phi, int wanted, BeamContext& con
     d2[k] = emission_distance(model, phi, context.next_[k], params.velocity_distance_cap);
     best = std::min(best, d2[k]);
   }
-  // Lost is decided on the best distance of the whole library; states left out are >= bound.
+  // The bound the states left out would have to be beyond for this frame's decisions to be the
+  // exact step's (0: they are already). Lost is decided on the best distance of the whole
+  // library; states left out are >= the bound.
+  const float bound = candidates.bound;
+  float needed = 0.0f;
   const float lost_sq = exact_.noise_levels_.lost_ceiling_sq();
-  if (found == wanted && best > lost_sq && bound <= lost_sq) return false;
   const float unexplained_sq = exact_.noise_levels_.lost_distance_sq(
       context.frame_noise_, context.history_.explained_residual.level());
-  if (found == wanted && best > unexplained_sq && bound <= unexplained_sq) return false;
+  if (candidates.bounded) {
+    if (best > lost_sq && bound <= lost_sq) needed = std::max(needed, lost_sq);
+    if (best > unexplained_sq && bound <= unexplained_sq) needed = std::max(needed, unexplained_sq);
+  }
 
   const float log_pause = exact_.noise_levels_.log_pause_emission(context.frame_noise_);
   const bool jump = params.jump_enabled;
@@ -249,25 +280,44 @@ bool BeamForward::sparse_emission(const float* phi, int wanted, BeamContext& con
   }
   const float pause = jump ? alpha[num_states] * std::exp(log_pause - shift) : 0.0f;
   sum += pause;
+  if (!(sum >= kMinNormaliser)) return false;
   // The states left out: their prediction is the background, their emission at most the
   // bound's. Their total is spread over up to M states, so it only matters where it could change
   // a decision: the maximum, the confidence window, the pause state's majority.
   float largest = 0.0f;
   for (std::size_t k = 0; k < count; ++k) largest = std::max(largest, weighted[k]);
-  if (found == wanted) {
+  if (candidates.bounded && background > 0.0f) {
+    // The smallest bound at which `share` of the background, emitted there, is at most `limit`
+    // (background * share * exp(-r / (2 s^2) - shift) <= limit).
+    const auto bound_for = [&](double share, double limit) {
+      if (!(limit > 0.0)) return FLT_MAX;
+      const double r =
+          (std::log(static_cast<double>(background) * share / limit) - static_cast<double>(shift)) /
+          static_cast<double>(inv_two_sigma_sq);
+      return static_cast<float>(std::clamp(r, 0.0, static_cast<double>(FLT_MAX)));
+    };
     const double emitted =
         std::exp(static_cast<double>(log_emission(bound, inv_two_sigma_sq) - shift));
     const double outside_total = static_cast<double>(background) * emitted;
     const double outside_state = static_cast<double>(background) * max_resume_share_ * emitted;
     const double window = 2.0 * params.confidence_window_frames + 1.0;
     const bool in_pause = pause > 0.5 * sum;
-    if (outside_state >= static_cast<double>(largest) ||
-        outside_state * window > beam_.outside_mass_tolerance * sum ||
-        in_pause != (pause > 0.5 * (sum + outside_total))) {
-      return false;
+    if (outside_state >= static_cast<double>(largest)) {
+      needed = std::max(needed, bound_for(max_resume_share_, largest));
+    }
+    if (outside_state * window > beam_.outside_mass_tolerance * sum) {
+      needed = std::max(needed,
+                        bound_for(max_resume_share_ * window, beam_.outside_mass_tolerance * sum));
+    }
+    if (in_pause != (pause > 0.5 * (sum + outside_total))) {
+      needed = std::max(needed, bound_for(1.0, 2.0 * pause - sum));
     }
   }
-  if (!(sum >= kMinNormaliser)) return false;
+  if (needed > 0.0f) {
+    // A little beyond, so that a search to it settles the frame (the tests above are strict).
+    settling_bound = needed < FLT_MAX / 2 ? needed * 1.001f + 1e-6f : FLT_MAX;
+    return false;
+  }
 
   // Accepted: the posterior over the merged states; those below the threshold leave the beam.
   const float scale = static_cast<float>(1.0 / sum);
@@ -289,6 +339,20 @@ bool BeamForward::sparse_emission(const float* phi, int wanted, BeamContext& con
   result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
   result.lost = best > lost_sq;
   return true;
+}
+
+bool BeamForward::sparse_step(const float* phi, BeamContext& context,
+                              FollowResult& result) const noexcept {
+  float settling_bound = FLT_MAX;
+  if (sparse_emission(phi, nearest_candidates(phi, beam_.jump_candidates, context), context, result,
+                      settling_bound) ||
+      sparse_emission(phi, nearest_candidates(phi, beam_.wide_jump_candidates, context), context,
+                      result, settling_bound)) {
+    return true;
+  }
+  if (settling_bound >= FLT_MAX) return false;
+  const CandidateSet within = candidates_within(phi, settling_bound, context);
+  return within.found >= 0 && sparse_emission(phi, within, context, result, settling_bound);
 }
 
 void BeamForward::materialise(BeamContext& context) const noexcept {
@@ -402,8 +466,7 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
         context.history_.noise_filter.apply(features, dt_s, context.frame_noise_);
     // Uncertain with the usual candidates: widen the search; still uncertain, the beam may have
     // lost the dancer: finish the frame with the full step.
-    if (!dense && !sparse_emission(phi.data(), beam_.jump_candidates, context, result) &&
-        !sparse_emission(phi.data(), beam_.wide_jump_candidates, context, result)) {
+    if (!dense && !sparse_step(phi.data(), context, result)) {
       materialise(context);
       dense = true;
     }

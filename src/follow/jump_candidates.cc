@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <istream>
 #include <ostream>
 #include <string>
@@ -26,6 +27,37 @@ struct ProjectedPoints {
   bool kdtree_get_bbox(Box& /*unused*/) const {
     return false;
   }
+};
+
+// nanoflann's result set for a radius search into caller-owned arrays of fixed capacity: the
+// search stops (addPoint returns false) at the first point beyond the capacity.
+class BoundedRadiusResult {
+ public:
+  BoundedRadiusResult(float radius_sq, std::size_t capacity, std::uint32_t* states, float* d2)
+      : radius_sq_(radius_sq), capacity_(capacity), states_(states), d2_(d2) {}
+  bool addPoint(float dist, std::uint32_t index) {
+    if (dist >= radius_sq_) return true;
+    if (count_ == capacity_) {
+      overflow_ = true;
+      return false;
+    }
+    states_[count_] = index;
+    d2_[count_] = dist;
+    ++count_;
+    return true;
+  }
+  float worstDist() const { return radius_sq_; }
+  bool full() const { return true; }
+  std::size_t size() const { return count_; }
+  bool overflow() const { return overflow_; }
+
+ private:
+  float radius_sq_;
+  std::size_t capacity_;
+  std::uint32_t* states_;
+  float* d2_;
+  std::size_t count_ = 0;
+  bool overflow_ = false;
 };
 
 using Tree =
@@ -90,21 +122,35 @@ Result<JumpCandidateIndex> JumpCandidateIndex::build(const TemplateModel& model)
   return JumpCandidateIndex(std::move(impl));
 }
 
-int JumpCandidateIndex::nearest(const float* phi, int k, std::uint32_t* states,
-                                float* projected_d2, float& bound) const noexcept {
+std::array<float, kDims> JumpCandidateIndex::project(const float* phi) const noexcept {
   const Impl& impl = *impl_;
   // Plain loops: an Eigen product of a dynamic difference would allocate its temporary.
-  float query[kDims] = {};
+  std::array<float, kDims> query{};
   for (int p = 0; p < impl.posture_dims; ++p) {
     const float centred = phi[p] - impl.mean[p];
-    for (int d = 0; d < kDims; ++d) query[d] += impl.axes(d, p) * centred;
+    for (int d = 0; d < kDims; ++d) query[static_cast<std::size_t>(d)] += impl.axes(d, p) * centred;
   }
+  return query;
+}
+
+int JumpCandidateIndex::nearest(const float* phi, int k, std::uint32_t* states,
+                                float* projected_d2, float& bound) const noexcept {
+  const std::array<float, kDims> query = project(phi);
   nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> result(static_cast<std::size_t>(k));
   result.init(states, projected_d2);
-  impl.tree->findNeighbors(result, query, nanoflann::SearchParams());
+  impl_->tree->findNeighbors(result, query.data(), nanoflann::SearchParams());
   const int found = static_cast<int>(result.size());
   bound = found == k ? result.worstDist() : 0.0f;
   return found;
+}
+
+int JumpCandidateIndex::within(const float* phi, float radius_sq, int capacity,
+                               std::uint32_t* states, float* projected_d2) const noexcept {
+  const std::array<float, kDims> query = project(phi);
+  BoundedRadiusResult result(radius_sq, static_cast<std::size_t>(std::max(capacity, 0)), states,
+                             projected_d2);
+  impl_->tree->findNeighbors(result, query.data(), nanoflann::SearchParams());
+  return result.overflow() ? -1 : static_cast<int>(result.size());
 }
 
 namespace {

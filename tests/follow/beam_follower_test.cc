@@ -153,6 +153,30 @@ TEST_F(BeamTest, ALongGapWidensTheBeamIntoAFullStepAndTheEstimatesAreTheSameAfte
   }
 }
 
+TEST_F(BeamTest, StatesWithinTheSettlingBoundSpareFullStepsAndKeepTheExactStates) {
+  // One nearest candidate leaves most frames uncertain; the states within the bound that settles
+  // the frame (a radius search) finish them sparsely. With room for a single such state the radius
+  // search overflows and the full step does it: the same states, more full steps.
+  BeamParams few;
+  few.jump_candidates = 1;
+  few.wide_jump_candidates = 1;
+  BeamParams no_radius = few;
+  no_radius.radius_candidates = 1;
+  HmmFollower exact = HmmFollower::create(model_, {}).value();
+  BeamFollower with_radius = BeamFollower::create(model_, {}, few).value();
+  BeamFollower without = BeamFollower::create(model_, {}, no_radius).value();
+  for (std::size_t t = 0; t < inputs_.size(); ++t) {
+    const FollowResult e = exact.step(inputs_[t], 1.0 / 60);
+    const FollowResult r = with_radius.step(inputs_[t], 1.0 / 60);
+    ASSERT_EQ(e.state, r.state) << "frame " << t;
+    EXPECT_EQ(e.lost, r.lost) << "frame " << t;
+    EXPECT_EQ(e.in_pause, r.in_pause) << "frame " << t;
+    EXPECT_NEAR(e.confidence, r.confidence, 1e-3) << "frame " << t;
+    ASSERT_EQ(e.state, without.step(inputs_[t], 1.0 / 60).state) << "frame " << t;
+  }
+  EXPECT_LT(with_radius.context().full_steps() * 2, without.context().full_steps());
+}
+
 TEST_F(BeamTest, PaperPresetAsTheExactStep) {
   const FollowParams paper = FollowParams::paper();
   HmmFollower exact = HmmFollower::create(model_, paper).value();
@@ -177,6 +201,11 @@ TEST(BeamParamsTest, RejectsBadParameters) {
   Result<BeamFollower> none = BeamFollower::create(model, {}, bad);
   ASSERT_FALSE(none);
   EXPECT_NE(none.error().message.find("jump_candidates"), std::string::npos);
+  bad = BeamParams{};
+  bad.radius_candidates = bad.wide_jump_candidates - 1;
+  Result<BeamFollower> small_radius = BeamFollower::create(model, {}, bad);
+  ASSERT_FALSE(small_radius);
+  EXPECT_NE(small_radius.error().message.find("radius_candidates"), std::string::npos);
   bad = BeamParams{};
   bad.prune_ratio = std::numeric_limits<float>::quiet_NaN();
   EXPECT_FALSE(BeamFollower::create(model, {}, bad));

@@ -11,8 +11,12 @@
 //   - Every state left out is at least the index's bound away from the input, so the mass each
 //     would have carried is bounded (the background's share times the bound's emission). When
 //     that could change a decision (the maximum, the confidence, the pause state's majority, or
-//     lost: the best distance of the library), or the beam grows past BeamParams::max_states,
-//     the frame is finished by the full (exact) step, and the beam is rebuilt from its posterior.
+//     lost: the best distance of the library), the search is widened: first to more nearest
+//     candidates, then to every state within the bound beyond which no left-out state could
+//     change it (a radius search of the index, when it holds at most
+//     BeamParams::radius_candidates states). When even that cannot settle the frame, or the
+//     beam grows past BeamParams::max_states, the frame is finished by the full (exact) step,
+//     and the beam is rebuilt from its posterior.
 //     Otherwise the posterior is normalised over the states kept: the left-out mass (spread over
 //     the far states, where the exact step keeps it below a per-state bound) is dropped, and the
 //     frame's log-likelihood misses it.
@@ -49,6 +53,10 @@ struct BeamParams {
   // before the full step is taken.
   int jump_candidates = 16;
   int wide_jump_candidates = 128;
+  // Still uncertain, every state within the bound that would settle the frame is taken (a radius
+  // search of the index), when there are at most this many; more, and the full step finishes
+  // the frame.
+  int radius_candidates = 4096;
   // A state leaves the beam when its posterior is below this times the largest one.
   float prune_ratio = 1e-8f;
   // Above this many states the next frame is a full step (a beam this wide saves nothing).
@@ -139,10 +147,27 @@ class BeamForward {
 
   float resume_share(int i) const noexcept;  // R_i
   void sparse_transition(const BandProbabilities& band, BeamContext& context) const noexcept;
-  // Emission over the beam and the jump candidates; false (context unchanged but for next_)
-  // when the full step must finish the frame.
-  bool sparse_emission(const float* phi, int candidates, BeamContext& context,
-                       FollowResult& result) const noexcept;
+  // Jump candidates of one frame, sorted in context.candidates_[0..found); every other state is
+  // at least `bound` away when `bounded` (false: the search returned every state it could).
+  struct CandidateSet {
+    int found = 0;
+    float bound = 0.0f;
+    bool bounded = false;
+  };
+  CandidateSet nearest_candidates(const float* phi, int k, BeamContext& context) const noexcept;
+  // Every state within radius_sq in the projection; found -1 when more than
+  // BeamParams::radius_candidates are.
+  CandidateSet candidates_within(const float* phi, float radius_sq,
+                                 BeamContext& context) const noexcept;
+  // The emission over the beam and the candidates, with the usual, then the wide candidates,
+  // then the states within the bound that settles the frame; false when none settles it and the
+  // full step must finish the frame.
+  bool sparse_step(const float* phi, BeamContext& context, FollowResult& result) const noexcept;
+  // Emission over the beam and these candidates; false (context unchanged but for next_) when
+  // the states left out could change a decision. settling_bound is then the bound beyond which
+  // they could not (FLT_MAX: none).
+  bool sparse_emission(const float* phi, const CandidateSet& candidates, BeamContext& context,
+                       FollowResult& result, float& settling_bound) const noexcept;
   // Adds the background to every state (the dense prediction of the full step).
   void materialise(BeamContext& context) const noexcept;
   void full_emission(const float* phi, BeamContext& context, FollowResult& result) const noexcept;

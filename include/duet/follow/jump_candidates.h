@@ -9,6 +9,7 @@
 // least `bound` away from the input: the follower can bound the mass it leaves out.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <iosfwd>
 #include <memory>
@@ -36,6 +37,13 @@ class JumpCandidateIndex {
   int nearest(const float* phi, int k, std::uint32_t* states, float* projected_d2,
               float& bound) const noexcept;
 
+  // Every state whose projected squared distance to phi is below radius_sq, up to `capacity` of
+  // them: writes their indices to states[0..n) (in no particular order) and returns n, or -1
+  // when more than `capacity` states lie within (the search stops there). Every other state's
+  // emission distance is >= radius_sq. Allocates nothing.
+  int within(const float* phi, float radius_sq, int capacity, std::uint32_t* states,
+             float* projected_d2) const noexcept;
+
   std::size_t memory_bytes() const noexcept;
   int num_states() const noexcept;
 
@@ -48,6 +56,8 @@ class JumpCandidateIndex {
 
  private:
   struct Impl;
+  // phi's posture on the index's principal axes.
+  std::array<float, kProjectedDims> project(const float* phi) const noexcept;
   explicit JumpCandidateIndex(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
