@@ -12,6 +12,7 @@
 #include <malloc.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -21,6 +22,7 @@
 #include <ctime>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "duet/features/feature_mirror.h"
@@ -248,6 +250,56 @@ void BM_ReadBandwidth(benchmark::State& state) {
   state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * state.range(0));
 }
 BENCHMARK(BM_ReadBandwidth)->Arg(27495 * 200)->Arg(1000000 * 200)->Unit(benchmark::kMicrosecond);
+
+// Would the second core pay (issue 13)? The same read split between this thread and a helper
+// thread that sleeps between frames (std::atomic wait/notify, as a live loop's helper would:
+// spinning would take the core the server's network and recorder threads run on). Each frame is
+// timed, wake-up included: median and p99 per frame, against BM_ReadBandwidth's one thread.
+void BM_ReadBandwidthTwoThreads(benchmark::State& state) {
+  if (!__builtin_cpu_supports("avx2")) {
+    state.SkipWithError("no AVX2 on this CPU");
+    return;
+  }
+  const auto floats = static_cast<std::size_t>(state.range(0)) / sizeof(float);
+  const std::size_t half = floats / 2;
+  std::vector<float> buffer(floats, 1.0f);
+  std::atomic<int> frame{0}, finished{0};
+  std::atomic<bool> quit{false};
+  std::thread helper([&] {
+    int seen = 0;
+    while (true) {
+      frame.wait(seen, std::memory_order_acquire);
+      if (quit.load()) return;
+      seen = frame.load(std::memory_order_acquire);
+      benchmark::DoNotOptimize(sum_avx2(buffer.data() + half, floats - half));
+      finished.store(seen, std::memory_order_release);
+    }
+  });
+  std::vector<double> frame_us;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    const int f = frame.fetch_add(1, std::memory_order_release) + 1;
+    frame.notify_one();
+    benchmark::DoNotOptimize(sum_avx2(buffer.data(), half));
+    while (finished.load(std::memory_order_acquire) != f) {
+    }
+    frame_us.push_back(
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
+            .count());
+  }
+  quit.store(true);
+  frame.fetch_add(1);
+  frame.notify_one();
+  helper.join();
+  state.counters["median_us"] = percentile(frame_us, 50);
+  state.counters["p99_us"] = percentile(frame_us, 99);
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * state.range(0));
+}
+BENCHMARK(BM_ReadBandwidthTwoThreads)
+    ->Arg(27495 * 200)
+    ->Arg(1000000 * 200)
+    ->Iterations(200)
+    ->Unit(benchmark::kMicrosecond);
 
 // Start-up from the model cache file: map it, check it, copy the features into the model (which
 // blocks them for the AVX2 kernel), load the jump candidate index and create the beam follower.
