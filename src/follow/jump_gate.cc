@@ -53,15 +53,19 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
       !follow_detail::is_jump(model, candidate_state_, result.state, steps, tolerance);
   held_s_ = same_candidate ? held_s_ + step_s : step_s;
   candidate_state_ = result.state;
-  if (held_s_ + 1e-6 >= hold) {  // (3 frames of 1/60 s make 0.05 s)
+  // The old place's reach: where its continuation would be.
+  const int take = model.take_of(previous_state);
+  const int begin = std::max(model.take_begin(take), previous_state - tolerance);
+  const int end = std::min(model.take_end(take), previous_state + 2 * steps + tolerance + 1);
+  double old_mass = 0.0;
+  for (int i = begin; i < end; ++i) old_mass += posterior[i];
+  if (held_s_ + 1e-6 >= hold &&  // (3 frames of 1/60 s make 0.05 s)
+      old_mass <= static_cast<double>(params.jump_old_place_mass) * total) {
     result.jumped = true;
     forget_candidate();
     return;
   }
   // Not yet: report the best state within reach of the old place.
-  const int take = model.take_of(previous_state);
-  const int begin = std::max(model.take_begin(take), previous_state - tolerance);
-  const int end = std::min(model.take_end(take), previous_state + 2 * steps + tolerance + 1);
   int best = begin;
   for (int i = begin + 1; i < end; ++i) {
     if (posterior[i] > posterior[best]) best = i;

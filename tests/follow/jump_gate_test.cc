@@ -78,10 +78,12 @@ TEST(JumpGate, AFarPlaceIsReportedOnlyOnceItHolds) {
   gate.apply(model, params, p.data(), 1.0f, 41, false, r);
   EXPECT_FALSE(r.jumped);
   EXPECT_EQ(r.state, 42);
-  // A real move to take 1 (advancing there) is reported on its third frame.
+  // A real move to take 1 (advancing there, the old place left with 1 % of the mass) is reported
+  // on its third frame.
   int previous = 42;
   for (int k = 0; k < 3; ++k) {
-    p = posterior(150 + k, previous + 1);
+    p = posterior(150 + k);
+    p[static_cast<std::size_t>(previous + 1)] = 0.01f;
     r = maximum_at(model, p, 150 + k);
     gate.apply(model, params, p.data(), 1.0f, previous, false, r);
     EXPECT_EQ(r.jumped, k == 2) << k;
@@ -187,10 +189,12 @@ TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
   r.jumped = false;
   gate.apply(model, params, p.data(), 1.0f, 41, false, r);
   EXPECT_FALSE(r.jumped);
-  // A real jump holds: reported on its third frame at 60 Hz (0.05 s >= 0.04 s).
+  // A real jump holds: reported on its third frame at 60 Hz (0.05 s >= 0.04 s); the old place
+  // keeps too little mass to hold it back.
   int previous = 42;
   for (int k = 0; k < 3; ++k) {
-    p = posterior(150 + k, previous + 1);
+    p = posterior(150 + k);
+    p[static_cast<std::size_t>(previous + 1)] = 0.01f;
     r = noisy(150 + k);
     gate.apply(model, params, p.data(), 1.0f, previous, false, r);
     EXPECT_EQ(r.jumped, k == 2) << k;
@@ -202,6 +206,47 @@ TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
   r = maximum_at(model, p, 150);
   clean.apply(model, params, p.data(), 1.0f, 40, false, r);
   EXPECT_TRUE(r.jumped);
+}
+
+TEST(JumpGate, UnderANoisySensorAFarPlaceWaitsUntilTheOldPlaceHasLostItsMass) {
+  FollowParams params;
+  params.jump_settle_s = 0.0f;
+  const TemplateModel model = two_takes();
+  const auto noisy = [&](int state) {
+    FollowResult r = maximum_at(model, {}, state);
+    r.sensor_noise_per_dim = 2.0f * params.noisy_jump_hold_level;
+    return r;
+  };
+  // The maximum sits at take 1 for six frames while the old place (the band's reach of the
+  // reported state) keeps 10 % of the mass: no jump, the old place goes on.
+  JumpGate gate;
+  int previous = 40;
+  for (int k = 0; k < 6; ++k) {
+    std::vector<float> p = posterior(150 + k, previous + 1);
+    FollowResult r = noisy(150 + k);
+    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+    EXPECT_FALSE(r.jumped) << k;
+    EXPECT_EQ(r.state, previous + 1) << k;
+    previous = r.state;
+  }
+  // Its mass gone (1 % left), the far place that has held on is reported at once.
+  std::vector<float> p = posterior(156);
+  p[static_cast<std::size_t>(previous + 1)] = 0.01f;
+  FollowResult r = noisy(156);
+  gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+  EXPECT_TRUE(r.jumped);
+  EXPECT_EQ(r.state, 156);
+  // With the criterion off (1) the hold alone decides: the third frame is a jump.
+  params.jump_old_place_mass = 1.0f;
+  JumpGate hold_only;
+  previous = 40;
+  for (int k = 0; k < 3; ++k) {
+    p = posterior(150 + k, previous + 1);
+    r = noisy(150 + k);
+    hold_only.apply(model, params, p.data(), 1.0f, previous, false, r);
+    EXPECT_EQ(r.jumped, k == 2) << k;
+    previous = r.state;
+  }
 }
 
 TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
@@ -216,6 +261,11 @@ TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
   EXPECT_FALSE(params.validate(200));
   params.noisy_jump_hold_s = 0.04f;
   params.noisy_jump_hold_level = 0.0f;
+  EXPECT_FALSE(params.validate(200));
+  params.noisy_jump_hold_level = 0.006f;
+  params.jump_old_place_mass = 1.5f;
+  EXPECT_FALSE(params.validate(200));
+  params.jump_old_place_mass = std::nanf("");
   EXPECT_FALSE(params.validate(200));
 }
 

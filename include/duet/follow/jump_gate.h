@@ -6,7 +6,9 @@
 // not a jump. A move out of the band's reach is reported only once the new place has held the
 // maximum for the hold in template time (a bounded decision delay; until then the best state near
 // the old place is reported): FollowParams::jump_hold_s, or under a noisy sensor the hold that
-// grows with the estimated noise (noisy_jump_hold_s).
+// grows with the estimated noise (noisy_jump_hold_s), and once the old place's reach holds at most
+// jump_old_place_mass of the posterior (a look-alike's brief maximum leaves the old place its
+// evidence; a real jump does not).
 // After a lost frame (or in the pause state) the new place is taken at once. Until the estimate
 // has first settled (FollowParams::jump_settle_s) a far move is the first placement being
 // refined: no jump is reported (half the false jumps left at 4 degrees per axis were those).
