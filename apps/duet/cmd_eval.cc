@@ -54,6 +54,7 @@ struct EvalArgs {
   std::optional<int> jump_tolerance;
   std::optional<float> jump_settle;
   std::optional<float> noisy_jump_hold;
+  std::optional<float> jump_old_place_mass;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
       pause_distance, lost_distance, velocity_cap, pause_noise_factor, lost_residual,
       lost_noise_factor, lost_residual_factor, emission_noise_factor, emission_noise_allowance,
@@ -223,6 +224,7 @@ int run_eval(EvalArgs& args) {
   if (args.jump_tolerance) hmm.jump_tolerance_frames = *args.jump_tolerance;
   if (args.jump_settle) hmm.jump_settle_s = *args.jump_settle;
   if (args.noisy_jump_hold) hmm.noisy_jump_hold_s = *args.noisy_jump_hold;
+  if (args.jump_old_place_mass) hmm.jump_old_place_mass = *args.jump_old_place_mass;
   if (Status s = hmm.validate(1); !s) return usage_error(s.error().message);
   if (args.dtw_back) options.dtw.window_back = *args.dtw_back;
   if (args.dtw_ahead) options.dtw.window_ahead = *args.dtw_ahead;
@@ -324,7 +326,7 @@ int run_eval(EvalArgs& args) {
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
       "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s "
-      "noisy_jump_hold {} s\n"
+      "noisy_jump_hold {} s jump_old_place_mass {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
       "lost_residual_factor {} emission_noise_factor {} emission_noise_allowance {} "
       "noise_filter_density {} noise_filter_allowance {}\n\n",
@@ -334,7 +336,7 @@ int run_eval(EvalArgs& args) {
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
       hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.noisy_jump_hold_s,
-      hmm.pause_noise_factor, hmm.lost_residual_per_dim, hmm.lost_noise_factor,
+      hmm.jump_old_place_mass, hmm.pause_noise_factor, hmm.lost_residual_per_dim, hmm.lost_noise_factor,
       hmm.lost_residual_factor, hmm.emission_noise_factor, hmm.emission_noise_allowance,
       hmm.noise_filter_density, hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
@@ -558,6 +560,12 @@ Command register_eval(CLI::App& app) {
                    "noisy_jump_hold_s: the jump hold under a noisy sensor, reached at "
                    "noisy_jump_hold_level of estimated noise (template seconds; 0 for none)")
       ->check(number_between(0.0, 10.0));
+  tuning
+      ->add_option("--jump-old-place-mass", args->jump_old_place_mass,
+                   "jump_old_place_mass: while a hold applies, a far place is reported only once "
+                   "the old place's reach holds at most this share of the posterior (1 for the "
+                   "hold alone)")
+      ->check(number_between(0.0, 1.0));
   tuning
       ->add_option("--jump-settle", args->jump_settle,
                    "jump_settle_s: after the start, moves of the estimate are the first placement "
