@@ -55,6 +55,7 @@ struct EvalArgs {
   std::optional<float> jump_settle;
   std::optional<float> noisy_jump_hold;
   std::optional<float> jump_old_place_mass;
+  std::optional<float> jump_settle_mass;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
       pause_distance, lost_distance, velocity_cap, pause_noise_factor, lost_residual,
       lost_noise_factor, lost_residual_factor, emission_noise_factor, emission_noise_allowance,
@@ -225,6 +226,7 @@ int run_eval(EvalArgs& args) {
   if (args.jump_settle) hmm.jump_settle_s = *args.jump_settle;
   if (args.noisy_jump_hold) hmm.noisy_jump_hold_s = *args.noisy_jump_hold;
   if (args.jump_old_place_mass) hmm.jump_old_place_mass = *args.jump_old_place_mass;
+  if (args.jump_settle_mass) hmm.jump_settle_mass = *args.jump_settle_mass;
   if (Status s = hmm.validate(1); !s) return usage_error(s.error().message);
   if (args.dtw_back) options.dtw.window_back = *args.dtw_back;
   if (args.dtw_ahead) options.dtw.window_ahead = *args.dtw_ahead;
@@ -326,7 +328,7 @@ int run_eval(EvalArgs& args) {
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
       "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s "
-      "noisy_jump_hold {} s jump_old_place_mass {}\n"
+      "(mass {}) noisy_jump_hold {} s jump_old_place_mass {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
       "lost_residual_factor {} emission_noise_factor {} emission_noise_allowance {} "
       "noise_filter_density {} noise_filter_allowance {}\n\n",
@@ -335,10 +337,11 @@ int run_eval(EvalArgs& args) {
       hmm.leave_prob, hmm.pause_stay_prob, hmm.emission_sigma, hmm.pause_distance_per_dim,
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
-      hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.noisy_jump_hold_s,
-      hmm.jump_old_place_mass, hmm.pause_noise_factor, hmm.lost_residual_per_dim, hmm.lost_noise_factor,
-      hmm.lost_residual_factor, hmm.emission_noise_factor, hmm.emission_noise_allowance,
-      hmm.noise_filter_density, hmm.noise_filter_allowance);
+      hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.jump_settle_mass,
+      hmm.noisy_jump_hold_s, hmm.jump_old_place_mass, hmm.pause_noise_factor,
+      hmm.lost_residual_per_dim, hmm.lost_noise_factor, hmm.lost_residual_factor,
+      hmm.emission_noise_factor, hmm.emission_noise_allowance, hmm.noise_filter_density,
+      hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
   if (!non_dance.value().empty()) {
     fmt::print(
@@ -572,6 +575,11 @@ Command register_eval(CLI::App& app) {
                    "being refined, not jumps, until it has held one place this long (template "
                    "seconds; 0 for none)")
       ->check(number_between(0.0, 10.0));
+  tuning
+      ->add_option("--jump-settle-mass", args->jump_settle_mass,
+                   "jump_settle_mass: only frames with at least this window mass count towards "
+                   "settling the first placement (0 for every frame)")
+      ->check(number_between(0.0, 1.0));
   tuning->add_option("--dtw-back", args->dtw_back, "online DTW window behind the estimate")
       ->check(non_negative_check());
   tuning->add_option("--dtw-ahead", args->dtw_ahead, "online DTW window ahead of the estimate")

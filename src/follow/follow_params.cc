@@ -24,6 +24,7 @@ FollowParams FollowParams::paper() {
   params.jump_hold_s = 0.0f;
   params.jump_tolerance_frames = 0;
   params.jump_settle_s = 0.0f;
+  params.jump_settle_mass = 0.0f;
   params.noisy_jump_hold_s = 0.0f;
   params.jump_old_place_mass = 1.0f;
   params.pause_noise_factor = 0.0f;
@@ -117,6 +118,10 @@ Status FollowParams::validate(int num_states) const {
   if (!(noisy_jump_hold_level > 0.0f && std::isfinite(noisy_jump_hold_level))) {
     return params_error("noisy_jump_hold_level must be finite and > 0, got " +
                         std::to_string(noisy_jump_hold_level));
+  }
+  if (!(jump_settle_mass >= 0.0f && jump_settle_mass <= 1.0f)) {
+    return params_error("jump_settle_mass must be in [0, 1], got " +
+                        std::to_string(jump_settle_mass));
   }
   if (!(jump_settle_s >= 0.0f && jump_settle_s <= 10.0f)) {
     return params_error("jump_settle_s must be in [0, 10] s, got " + std::to_string(jump_settle_s));

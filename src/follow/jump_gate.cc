@@ -29,7 +29,10 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
       !follow_detail::is_jump(model, previous_state, result.state, steps, tolerance)) {
     // Within reach of the old place: no jump, whatever the raw maximum's step was.
     result.jumped = false;
-    if (previous_state >= 0 && result.state >= 0) settled_s_ += step_s;
+    // Settling counts the frames the follower is sure of; once settled, it stays settled.
+    const bool sure = settled_s_ + 1e-6 >= params.jump_settle_s ||
+                      result.window_mass >= params.jump_settle_mass;
+    if (previous_state >= 0 && result.state >= 0 && sure) settled_s_ += step_s;
     forget_candidate();
     return;
   }

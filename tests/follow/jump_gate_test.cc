@@ -30,6 +30,7 @@ FollowResult maximum_at(const TemplateModel& model, const std::vector<float>& p,
   r.take = model.take_of(state);
   r.frame_in_take = state - model.take_begin(r.take);
   r.jumped = true;  // what decide() says of any move out of the band
+  r.window_mass = 1.0f;  // a sure maximum (settles the first placement)
   (void)p;
   return r;
 }
@@ -147,6 +148,21 @@ TEST(JumpGate, TheFirstPlacementIsRefinedWithoutJumpsUntilItHasSettled) {
   FollowResult r = maximum_at(model, p, 140);
   gate.apply(model, params, p.data(), 1.0f, previous, false, r);
   EXPECT_TRUE(r.jumped);
+  // Frames the follower is unsure of (window mass under jump_settle_mass) do not settle it.
+  JumpGate unsure;
+  previous = 60;
+  for (int k = 1; k <= 12; ++k) {
+    const std::vector<float> q = posterior(60 + k);
+    FollowResult u = maximum_at(model, q, 60 + k);
+    u.window_mass = 0.9f;
+    unsure.apply(model, params, q.data(), 1.0f, previous, false, u);
+    previous = u.state;
+  }
+  FollowResult far = maximum_at(model, p, 140);
+  far.window_mass = 0.9f;
+  unsure.apply(model, params, p.data(), 1.0f, previous, false, far);
+  EXPECT_FALSE(far.jumped);
+  EXPECT_EQ(far.state, 140);
   // reset() starts the first placement over.
   gate.reset();
   p = posterior(20);
@@ -266,6 +282,9 @@ TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
   params.jump_old_place_mass = 1.5f;
   EXPECT_FALSE(params.validate(200));
   params.jump_old_place_mass = std::nanf("");
+  EXPECT_FALSE(params.validate(200));
+  params.jump_old_place_mass = 0.05f;
+  params.jump_settle_mass = -0.5f;
   EXPECT_FALSE(params.validate(200));
 }
 

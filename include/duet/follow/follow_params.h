@@ -154,6 +154,10 @@ struct FollowParams {
   // reach of its place from frame to frame for jump_settle_s (template time), a far move takes
   // the new place without reporting a jump. 0: every far move is a jump from the first frame on.
   float jump_settle_s = 0.1f;
+  // ... counting only frames the follower is sure of (window mass at least jump_settle_mass):
+  // under noise a standing start sits on one take's standing frames with a window mass of
+  // 0.4-0.9 before it moves to another's. 0: every frame within reach counts.
+  float jump_settle_mass = 0.99f;
 
   // Input at another rate: each input frame applies n = clamp(round(dt_s * template_fps), 1,
   // max_steps_per_frame) template-rate transitions before its emission.

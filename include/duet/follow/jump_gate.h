@@ -10,8 +10,9 @@
 // jump_old_place_mass of the posterior (a look-alike's brief maximum leaves the old place its
 // evidence; a real jump does not).
 // After a lost frame (or in the pause state) the new place is taken at once. Until the estimate
-// has first settled (FollowParams::jump_settle_s) a far move is the first placement being
-// refined: no jump is reported (half the false jumps left at 4 degrees per axis were those).
+// has first settled (FollowParams::jump_settle_s of frames within reach with a window mass of at
+// least jump_settle_mass) a far move is the first placement being refined: no jump is reported
+// (half the false jumps left at 4 degrees per axis were those).
 #pragma once
 
 #include "duet/follow/follow_params.h"
