@@ -498,7 +498,7 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
                           result.steps, params.confidence_window_frames, result);
   } else {
     follow_detail::describe_state(model, alpha, 1.0f, sparse_argmax(context),
-                                  params.confidence_window_frames, result);
+                                  params.confidence_window_frames, result, context.beam_);
     result.in_pause = alpha[num_states] > 0.5f;
     result.jumped =
         follow_detail::is_jump(model, context.history_.previous_state, result.state, result.steps);

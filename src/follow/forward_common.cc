@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "duet/follow/copy_places.h"
 #include "duet/follow/simd.h"
 #include "kernels_avx2.h"
 
@@ -167,12 +168,17 @@ bool is_jump(const TemplateModel& model, int previous_state, int state, int step
 }
 
 void describe_state(const TemplateModel& model, const float* posterior, float total, int state,
-                    int window, FollowResult& result) noexcept {
+                    int window, FollowResult& result, std::span<const int> support) noexcept {
   const int take = model.take_of(state);
-  const int begin = std::max(model.take_begin(take), state - window);
-  const int end = std::min(model.take_end(take), state + window + 1);
   float mass = 0.0f;
-  for (int i = begin; i < end; ++i) mass += posterior[i];
+  if (const CopyPlaces* places = model.copy_places(); places != nullptr) {
+    mass = support.empty() ? places->window_mass(posterior, state, window)
+                           : places->window_mass(posterior, state, window, support);
+  } else {
+    const int begin = std::max(model.take_begin(take), state - window);
+    const int end = std::min(model.take_end(take), state + window + 1);
+    for (int i = begin; i < end; ++i) mass += posterior[i];
+  }
   result.state = state;
   result.take = take;
   result.frame_in_take = state - model.take_begin(take);

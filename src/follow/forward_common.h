@@ -77,8 +77,11 @@ void normalise(float* mass, int count, int uniform_count) noexcept;
 
 // Fills state (= `state`), take, frame_in_take and confidence (mass within +/- window frames in
 // the same take, divided by total).
+// In a library grown with copies (TemplateModel::copy_places) the window is taken in the captured
+// takes, over every copy; `support`, when not empty, lists the only states that can hold mass
+// (a beam), which is then all that is read.
 void describe_state(const TemplateModel& model, const float* posterior, float total, int state,
-                    int window, FollowResult& result) noexcept;
+                    int window, FollowResult& result, std::span<const int> support = {}) noexcept;
 
 // Fills state (argmax of posterior over the M template states, eq. 8-9), take, frame_in_take,
 // confidence (mass within +/- window frames in the same take, divided by total), in_pause

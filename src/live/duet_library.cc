@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "duet/base/content_hash.h"
+#include "duet/follow/copy_places.h"
 #include "duet/follow/model_cache.h"
 #include "duet/io/motion_argument.h"
 
@@ -83,8 +84,8 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
     if (!leader) return leader.error();
     Result<LoadedMotion> partner = load_motion(pair.partner, options.load);
     if (!partner) return partner.error();
-    const std::string what = "pair " + std::to_string(k + 1) + " (" + leader_word + ", " +
-                             partner_word + ")";
+    const std::string what =
+        "pair " + std::to_string(k + 1) + " (" + leader_word + ", " + partner_word + ")";
     if (Status ok = check_duet(what, leader.value(), partner.value(), options.trim_to_shorter);
         !ok) {
       return ok.error();
@@ -96,7 +97,8 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
     take.response_motion = std::move(user_leads ? partner.value() : leader.value());
     take.first_state = total_frames;
     if (!library.takes_.empty() &&
-        std::abs(take.template_motion.clip.frame_rate() - library.takes_[0].template_motion.clip.frame_rate()) > 1e-9) {
+        std::abs(take.template_motion.clip.frame_rate() -
+                 library.takes_[0].template_motion.clip.frame_rate()) > 1e-9) {
       return Error{what + ": every duet in a library must have the same frame rate"};
     }
     Result<FeatureExtractor> extractor = FeatureExtractor::create(
@@ -106,7 +108,8 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
     total_frames += take.template_motion.clip.frame_count();
     library.takes_.push_back(std::move(take));
   }
-  if (progress) progress(static_cast<int>(pairs.size()), static_cast<int>(pairs.size()), "features");
+  if (progress)
+    progress(static_cast<int>(pairs.size()), static_cast<int>(pairs.size()), "features");
 
   FeatureMatrix all(total_frames, options.features.dimension());
   std::vector<int> take_start;
@@ -133,8 +136,8 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
 std::uint64_t DuetLibrary::model_key(const FeatureMatrix& features,
                                      const std::vector<int>& take_start, int velocity_dims,
                                      const LibraryOptions& options) {
-  std::uint64_t key = content_hash(features.data(), static_cast<std::size_t>(features.size()) *
-                                                        sizeof(float));
+  std::uint64_t key =
+      content_hash(features.data(), static_cast<std::size_t>(features.size()) * sizeof(float));
   key = content_hash(take_start.data(), take_start.size() * sizeof(int), key);
   const std::int64_t shape[] = {features.rows(), features.cols(), velocity_dims,
                                 options.grow_to_states, options.grow_seed};
@@ -160,22 +163,33 @@ Status DuetLibrary::grow_and_cache(TemplateModel captured, std::uint64_t key) {
     if (options_.grow_to_states == 0) return captured;
     return synthesize_library(captured, grow);
   };
+  // A grown library's confidence counts every copy of a moment (copy_places.h).
+  const auto with_copy_places = [&](TemplateModel model) -> Result<TemplateModel> {
+    if (copy_sources_.empty()) return model;
+    Result<CopyPlaces> places = CopyPlaces::build(model, captured.num_takes(), copy_sources_);
+    if (!places) return places.error();
+    model.set_copy_places(std::make_shared<const CopyPlaces>(std::move(places).value()));
+    return model;
+  };
   if (options_.model_cache.empty()) {
     Result<TemplateModel> model = build();
     if (!model) return model.error();
-    model_ = std::make_shared<const TemplateModel>(std::move(model).value());
+    Result<TemplateModel> placed = with_copy_places(std::move(model).value());
+    if (!placed) return placed.error();
+    model_ = std::make_shared<const TemplateModel>(std::move(placed).value());
   } else {
     Result<CachedModel> cached =
         load_or_build_model_cache(options_.model_cache, key, build, &model_cache_note_);
     if (!cached) return cached.error();
-    model_ = std::make_shared<const TemplateModel>(std::move(cached.value().model));
-    candidate_index_ =
-        std::make_shared<const JumpCandidateIndex>(std::move(cached.value().index));
+    Result<TemplateModel> placed = with_copy_places(std::move(cached.value().model));
+    if (!placed) return placed.error();
+    model_ = std::make_shared<const TemplateModel>(std::move(placed).value());
+    candidate_index_ = std::make_shared<const JumpCandidateIndex>(std::move(cached.value().index));
   }
   const std::size_t takes = takes_.size() + copy_sources_.size();
   if (static_cast<std::size_t>(model_->num_takes()) != takes) {
-    return Error{"the library model has " + std::to_string(model_->num_takes()) +
-                 " takes where " + std::to_string(takes) + " were expected"};
+    return Error{"the library model has " + std::to_string(model_->num_takes()) + " takes where " +
+                 std::to_string(takes) + " were expected"};
   }
   return Ok{};
 }

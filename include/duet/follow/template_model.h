@@ -15,6 +15,8 @@
 
 namespace duet {
 
+class CopyPlaces;
+
 // Row i is the feature vector phi_i of template state i. Row-major float: the per-frame emission
 // streams through every row once, so rows must be contiguous and small (27k x 60 floats = 6.5 MB).
 using FeatureMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -69,6 +71,14 @@ class TemplateModel {
   // The take that contains state (O(log takes)); state must be in [0, M).
   int take_of(int state) const;
 
+  // A library grown with copies of its takes (copy_places.h): where each state sits in the
+  // captured takes, for a confidence that counts every copy of a moment. Null otherwise. Set
+  // once, before the model is shared; copies of the model share it.
+  const CopyPlaces* copy_places() const { return copy_places_.get(); }
+  void set_copy_places(std::shared_ptr<const CopyPlaces> places) {
+    copy_places_ = std::move(places);
+  }
+
  private:
   TemplateModel() = default;
 
@@ -84,6 +94,7 @@ class TemplateModel {
   std::vector<int> take_start_;          // num_takes + 1 entries; the last one is M
   double frame_rate_hz_ = 0.0;
   int velocity_dims_ = 0;
+  std::shared_ptr<const CopyPlaces> copy_places_;
 };
 
 }  // namespace duet
