@@ -85,7 +85,11 @@ TEST(NoAllocation, StepsAllocateNothing) {
       BeamFollower::create(model, FollowParams::paper(),
                            BeamParams::suited_to(FollowParams::paper()))
           .value();
-  Tracker* trackers[] = {&hmm, &l2r, &hmm_sharp, &naive, &nn, &dtw, &beam, &beam_paper};
+  BeamParams few;  // one nearest candidate: most frames widen to the radius search
+  few.jump_candidates = few.wide_jump_candidates = 1;
+  BeamFollower beam_radius = BeamFollower::create(model, {}, few).value();
+  Tracker* trackers[] = {&hmm, &l2r, &hmm_sharp, &naive, &nn, &dtw, &beam, &beam_paper,
+                         &beam_radius};
 
   // Inputs made beforehand: exact, noisy, missing, far, at 30 Hz and late.
   std::vector<std::vector<float> > inputs;
