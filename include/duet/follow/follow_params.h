@@ -155,8 +155,8 @@ struct FollowParams {
   // the new place without reporting a jump. 0: every far move is a jump from the first frame on.
   float jump_settle_s = 0.1f;
   // ... counting only frames the follower is sure of (window mass at least jump_settle_mass):
-  // under noise a standing start sits on one take's standing frames with a window mass of
-  // 0.4-0.9 before it moves to another's. 0: every frame within reach counts.
+  // under noise the first placement often sits on a look-alike place of another take with a
+  // window mass of 0.6-0.97 before the maximum moves on. 0: every frame within reach counts.
   float jump_settle_mass = 0.99f;
 
   // Input at another rate: each input frame applies n = clamp(round(dt_s * template_fps), 1,
