@@ -251,6 +251,8 @@ void PartnerMetricsAccumulator::add(const Performance& performance,
       ground_speed_sum_mps_ += r.ground_speed_sum_mps;
       ground_feet_ += r.ground_feet;
       frame_max_rad_s_.push_back(r.max_angular_speed_rad_s);
+      if (!performance.truth[f].jump)
+        true_frame_max_rad_s_.push_back(r.true_max_angular_speed_rad_s);
       max_slide_mps_ = std::max(max_slide_mps_, r.planted_slide_mps);
       sliding_frames_ += r.planted_slide_mps > options_.slide_limit_mps ? 1 : 0;
     }
@@ -338,6 +340,8 @@ void PartnerMetricsAccumulator::merge(const PartnerMetricsAccumulator& other) {
                               other.jump_true_max_rad_s_.end());
   frame_max_rad_s_.insert(frame_max_rad_s_.end(), other.frame_max_rad_s_.begin(),
                           other.frame_max_rad_s_.end());
+  true_frame_max_rad_s_.insert(true_frame_max_rad_s_.end(), other.true_frame_max_rad_s_.begin(),
+                               other.true_frame_max_rad_s_.end());
   jump_rejoin_s_.insert(jump_rejoin_s_.end(), other.jump_rejoin_s_.begin(),
                         other.jump_rejoin_s_.end());
   jump_spacing_m_.insert(jump_spacing_m_.end(), other.jump_spacing_m_.begin(),
@@ -424,6 +428,10 @@ PartnerMetrics PartnerMetricsAccumulator::summary() const {
   m.frame_speed_deg_s = rad_to_deg(quantile(frame_max_rad_s_, options_.reference_percentile));
   m.captured_frame_speed_deg_s =
       rad_to_deg(quantile(reference_.frame_max_rad_s, options_.reference_percentile));
+  if (!true_frame_max_rad_s_.empty()) {
+    m.true_frame_speed_deg_s =
+        rad_to_deg(quantile(true_frame_max_rad_s_, options_.reference_percentile));
+  }
   m.max_slide_mps = max_slide_mps_;
   m.sliding_frames = sliding_frames_;
   return m;

@@ -102,13 +102,13 @@ void append_steadiness_table(std::string& out, const EvalReport& report) {
   const PartnerMetricsOptions& o = report.partner_options;
   out += "\npartner steadiness and transitions after jumps (issue 11; docs/evaluation.md):\n";
   constexpr const char* kHeader =
-      "{:<18} {:<12} {:>8} {:>8} {:>6} {:>8} {:>8} {:>7} {:>8} {:>8} {:>7} {:>8} {:>8} {:>8} "
-      "{:>6} {:>8} {:>7}\n";
+      "{:<18} {:<12} {:>8} {:>8} {:>6} {:>6} {:>8} {:>8} {:>7} {:>8} {:>8} {:>7} {:>8} {:>8} "
+      "{:>8} {:>6} {:>8} {:>7}\n";
   fmt::format_to(std::back_inserter(out), kHeader, "case", "corrections", "speed", "captured",
-                 "ratio", "hand med", "sensed", ">win99", "rejoin", "rejoin", "in time", "spacing",
-                 "spacing", "slide", ">limit", "slide", ">limit");
+                 "ratio", "x true", "hand med", "sensed", ">win99", "rejoin", "rejoin", "in time",
+                 "spacing", "spacing", "slide", ">limit", "slide", ">limit");
   fmt::format_to(std::back_inserter(out), kHeader, "", "",
-                 fmt::format("p{:g}", 100.0 * o.reference_percentile), "deg/s", "", "cm", "cm",
+                 fmt::format("p{:g}", 100.0 * o.reference_percentile), "deg/s", "", "", "cm", "cm",
                  "jumps", "med s", "max s", "jumps", "med cm", "max cm", "jump m/s", "jumps",
                  "all m/s", "frames");
   for (const PartnerRow& row : report.partner_rows) {
@@ -122,6 +122,8 @@ void append_steadiness_table(std::string& out, const EvalReport& report) {
         fmt::format("{:.0f}", m.captured_frame_speed_deg_s),
         partner_cell(m.captured_frame_speed_deg_s > 0.0,
                      m.frame_speed_deg_s / std::max(m.captured_frame_speed_deg_s, 1e-9), 2),
+        partner_cell(m.true_frame_speed_deg_s > 0.0,
+                     m.frame_speed_deg_s / std::max(m.true_frame_speed_deg_s, 1e-9), 2),
         partner_cell(hands, m.median_hand_error_cm, 2),
         partner_cell(hands, m.median_sensed_hand_error_cm, 2),
         jumps ? fmt::format("{}/{}", m.jumps_over_window_reference, m.jumps) : "-",
@@ -141,6 +143,10 @@ void append_steadiness_table(std::string& out, const EvalReport& report) {
        fmt::format("p{:g} of the per-frame largest joint angular speed: the partner's, the "
                    "captured partner's over the same takes; ratio = speed / captured",
                    100.0 * o.reference_percentile));
+  line("x true",
+       "speed / the same percentile of the true response as the performance shows it "
+       "(the captured partner at the true frames and the performance's timing: a "
+       "faster dance asks a faster partner)");
   line("hand med, sensed",
        "median over contact frames of |partner wrist to user wrist - captured|, the user's real "
        "wrist (before the sensor's noise) and the wrist the sensor reports");
@@ -230,7 +236,7 @@ void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::
                  "{},{},{},{},{},{},{:.4f},{},{:.4f},{:.4f},{:.5f},{:.5f},{:.3f},{:.3f},{},{:.2f},"
                  "{:.2f},{},"
                  "{:.2f},{},{:.2f},{:.5f},{:.3f},{:.2f},{:.2f},{},{},{:.2f},{:.2f},{:.2f},{:.2f},"
-                 "{:.3f},{:.3f},{},{:.2f},{:.2f},{:.3f},{},{:.3f},{},{:.4f}\n",
+                 "{:.3f},{:.3f},{},{:.2f},{:.2f},{:.3f},{},{:.3f},{},{:.4f},{:.2f}\n",
                  row.case_name, row.config, take, take_name, row.aligned ? 1 : 0, m.frames,
                  m.mean_joint_error_cm, m.hand_samples, m.median_hand_error_cm,
                  m.mean_hand_error_cm, m.slip_rate, m.captured_slip_rate, m.ground_speed_cm_s,
@@ -243,7 +249,7 @@ void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::
                  m.captured_frame_speed_deg_s, m.median_rejoin_s, m.max_rejoin_s,
                  m.jumps_rejoined_in_time, m.median_spacing_error_cm, m.max_spacing_error_cm,
                  m.max_jump_slide_mps, m.jumps_sliding, m.max_slide_mps, m.sliding_frames,
-                 m.median_sensed_hand_error_cm);
+                 m.median_sensed_hand_error_cm, m.true_frame_speed_deg_s);
 }
 
 // reliability.dat and its plot: per case, the 10 confidence bins of the first tracker (hmm when
@@ -307,7 +313,8 @@ std::string format_partner_csv(const EvalReport& report) {
       "jumps_over_window_reference,jumps_over_window_reference_and_truth,mean_jerk_mps3,"
       "true_mean_jerk_mps3,frame_speed_deg_s,captured_frame_speed_deg_s,median_rejoin_s,"
       "max_rejoin_s,jumps_rejoined_in_time,median_spacing_error_cm,max_spacing_error_cm,"
-      "max_jump_slide_mps,jumps_sliding,max_slide_mps,sliding_frames,median_sensed_hand_error_cm\n";
+      "max_jump_slide_mps,jumps_sliding,max_slide_mps,sliding_frames,median_sensed_hand_error_cm,"
+      "true_frame_speed_deg_s\n";
   for (const PartnerRow& row : report.partner_rows) {
     for (const auto& [take, metrics] : row.per_take) {
       append_partner_csv_row(out, row, std::to_string(take), take_name(report, take), metrics);

@@ -273,6 +273,9 @@ TEST(PartnerMetricsAccumulator, SteadinessAndTheTransitionAfterAJump) {
   for (int f = 0; f < 30; ++f) {
     PartnerFrameRecord& r = records[static_cast<std::size_t>(f)];
     r.max_angular_speed_rad_s = 1.0 + 0.01 * f;  // p99 of frames 1..29: frame 29's 1.29
+    // The true response: frame 29's 2.29 is its p99, unless the jump frames (where the true
+    // response is cut, and the record holds no speed of its own) were counted.
+    r.true_max_angular_speed_rad_s = f == 5 || f == 20 ? 10.0 : 2.0 + 0.01 * f;
     if (f >= 5 && f < 8) r.hands_joined = false;
     if (f >= 20) r.hands_joined = false;
     r.spacing_error_m = f >= 5 && f < 7 ? 0.5 : (f >= 20 && f < 25 ? 0.4 - 0.1 * (f - 20) : 0.01);
@@ -289,6 +292,7 @@ TEST(PartnerMetricsAccumulator, SteadinessAndTheTransitionAfterAJump) {
   ASSERT_EQ(m.jumps, 2);
   EXPECT_NEAR(m.frame_speed_deg_s, rad_to_deg(1.29), 1e-9);
   EXPECT_NEAR(m.captured_frame_speed_deg_s, rad_to_deg(0.99), 1e-9);
+  EXPECT_NEAR(m.true_frame_speed_deg_s, rad_to_deg(2.29), 1e-9);
   EXPECT_TRUE(std::isinf(m.max_rejoin_s));  // the second jump never rejoins
   EXPECT_TRUE(std::isinf(m.median_rejoin_s));
   EXPECT_EQ(m.jumps_rejoined_in_time, 1);  // the first, at 0.3 s

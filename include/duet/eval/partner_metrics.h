@@ -245,6 +245,11 @@ struct PartnerMetrics {
   // output (frames from the second) and of the captured response over the same takes.
   double frame_speed_deg_s = 0.0;
   double captured_frame_speed_deg_s = 0.0;
+  // The same percentile for the true response as the performance shows it (the captured partner
+  // at the true frames, at the performance's timing; frames of a true jump left out, where the
+  // true response is cut): a performance danced 1.4x faster than the capture asks a partner
+  // 1.4x faster than the captured one. 0 without such frames.
+  double true_frame_speed_deg_s = 0.0;
   // After the jumps (the `jumps` above): rejoin time, median and largest over jumps (seconds;
   // infinity when some jump did not rejoin within rejoin_search_s), and how many rejoined within
   // rejoin_deadline_s.
@@ -286,10 +291,11 @@ class PartnerMetricsAccumulator {
   std::vector<double> hand_errors_m_, sensed_hand_errors_m_;
   std::vector<double> jump_max_rad_s_;  // one per jump window
   std::vector<double> jump_true_max_rad_s_;
-  std::vector<double> frame_max_rad_s_;  // output, frames from the second
-  std::vector<double> jump_rejoin_s_;    // per jump window; infinity: not rejoined
-  std::vector<double> jump_spacing_m_;   // per jump, rejoin_deadline_s after it
-  std::vector<double> jump_slide_mps_;   // per jump, largest planted slide in the window
+  std::vector<double> frame_max_rad_s_;       // output, frames from the second
+  std::vector<double> true_frame_max_rad_s_;  // the true response, frames that are no true jump
+  std::vector<double> jump_rejoin_s_;         // per jump window; infinity: not rejoined
+  std::vector<double> jump_spacing_m_;        // per jump, rejoin_deadline_s after it
+  std::vector<double> jump_slide_mps_;        // per jump, largest planted slide in the window
   double max_slide_mps_ = 0.0;
   long long sliding_frames_ = 0;
   CapturedReference reference_;
