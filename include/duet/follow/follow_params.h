@@ -153,7 +153,10 @@ struct FollowParams {
   // finding where the dancer is, not the dancer jumping. Until the estimate has stayed within
   // reach of its place from frame to frame for jump_settle_s (template time), a far move takes
   // the new place without reporting a jump. 0: every far move is a jump from the first frame on.
-  float jump_settle_s = 0.1f;
+  // 0.3 s (0.1 before session 6): at 4 degrees per axis the first placement can sit on a
+  // look-alike for a few frames at a time for seconds (`improv-30hz-noisy` seed 3: 8.4 -> 1.1
+  // false jumps a minute); docs/follower.md, "Jump decisions".
+  float jump_settle_s = 0.3f;
   // ... counting only frames the follower is sure of (window mass at least jump_settle_mass):
   // under noise the first placement often sits on a look-alike place of another take with a
   // window mass of 0.6-0.97 before the maximum moves on. 0: every frame within reach counts.
