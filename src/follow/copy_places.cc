@@ -59,20 +59,15 @@ Result<CopyPlaces> CopyPlaces::build(const TemplateModel& model, int captured_ta
   return places;
 }
 
-int CopyPlaces::captured_take_begin(int place) const noexcept {
-  // The last take start at or before place.
-  const auto it = std::upper_bound(take_start_.begin(), take_start_.end() - 1, place);
-  return *(it - 1);
-}
-
-int CopyPlaces::captured_take_end(int place) const noexcept {
-  return *std::upper_bound(take_start_.begin(), take_start_.end() - 1, place);
+std::pair<int, int> CopyPlaces::window_of(int state, int window) const noexcept {
+  const int place = place_of(state);
+  // The captured take holding place: the last take start at or before it.
+  const auto next = std::upper_bound(take_start_.begin(), take_start_.end() - 1, place);
+  return {std::max(*(next - 1), place - window), std::min(*next, place + window + 1)};
 }
 
 float CopyPlaces::window_mass(const float* posterior, int state, int window) const noexcept {
-  const int place = place_of(state);
-  const int begin = std::max(captured_take_begin(place), place - window);
-  const int end = std::min(captured_take_end(place), place + window + 1);
+  const auto [begin, end] = window_of(state, window);
   float mass = 0.0f;
   for (int k = copy_offsets_[static_cast<std::size_t>(begin)];
        k < copy_offsets_[static_cast<std::size_t>(end)]; ++k) {
@@ -83,9 +78,7 @@ float CopyPlaces::window_mass(const float* posterior, int state, int window) con
 
 float CopyPlaces::window_mass(const float* posterior, int state, int window,
                               std::span<const int> support) const noexcept {
-  const int place = place_of(state);
-  const int begin = std::max(captured_take_begin(place), place - window);
-  const int end = std::min(captured_take_end(place), place + window + 1);
+  const auto [begin, end] = window_of(state, window);
   float mass = 0.0f;
   for (const int s : support) {
     const int p = place_of(s);

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "duet/base/result.h"
@@ -40,9 +41,8 @@ class CopyPlaces {
                     std::span<const int> support) const noexcept;
 
  private:
-  // The captured take's bounds around place p: [begin, end) in captured states.
-  int captured_take_begin(int place) const noexcept;
-  int captured_take_end(int place) const noexcept;
+  // The captured states [first, second) within `window` frames of state's place, in its take.
+  std::pair<int, int> window_of(int state, int window) const noexcept;
 
   std::vector<int> place_;         // per state: the captured state it shows
   std::vector<int> take_start_;    // the captured takes' first states, and their end
