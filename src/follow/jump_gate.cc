@@ -30,8 +30,8 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
     // Within reach of the old place: no jump, whatever the raw maximum's step was.
     result.jumped = false;
     // Settling counts the frames the follower is sure of; once settled, it stays settled.
-    const bool sure = settled_s_ + 1e-6 >= params.jump_settle_s ||
-                      result.window_mass >= params.jump_settle_mass;
+    const bool sure =
+        settled_s_ + 1e-6 >= params.jump_settle_s || result.window_mass >= params.jump_settle_mass;
     if (previous_state >= 0 && result.state >= 0 && sure) settled_s_ += step_s;
     forget_candidate();
     return;
@@ -61,7 +61,11 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
   const int begin = std::max(model.take_begin(take), previous_state - tolerance);
   const int end = std::min(model.take_end(take), previous_state + 2 * steps + tolerance + 1);
   double old_mass = 0.0;
-  for (int i = begin; i < end; ++i) old_mass += posterior[i];
+  int best = begin;  // the most likely state there
+  for (int i = begin; i < end; ++i) {
+    old_mass += posterior[i];
+    if (posterior[i] > posterior[best]) best = i;
+  }
   if (held_s_ + 1e-6 >= hold &&  // (3 frames of 1/60 s make 0.05 s)
       old_mass <= static_cast<double>(params.jump_old_place_mass) * total) {
     result.jumped = true;
@@ -69,10 +73,6 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
     return;
   }
   // Not yet: report the best state within reach of the old place.
-  int best = begin;
-  for (int i = begin + 1; i < end; ++i) {
-    if (posterior[i] > posterior[best]) best = i;
-  }
   follow_detail::describe_state(model, posterior, total, best, params.confidence_window_frames,
                                 result);
   result.jumped = false;
