@@ -29,9 +29,16 @@ FollowResult maximum_at(const TemplateModel& model, const std::vector<float>& p,
   r.state = state;
   r.take = model.take_of(state);
   r.frame_in_take = state - model.take_begin(r.take);
-  r.jumped = true;  // what decide() says of any move out of the band
+  r.jumped = true;       // what decide() says of any move out of the band
   r.window_mass = 1.0f;  // a sure maximum (settles the first placement)
   (void)p;
+  return r;
+}
+
+// The same from a sensor noisy enough for the whole noisy hold.
+FollowResult noisy_maximum_at(const TemplateModel& model, const FollowParams& params, int state) {
+  FollowResult r = maximum_at(model, {}, state);
+  r.sensor_noise_per_dim = 2.0f * params.noisy_jump_hold_level;
   return r;
 }
 
@@ -188,11 +195,7 @@ TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
   params.jump_settle_s = 0.0f;
 
   const TemplateModel model = two_takes();
-  const auto noisy = [&](int state) {
-    FollowResult r = maximum_at(model, {}, state);
-    r.sensor_noise_per_dim = 2.0f * params.noisy_jump_hold_level;
-    return r;
-  };
+  const auto noisy = [&](int state) { return noisy_maximum_at(model, params, state); };
   // One frame at take 1 and back: the old place goes on, no jump either way.
   JumpGate gate;
   std::vector<float> p = posterior(150, 41);
@@ -228,11 +231,7 @@ TEST(JumpGate, UnderANoisySensorAFarPlaceWaitsUntilTheOldPlaceHasLostItsMass) {
   FollowParams params;
   params.jump_settle_s = 0.0f;
   const TemplateModel model = two_takes();
-  const auto noisy = [&](int state) {
-    FollowResult r = maximum_at(model, {}, state);
-    r.sensor_noise_per_dim = 2.0f * params.noisy_jump_hold_level;
-    return r;
-  };
+  const auto noisy = [&](int state) { return noisy_maximum_at(model, params, state); };
   // The maximum sits at take 1 for six frames while the old place (the band's reach of the
   // reported state) keeps 10 % of the mass: no jump, the old place goes on.
   JumpGate gate;
