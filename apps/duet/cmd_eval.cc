@@ -62,6 +62,7 @@ struct EvalArgs {
       noise_filter_density, noise_filter_allowance;
   std::optional<double> tempo_time_constant;
   bool fixed_band = false;
+  bool no_outlier_gate = false;
   std::optional<int> dtw_back, dtw_ahead;
   // Feature weights (FeatureSpec); unset keeps the defaults.
   std::optional<double> posture_weight, root_velocity_weight, effector_speed_weight,
@@ -221,6 +222,7 @@ int run_eval(EvalArgs& args) {
   if (args.lost_residual_factor) hmm.lost_residual_factor = *args.lost_residual_factor;
   if (args.tempo_time_constant) hmm.tempo_time_constant_s = *args.tempo_time_constant;
   if (args.fixed_band) hmm.tempo_adaptive = false;
+  if (args.no_outlier_gate) hmm.gate_outliers = false;
   if (args.jump_hold) hmm.jump_hold_s = *args.jump_hold;
   if (args.jump_tolerance) hmm.jump_tolerance_frames = *args.jump_tolerance;
   if (args.jump_settle) hmm.jump_settle_s = *args.jump_settle;
@@ -549,6 +551,9 @@ Command register_eval(CLI::App& app) {
       ->check(positive_check());
   tuning->add_flag("--fixed-band", args->fixed_band,
                    "Keep the band fixed at the template's tempo (tempo_adaptive = false)");
+  tuning->add_flag("--no-outlier-gate", args->no_outlier_gate,
+                   "gate_outliers = false: a frame that would hand the pause state the majority "
+                   "right after a followed frame is evidence like any other");
   tuning
       ->add_option("--jump-hold", args->jump_hold,
                    "jump_hold_s: how long a far place must hold the posterior's maximum before "

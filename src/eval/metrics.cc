@@ -36,6 +36,7 @@ FrameEstimate frame_estimate(const FollowResult& r, double step_us) {
   e.best_distance_per_dim = r.best_distance_per_dim;
   e.sensor_noise_per_dim = r.sensor_noise_per_dim;
   e.in_pause = r.in_pause;
+  e.outlier = r.outlier;
   e.step_us = step_us;
   return e;
 }

@@ -319,7 +319,17 @@ bool BeamForward::sparse_emission(const float* phi, const CandidateSet& candidat
     return false;
   }
 
-  // Accepted: the posterior over the merged states; those below the threshold leave the beam.
+  // Accepted. An outlier's evidence is set aside, as in the exact step (FollowParams::
+  // gate_outliers); the pause state's majority is settled above.
+  if (context.history_.is_outlier(params, pause > 0.5 * sum, best,
+                                  exact_.noise_levels_.pause_distance_sq(context.frame_noise_))) {
+    renormalise_without_evidence(context);
+    result.outlier = true;
+    result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
+    result.lost = best > lost_sq;
+    return true;
+  }
+  // The posterior over the merged states; those below the threshold leave the beam.
   const float scale = static_cast<float>(1.0 / sum);
   const float threshold = largest * beam_.prune_ratio;
   context.beam_.clear();
@@ -355,6 +365,22 @@ bool BeamForward::sparse_step(const float* phi, BeamContext& context,
   return within.found >= 0 && sparse_emission(phi, within, context, result, settling_bound);
 }
 
+void BeamForward::renormalise_without_evidence(BeamContext& context) const noexcept {
+  const int num_states = exact_.model_->num_states();
+  float* alpha = context.alpha_.data();
+  float total = alpha[num_states] + context.background_;
+  for (const int i : context.beam_) total += alpha[i];
+  if (total > 0.0f && std::isfinite(total)) {
+    const float scale = 1.0f / total;
+    for (const int i : context.beam_) alpha[i] *= scale;
+    alpha[num_states] *= scale;
+    context.background_ *= scale;
+  }
+  // Unpruned, the beam spreads along the band while frames carry no evidence; too wide, the next
+  // frame is a full step (which also keeps the buffers within their reserved size).
+  if (static_cast<int>(context.beam_.size()) > beam_.max_states) context.full_next_ = true;
+}
+
 void BeamForward::materialise(BeamContext& context) const noexcept {
   const int num_states = exact_.model_->num_states();
   const float background = context.background_;
@@ -371,12 +397,20 @@ void BeamForward::full_emission(const float* phi, BeamContext& context,
   const FollowParams& params = exact_.params_;
   const float best = follow_detail::emission_distances(model, phi, params.velocity_distance_cap,
                                                        context.distance_sq_.data());
-  result.log_likelihood = follow_detail::weigh_and_normalise(
+  const double log_likelihood = follow_detail::weigh_and_normalise(
       context.alpha_.data(), context.distance_sq_.data(), best,
       exact_.noise_levels_.inv_two_sigma_sq(context.frame_noise_), model.num_states(),
       exact_.noise_levels_.log_pause_emission(context.frame_noise_), params.jump_enabled,
       context.scratch_.data());
-  context.alpha_.swap(context.scratch_);
+  result.outlier = context.history_.is_outlier(
+      params, context.scratch_[static_cast<std::size_t>(model.num_states())] > 0.5f, best,
+      exact_.noise_levels_.pause_distance_sq(context.frame_noise_));
+  if (result.outlier) {
+    follow_detail::normalise(context.alpha_.data(), model.num_states() + 1, model.num_states());
+  } else {
+    result.log_likelihood = log_likelihood;
+    context.alpha_.swap(context.scratch_);
+  }
   result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
   result.lost = best > exact_.noise_levels_.lost_ceiling_sq();
 }
@@ -475,19 +509,7 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
     follow_detail::normalise(context.alpha_.data(), num_states + 1, num_states);
     result.best_distance_per_dim = -1.0f;
   } else {
-    // No evidence: renormalise the beam, the background and the pause state together.
-    float* alpha = context.alpha_.data();
-    float total = alpha[num_states] + context.background_;
-    for (const int i : context.beam_) total += alpha[i];
-    if (total > 0.0f && std::isfinite(total)) {
-      const float scale = 1.0f / total;
-      for (const int i : context.beam_) alpha[i] *= scale;
-      alpha[num_states] *= scale;
-      context.background_ *= scale;
-    }
-    // Unpruned, the beam spreads along the band while frames are missing; too wide, the next
-    // frame is a full step (which also keeps the buffers within their reserved size).
-    if (static_cast<int>(context.beam_.size()) > beam_.max_states) context.full_next_ = true;
+    renormalise_without_evidence(context);
     result.best_distance_per_dim = -1.0f;
   }
 
@@ -522,12 +544,14 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   ++context.history_.frames;
   context.history_.previous_state = result.state;
   context.history_.previous_lost = result.lost;
+  context.history_.previous_outlier = result.outlier;
   const bool unexplained =
       !result.missing && result.best_distance_per_dim * static_cast<float>(model.num_dims()) >
                              exact_.noise_levels_.lost_distance_sq(
                                  context.frame_noise_, context.history_.explained_residual.level());
   context.history_.explained_residual.update(
-      result.best_distance_per_dim, !result.missing && !result.in_pause && !result.jumped, dt_s);
+      result.best_distance_per_dim,
+      !result.missing && !result.outlier && !result.in_pause && !result.jumped, dt_s);
   result.lost = result.lost || unexplained;
   return result;
 }

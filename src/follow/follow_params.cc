@@ -27,6 +27,7 @@ FollowParams FollowParams::paper() {
   params.jump_settle_mass = 0.0f;
   params.noisy_jump_hold_s = 0.0f;
   params.jump_old_place_mass = 1.0f;
+  params.gate_outliers = false;
   params.pause_noise_factor = 0.0f;
   params.emission_noise_factor = 0.0f;
   params.emission_noise_allowance = 0.0f;
@@ -122,6 +123,10 @@ Status FollowParams::validate(int num_states) const {
   if (!(jump_settle_mass >= 0.0f && jump_settle_mass <= 1.0f)) {
     return params_error("jump_settle_mass must be in [0, 1], got " +
                         std::to_string(jump_settle_mass));
+  }
+  if (!(outlier_pause_fraction >= 0.0f && std::isfinite(outlier_pause_fraction))) {
+    return params_error("outlier_pause_fraction must be finite and >= 0, got " +
+                        std::to_string(outlier_pause_fraction));
   }
   if (!(jump_settle_s >= 0.0f && jump_settle_s <= 10.0f)) {
     return params_error("jump_settle_s must be in [0, 10] s, got " + std::to_string(jump_settle_s));

@@ -14,6 +14,7 @@ void FollowerHistory::reset() noexcept {
   frames = 0;
   previous_state = -1;
   previous_lost = false;
+  previous_outlier = false;
   tempo.reset();
   jump_gate.reset();
   sensor_noise.reset();

@@ -10,7 +10,6 @@
 
 namespace duet {
 
-
 // ---------------------------------------------------------------------------------------------
 // ForwardContext
 
@@ -196,18 +195,27 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
     const float best = follow_detail::emission_distances(
         model, phi.data(), params_.velocity_distance_cap, context.distance_sq_.data());
     const float noise = result.sensor_noise_per_dim;
-    result.log_likelihood = follow_detail::weigh_and_normalise(
+    const double log_likelihood = follow_detail::weigh_and_normalise(
         context.alpha_.data(), context.distance_sq_.data(), best,
-        noise_levels_.inv_two_sigma_sq(noise), num_states,
-        noise_levels_.log_pause_emission(noise), params_.jump_enabled, context.scratch_.data());
-    context.alpha_.swap(context.scratch_);
+        noise_levels_.inv_two_sigma_sq(noise), num_states, noise_levels_.log_pause_emission(noise),
+        params_.jump_enabled, context.scratch_.data());
+    result.outlier = context.history_.is_outlier(
+        params_, context.scratch_[static_cast<std::size_t>(num_states)] > 0.5f, best,
+        noise_levels_.pause_distance_sq(noise));
+    if (result.outlier) {
+      // Set aside like a dropped frame's evidence: the transitions conserve mass.
+      follow_detail::normalise(context.alpha_.data(), num_states + 1, num_states);
+    } else {
+      result.log_likelihood = log_likelihood;
+      context.alpha_.swap(context.scratch_);
+    }
+    unexplained =
+        best > noise_levels_.lost_distance_sq(noise, context.history_.explained_residual.level());
     result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
     // lost is completed below, once in_pause is known. The band's tempo and the jump gate go on
     // the fixed ceiling: taught only by frames within the noise-scaled level, the tempo lagged
     // on clean input at 1.4x (100% -> 98.8% within 100 ms).
     result.lost = best > noise_levels_.lost_ceiling_sq();
-    unexplained =
-        best > noise_levels_.lost_distance_sq(noise, context.history_.explained_residual.level());
   } else {
     context.history_.noise_filter.miss(dt_s);
     // No evidence: the transitions conserve mass; renormalise only to stop float drift.
@@ -219,15 +227,16 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   follow_detail::decide(model, alpha, 1.0f, alpha[num_states], context.history_.previous_state,
                         result.steps, params_.confidence_window_frames, result);
   context.history_.jump_gate.apply(model, params_, alpha, 1.0f, context.history_.previous_state,
-                           context.history_.previous_lost, result);
+                                   context.history_.previous_lost, result);
   result.lost = result.missing ? context.history_.previous_lost : (result.lost || result.in_pause);
   if (params_.calibrate_confidence) {
-    result.confidence = ConfidenceCalibration::apply(result.window_mass, result.sensor_noise_per_dim);
+    result.confidence =
+        ConfidenceCalibration::apply(result.window_mass, result.sensor_noise_per_dim);
   }
   if (params_.tempo_adaptive) {
     const bool band_move = !result.missing && !result.lost && !result.jumped;
-    context.history_.tempo.update(context.history_.previous_state, result.state, result.steps, dt_s, band_move,
-                          tempo_limits_);
+    context.history_.tempo.update(context.history_.previous_state, result.state, result.steps, dt_s,
+                                  band_move, tempo_limits_);
   }
   result.tempo = context.history_.tempo.tempo();
 
@@ -235,8 +244,10 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   ++context.history_.frames;
   context.history_.previous_state = result.state;
   context.history_.previous_lost = result.lost;
-  context.history_.explained_residual.update(result.best_distance_per_dim,
-                                     !result.missing && !result.in_pause && !result.jumped, dt_s);
+  context.history_.previous_outlier = result.outlier;
+  context.history_.explained_residual.update(
+      result.best_distance_per_dim,
+      !result.missing && !result.outlier && !result.in_pause && !result.jumped, dt_s);
   result.lost = result.lost || unexplained;
   return result;
 }

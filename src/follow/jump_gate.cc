@@ -30,13 +30,12 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
     // Within reach of the old place: no jump, whatever the raw maximum's step was.
     result.jumped = false;
     // Settling counts the frames the follower is sure of; once settled, it stays settled.
-    const bool sure =
-        settled_s_ + 1e-6 >= params.jump_settle_s || result.window_mass >= params.jump_settle_mass;
+    const bool sure = settled(params) || result.window_mass >= params.jump_settle_mass;
     if (previous_state >= 0 && result.state >= 0 && sure) settled_s_ += step_s;
     forget_candidate();
     return;
   }
-  if (settled_s_ + 1e-6 < params.jump_settle_s) {
+  if (!settled(params)) {
     // Still finding the first place: take the new one and start settling there.
     result.jumped = false;
     settled_s_ = 0.0;

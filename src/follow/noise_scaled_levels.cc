@@ -37,21 +37,28 @@ float NoiseScaledLevels::inv_two_sigma_sq(float noise) const noexcept {
   return static_cast<float>(0.5 / (sigma_sq_ + emission_noise_factor_ * excess));
 }
 
+double NoiseScaledLevels::pause_per_dim(float noise) const noexcept {
+  return pause_distance_per_dim_ +
+         pause_noise_factor_ * std::max(0.0, usable(noise) - pause_noise_allowance_);
+}
+
 float NoiseScaledLevels::log_pause_emission(float noise) const noexcept {
-  const double n = usable(noise);
-  const double per_dim =
-      pause_distance_per_dim_ + pause_noise_factor_ * std::max(0.0, n - pause_noise_allowance_);
-  return static_cast<float>(std::max(-per_dim * dims_ * double{inv_two_sigma_sq(noise)},
-                                     double{follow_detail::kMinLogEmission}));
+  return static_cast<float>(
+      std::max(-pause_per_dim(noise) * dims_ * double{inv_two_sigma_sq(noise)},
+               double{follow_detail::kMinLogEmission}));
+}
+
+float NoiseScaledLevels::pause_distance_sq(float noise) const noexcept {
+  return static_cast<float>(std::min(pause_per_dim(noise) * dims_, double{FLT_MAX}));
 }
 
 float NoiseScaledLevels::lost_distance_sq(float noise, float residual) const noexcept {
   const double n = usable(noise);
   const double r = std::isfinite(residual) ? std::max(0.0, double{residual}) : 0.0;
   // +inf residual (the paper's preset) leaves the fixed ceiling alone.
-  const double per_dim =
-      std::min(lost_ceiling_per_dim_, std::max(lost_residual_per_dim_ + lost_noise_factor_ * n,
-                                               lost_residual_factor_ * r));
+  const double per_dim = std::min(
+      lost_ceiling_per_dim_,
+      std::max(lost_residual_per_dim_ + lost_noise_factor_ * n, lost_residual_factor_ * r));
   return static_cast<float>(std::min(per_dim * dims_, double{FLT_MAX}));
 }
 

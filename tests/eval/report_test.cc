@@ -187,8 +187,8 @@ TEST(EvalReportCsv, HasTheCalibrationErrorAndTheFramesCsvItsRows) {
   EXPECT_EQ(format_frames_csv(report),
             "case,tracker,take,error_ms,confidence,window_mass,best_distance_per_dim,"
             "sensor_noise_per_dim,lost,in_pause,jumped,true_take,true_frame,estimated_take,"
-            "estimated_frame,true_jump\n"
-            "clean,hmm,0,33.3,0.50000,0.75000,0.000000,0.0020000,1,0,1,0,7.0,0,5,1\n");
+            "estimated_frame,true_jump,outlier\n"
+            "clean,hmm,0,33.3,0.50000,0.75000,0.000000,0.0020000,1,0,1,0,7.0,0,5,1,0\n");
 }
 
 }  // namespace

@@ -94,7 +94,9 @@ TEST(ForwardEquivalence, SameAlphaAndEstimatesOverJumpsRatesAndMissingFrames) {
     // the pause level and the emission's scale fixed, the input unfiltered and the raw window
     // mass (the noise scaling is tested on its own, sensor_noise_test.cc and
     // noise_filter_test.cc; it changes no part of the forward but the emissions and the input).
+    // Nor has it the outlier gate (tested in hmm_follower_test.cc).
     Scenario s = scenario;
+    s.params.gate_outliers = false;
     s.params.pause_noise_factor = 0.0f;
     s.params.emission_noise_factor = 0.0f;
     s.params.noise_filter_density = 0.0f;

@@ -155,6 +155,62 @@ TEST_F(RobustnessTest, FeaturesFarFromEveryTemplateFrame) {
   }
 }
 
+TEST_F(RobustnessTest, AnOutlierFrameIsSetAsideAndASecondInARowIsEvidence) {
+  std::vector<float> outlier(kDims, 30.0f);
+  outlier[0] = -30.0f;
+  {
+    // One outlier while followed: transitions only, the estimate moves on along the band, no
+    // pause, no jump; the next frames are followed as before.
+    HmmFollower hmm = HmmFollower::create(model_, {}).value();
+    track(hmm, 0, 100);
+    const FollowResult r = hmm.step(outlier, kDt);
+    EXPECT_TRUE(r.outlier);
+    EXPECT_TRUE(r.lost);  // nothing explains it
+    EXPECT_FALSE(r.in_pause);
+    EXPECT_FALSE(r.jumped);
+    EXPECT_LE(std::abs(r.state - 100), 2);
+    EXPECT_EQ(r.log_likelihood, 0.0);
+    expect_valid_alpha(hmm);
+    const FollowResult next = hmm.step(template_frame(101), kDt);
+    EXPECT_FALSE(next.outlier);
+    EXPECT_FALSE(next.lost);
+    EXPECT_FALSE(next.jumped);
+    EXPECT_EQ(next.state, 101);
+    track(hmm, 102, 10);
+  }
+  {
+    // Two in a row: the second is evidence, the pause state takes the mass.
+    HmmFollower hmm = HmmFollower::create(model_, {}).value();
+    track(hmm, 0, 100);
+    EXPECT_TRUE(hmm.step(outlier, kDt).outlier);
+    const FollowResult second = hmm.step(outlier, kDt);
+    EXPECT_FALSE(second.outlier);
+    EXPECT_TRUE(second.in_pause);
+    EXPECT_TRUE(second.lost);
+  }
+  {
+    // Without the gate the first one already hands the pause state the mass.
+    FollowParams params;
+    params.gate_outliers = false;
+    HmmFollower hmm = HmmFollower::create(model_, params).value();
+    track(hmm, 0, 100);
+    const FollowResult r = hmm.step(outlier, kDt);
+    EXPECT_FALSE(r.outlier);
+    EXPECT_TRUE(r.in_pause);
+  }
+  {
+    // A frame another place explains (the dancer jumped) is never an outlier: evidence at once.
+    HmmFollower hmm = HmmFollower::create(model_, {}).value();
+    track(hmm, 0, 100);
+    FollowResult r;
+    for (int i = 700; i < 703; ++i) {
+      r = hmm.step(template_frame(i), kDt);
+      EXPECT_FALSE(r.outlier) << i;
+    }
+    EXPECT_EQ(r.state, 702);
+  }
+}
+
 TEST_F(RobustnessTest, SharpEmissionAndDistantPauseNeverUnderflow) {
   // sigma = 0.05 puts log-emissions of other frames around -1e4: exp underflows for everything
   // but the best frame, and the pause emission underflows entirely.

@@ -29,6 +29,7 @@ struct FrameEstimate {
   float best_distance_per_dim = 0.0f;
   float sensor_noise_per_dim = 0.0f;
   bool in_pause = false;
+  bool outlier = false;  // FollowResult::outlier: the frame's evidence was set aside
 };
 
 // A follower's result as scored; step_us its measured wall-clock time.

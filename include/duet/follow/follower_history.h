@@ -9,8 +9,8 @@
 #include "duet/follow/jump_gate.h"
 #include "duet/follow/noise_filter.h"
 #include "duet/follow/sensor_noise.h"
-#include "duet/follow/tempo_band.h"
 #include "duet/follow/template_model.h"
+#include "duet/follow/tempo_band.h"
 
 namespace duet {
 
@@ -24,10 +24,22 @@ struct FollowerHistory {
   // Back to the first frame (the estimators keep their sizes). Allocates nothing.
   void reset() noexcept;
 
+  // Whether this frame is an outlier whose evidence is set aside (FollowParams::gate_outliers):
+  // its evidence would hand the pause state the majority, its best squared distance is beyond
+  // outlier_pause_fraction of the pause level's (pause_distance_sq), and the previous frame was
+  // followed: the first placement settled, the frame neither lost nor itself an outlier.
+  bool is_outlier(const FollowParams& params, bool pause_majority, float best_distance_sq,
+                  float pause_distance_sq) const noexcept {
+    return params.gate_outliers && pause_majority &&
+           best_distance_sq > params.outlier_pause_fraction * pause_distance_sq &&
+           previous_state >= 0 && !previous_lost && !previous_outlier && jump_gate.settled(params);
+  }
+
   double total_log_likelihood = 0.0;  // a sum over the whole performance, hence double
   long long frames = 0;
   int previous_state = -1;
   bool previous_lost = false;
+  bool previous_outlier = false;  // the previous frame's evidence was set aside (outlier gate)
   TempoEstimator tempo;
   JumpGate jump_gate;
   SensorNoiseEstimator sensor_noise;

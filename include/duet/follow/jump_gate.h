@@ -36,6 +36,10 @@ class JumpGate {
   // maximum is taken at once. Allocates nothing.
   void apply(const TemplateModel& model, const FollowParams& params, const float* posterior,
              float total, int previous_state, bool previous_lost, FollowResult& result) noexcept;
+  // Whether the first placement has settled (FollowParams::jump_settle_s).
+  bool settled(const FollowParams& params) const noexcept {
+    return settled_s_ + 1e-6 >= params.jump_settle_s;
+  }
   // The hold (template seconds) at this sensor noise (FollowResult::sensor_noise_per_dim).
   static float hold_s(const FollowParams& params, float sensor_noise_per_dim) noexcept;
 

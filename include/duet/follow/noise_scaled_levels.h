@@ -20,6 +20,9 @@ class NoiseScaledLevels {
   // max(0, noise - pause_noise_allowance) per dimension. noise:
   // SensorNoiseEstimator::variance_per_dim(); weighed with inv_two_sigma_sq(noise).
   float log_pause_emission(float noise) const noexcept;
+  // That level as a squared distance over all D dimensions: a template state further than this
+  // from the input emits less than the pause state.
+  float pause_distance_sq(float noise) const noexcept;
   // Squared distance (over all D dimensions) beyond which no template frame explains the input:
   // the larger of lost_residual_per_dim + lost_noise_factor * noise and lost_residual_factor *
   // residual (ExplainedResidual::level()), at most lost_distance_per_dim.
@@ -28,6 +31,8 @@ class NoiseScaledLevels {
   float lost_ceiling_sq() const noexcept;
 
  private:
+  double pause_per_dim(float noise) const noexcept;  // pause_distance_sq / D
+
   double dims_ = 0.0;
   double sigma_sq_ = 0.0;
   double emission_noise_factor_ = 0.0;

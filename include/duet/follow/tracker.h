@@ -23,6 +23,10 @@ struct FollowResult {
   bool lost = false;      // no template frame explains the input (see FollowParams)
   bool in_pause = false;  // the pause state holds most of the posterior mass
   bool missing = false;   // the input held NaN/inf: transition only, no emission
+  // An outlier frame (FollowParams::gate_outliers): its evidence would have handed the pause
+  // state the majority right after a frame that was followed, so it was set aside like a dropped
+  // frame's (the estimate moved on along the band).
+  bool outlier = false;
   int steps = 0;          // template-rate transitions applied for this frame
   // log p(phi_t | phi_1..t-1), up to the Gaussian's constant normaliser; 0 for missing frames.
   // Trackers that are not probabilistic report the negative best distance / (2 sigma^2).
