@@ -1,7 +1,9 @@
 #include "duet/live/follow_session.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 namespace duet {
 
@@ -11,25 +13,33 @@ Result<FollowSession> FollowSession::create(const DuetLibrary& library,
                                             std::unique_ptr<Tracker> tracker,
                                             const PostureBiasParams& bias) {
   if (!tracker) return Error{"follow session: no tracker"};
+  const int joints = user_skeleton ? user_skeleton->joint_count() : 0;
   Result<FeatureExtractor> extractor = library.make_extractor(std::move(user_skeleton), user_roles);
   if (!extractor) return Error{"the user's motion: " + extractor.error().message};
-  return FollowSession(library, std::move(extractor).value(), std::move(tracker), bias);
+  return FollowSession(library, std::move(extractor).value(), std::move(tracker), bias, joints);
 }
 
 FollowSession::FollowSession(const DuetLibrary& library, FeatureExtractor extractor,
-                             std::unique_ptr<Tracker> tracker, const PostureBiasParams& bias)
+                             std::unique_ptr<Tracker> tracker, const PostureBiasParams& bias,
+                             int joints)
     : library_(&library),
       extractor_(std::move(extractor)),
       context_(extractor_.make_context()),
       tracker_(std::move(tracker)),
       features_(static_cast<std::size_t>(extractor_.dimension())),
       bias_(extractor_.spec().block_begin(FeatureBlock::kPosture),
-            extractor_.spec().block_size(FeatureBlock::kPosture), bias) {}
+            extractor_.spec().block_size(FeatureBlock::kPosture), bias),
+      repeats_(joints) {}
 
 FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
                                  std::span<const Quat> rotations_ls, double time_s) noexcept {
-  extractor_.extract(context_, translations_ls, rotations_ls, time_s, features_);
-  library_->normalizer().apply(features_);
+  if (repeats_.is_repeat(translations_ls, rotations_ls)) {
+    // No new evidence, and kept out of the velocities: the tracker moves its band on.
+    std::ranges::fill(features_, std::numeric_limits<float>::quiet_NaN());
+  } else {
+    extractor_.extract(context_, translations_ls, rotations_ls, time_s, features_);
+    library_->normalizer().apply(features_);
+  }
   const double dt_s = has_previous_ ? time_s - previous_time_s_ : 0.0;
   if (std::isfinite(time_s)) {
     previous_time_s_ = time_s;
@@ -85,6 +95,7 @@ void FollowSession::reset() noexcept {
   context_.reset();
   tracker_->reset();
   bias_.reset();
+  repeats_.reset();
   has_previous_ = false;
   previous_state_ = -1;
   previous_place_ = {};

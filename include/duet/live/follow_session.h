@@ -10,6 +10,7 @@
 #include "duet/features/posture_bias.h"
 #include "duet/follow/tracker.h"
 #include "duet/live/duet_library.h"
+#include "duet/live/repeated_frame.h"
 
 namespace duet {
 
@@ -26,7 +27,8 @@ class FollowSession {
   // One input frame: local pose of the user's skeleton at time_s (seconds, increasing). The time
   // since the previous frame drives the tracker's rate handling. Allocates nothing. In a grown
   // library (LibraryOptions::grow_to_states) the result's take and frame_in_take are the
-  // captured take's (DuetLibrary::place_of); state stays the model's.
+  // captured take's (DuetLibrary::place_of); state stays the model's. A frame that repeats the
+  // previous one bit for bit reaches the tracker as missing (repeated_frame.h).
   FollowResult step(std::span<const Vec3> translations_ls, std::span<const Quat> rotations_ls,
                     double time_s) noexcept;
   void reset() noexcept;
@@ -38,7 +40,7 @@ class FollowSession {
 
  private:
   FollowSession(const DuetLibrary& library, FeatureExtractor extractor,
-                std::unique_ptr<Tracker> tracker, const PostureBiasParams& bias);
+                std::unique_ptr<Tracker> tracker, const PostureBiasParams& bias, int joints);
   // A grown library: the estimate's take and frame as the captured take's.
   void report_captured_place(FollowResult& result) noexcept;
 
@@ -48,6 +50,7 @@ class FollowSession {
   std::unique_ptr<Tracker> tracker_;
   std::vector<float> features_;
   PostureBias bias_;  // the user's rig's posture offset, learnt online
+  RepeatedFrameDetector repeats_;
   double previous_time_s_ = 0.0;
   bool has_previous_ = false;
   int previous_state_ = -1;  // the estimate of the previous frame

@@ -1,0 +1,62 @@
+// RepeatedFrameDetector: a pose sent again bit for bit is a repeat once; a hold is not.
+#include "duet/live/repeated_frame.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace duet {
+namespace {
+
+struct Pose {
+  std::vector<Vec3> t;
+  std::vector<Quat> r;
+};
+
+Pose pose(double x) {
+  return {{Vec3(x, 1.0, 0.0), Vec3(0.0, x, 0.5)},
+          {Quat(Eigen::AngleAxisd(x, Vec3::UnitY())), Quat::Identity()}};
+}
+
+TEST(RepeatedFrameDetector, ASingleRepeatIsSetAsideAHoldIsNot) {
+  RepeatedFrameDetector detector(2);
+  const Pose a = pose(0.1), b = pose(0.2);
+  EXPECT_FALSE(detector.is_repeat(a.t, a.r));  // nothing before it
+  EXPECT_TRUE(detector.is_repeat(a.t, a.r));   // sent again
+  EXPECT_FALSE(detector.is_repeat(a.t, a.r));  // and again: a hold, evidence
+  EXPECT_FALSE(detector.is_repeat(a.t, a.r));
+  EXPECT_FALSE(detector.is_repeat(b.t, b.r));
+  EXPECT_TRUE(detector.is_repeat(b.t, b.r));
+  EXPECT_FALSE(detector.is_repeat(a.t, a.r));
+}
+
+TEST(RepeatedFrameDetector, AnyDifferenceIsANewFrame) {
+  RepeatedFrameDetector detector(2);
+  Pose a = pose(0.3);
+  EXPECT_FALSE(detector.is_repeat(a.t, a.r));
+  a.t[1].z() = std::nextafter(a.t[1].z(), 1.0);  // one bit in one joint
+  EXPECT_FALSE(detector.is_repeat(a.t, a.r));
+  a.r[0].w() = std::nextafter(a.r[0].w(), 0.0);
+  EXPECT_FALSE(detector.is_repeat(a.t, a.r));
+}
+
+TEST(RepeatedFrameDetector, NaNPosesAndOtherSizesAreNeverRepeatsAndResetForgets) {
+  RepeatedFrameDetector detector(2);
+  Pose n = pose(0.4);
+  n.t[0].x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(detector.is_repeat(n.t, n.r));
+  EXPECT_FALSE(detector.is_repeat(n.t, n.r));  // NaN never equals itself
+  const Pose a = pose(0.5);
+  EXPECT_FALSE(detector.is_repeat(a.t, a.r));
+  const std::vector<Vec3> one = {Vec3::Zero()};
+  const std::vector<Quat> one_r = {Quat::Identity()};
+  EXPECT_FALSE(detector.is_repeat(one, one_r));  // another skeleton's pose
+  EXPECT_FALSE(detector.is_repeat(a.t, a.r));
+  detector.reset();
+  EXPECT_FALSE(detector.is_repeat(a.t, a.r));
+}
+
+}  // namespace
+}  // namespace duet
