@@ -162,12 +162,12 @@ struct FollowParams {
   // window mass of 0.6-0.97 before the maximum moves on. 0: every frame within reach counts.
   float jump_settle_mass = 0.99f;
   // Outlier gate: a frame whose evidence would hand the pause state the majority right after a
-  // frame that was followed (neither lost nor itself an outlier) is taken for an outlier of the
-  // sensor: its evidence is set aside (transitions only, as for a dropped frame). A second such
-  // frame in a row is evidence again: the dancer really jumped, paused or left the library, one
-  // frame later. Without it one outlier frame at 4 degrees per axis moved the posterior to the
-  // pause state and from there to a look-alike place and back (two false jumps); innovation
-  // gating, as in a Kalman filter's measurement gate.
+  // frame that was followed (the first placement settled, that frame neither lost nor itself an
+  // outlier) is taken for an outlier of the sensor: its evidence is set aside (transitions only,
+  // as for a dropped frame). A second such frame in a row is evidence again: the dancer really
+  // jumped, paused or left the library, one frame later. Without it one outlier frame at 4
+  // degrees per axis moved the posterior to the pause state and from there to a look-alike place
+  // and back (two false jumps); innovation gating, as in a Kalman filter's measurement gate.
   bool gate_outliers = true;
   // ... only when nothing explains the frame well either: its best distance is beyond this share
   // of the pause state's level (NoiseScaledLevels::pause_distance_sq). Where the follower merely
