@@ -176,7 +176,7 @@ int run_follow(const FollowArgs& args) {
   Clip partner(loop.value().partner_skeleton(), user.frame_rate(), user.frame_count());
   std::string trace =
       "frame,time_s,take,template_frame,confidence,jumped,lost,in_pause,best_distance_per_dim,"
-      "sensor_noise_per_dim\n";
+      "sensor_noise_per_dim,missing,outlier\n";
   std::vector<FollowResult> results;
   results.reserve(static_cast<std::size_t>(user.frame_count()));
   SourceFrame frame;
@@ -190,10 +190,10 @@ int run_follow(const FollowArgs& args) {
     const LiveOutput& out = loop.value().step(frame);
     const FollowResult& r = out.follow;
     results.push_back(r);
-    fmt::format_to(std::back_inserter(trace), "{},{:.6f},{},{},{:.4f},{},{},{},{:.6f},{:.7f}\n", f,
-                   frame.time_s, r.take, r.frame_in_take, r.confidence, r.jumped ? 1 : 0,
+    fmt::format_to(std::back_inserter(trace), "{},{:.6f},{},{},{:.4f},{},{},{},{:.6f},{:.7f},{},{}\n",
+                   f, frame.time_s, r.take, r.frame_in_take, r.confidence, r.jumped ? 1 : 0,
                    r.lost ? 1 : 0, r.in_pause ? 1 : 0, r.best_distance_per_dim,
-                   r.sensor_noise_per_dim);
+                   r.sensor_noise_per_dim, r.missing ? 1 : 0, r.outlier ? 1 : 0);
     std::ranges::copy(out.partner_translations_ls, partner.translations_ls(f).begin());
     std::ranges::copy(out.partner_rotations_ls, partner.rotations_ls(f).begin());
     if (f % 64 == 0) bar.update(f, user.frame_count());
@@ -218,9 +218,10 @@ int run_follow(const FollowArgs& args) {
   const LostSummary summary = summarise_lost(results);
   fmt::print(
       "followed {} frames ({:.1f} s) against {} take(s), {} states: {} jumps, {} lost "
-      "frames; corrections: {}{}\n",
+      "frames{}; corrections: {}{}\n",
       user.frame_count(), user.duration(), library->takes().size(), library->model().num_states(),
-      summary.jumps, summary.lost, corrections_string(loop.value().params()),
+      summary.jumps, summary.lost, describe_set_aside(summary),
+      corrections_string(loop.value().params()),
       loop.value().params().foot_hold.enabled ? ", foot hold" : "");
   if (truth) print_accuracy_summary(*truth, results, library->frame_rate());
   if (summary.lost_fraction() <= kMostlyLostFraction) return kExitOk;
@@ -264,7 +265,9 @@ Command register_follow(CLI::App& app) {
   app.add_option("--trace", args->trace_path,
                  "Write one CSV row per input frame: "
                  "frame,time_s,take,template_frame,confidence,jumped,lost,in_pause,"
-                 "best_distance_per_dim,sensor_noise_per_dim");
+                 "best_distance_per_dim,sensor_noise_per_dim,missing,outlier (missing: no "
+                 "usable pose, or the sensor repeated the last one; outlier: a frame nothing "
+                 "explained, its evidence set aside)");
   app.add_option("-o,--output", args->output_path,
                  "Write the partner's motion: BVH in the response takes' units, in the user's "
                  "world frame, at the input's rate and frame count");

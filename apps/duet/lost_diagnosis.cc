@@ -12,8 +12,16 @@ LostSummary summarise_lost(std::span<const FollowResult> results) {
     ++summary.frames;
     summary.lost += r.lost ? 1 : 0;
     summary.jumps += r.jumped ? 1 : 0;
+    summary.missing += r.missing ? 1 : 0;
+    summary.outliers += r.outlier ? 1 : 0;
   }
   return summary;
+}
+
+std::string describe_set_aside(const LostSummary& summary) {
+  if (summary.missing == 0 && summary.outliers == 0) return "";
+  return fmt::format(" (frames without evidence: {} missing or repeated, {} outliers set aside)",
+                     summary.missing, summary.outliers);
 }
 
 std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostContext& context) {
@@ -46,8 +54,9 @@ std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostCon
       causes.push_back(fmt::format(
           "units: the dancer is {:.2f} m tall at {} ({}){}; pass --input-scale with the file's "
           "metres per unit",
-          height, input.units_name.empty() ? fmt::format("{:g} m per unit", input.metres_per_unit)
-                                            : input.units_name,
+          height,
+          input.units_name.empty() ? fmt::format("{:g} m per unit", input.metres_per_unit)
+                                   : input.units_name,
           input.units_source, input.units_warning.empty() ? "" : " — " + input.units_warning));
     }
     // The rig: roles found without a known convention may be wrong.

@@ -22,9 +22,13 @@ struct LostSummary {
   int frames = 0;
   int lost = 0;
   int jumps = 0;
+  int missing = 0;   // no usable pose, or the sensor repeated the last one (FollowResult::missing)
+  int outliers = 0;  // evidence set aside (FollowResult::outlier)
   double lost_fraction() const { return frames > 0 ? static_cast<double>(lost) / frames : 0.0; }
 };
 LostSummary summarise_lost(std::span<const FollowResult> results);
+// " (frames without evidence: M missing or repeated, K outliers set aside)", or "" when none.
+std::string describe_set_aside(const LostSummary& summary);
 
 // What the input looked like, for the checks.
 struct LostContext {

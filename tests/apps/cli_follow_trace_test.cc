@@ -1,0 +1,69 @@
+// `duet follow --trace`: a frame the sensor sent twice reaches the follower as missing, and the
+// summary and the trace say so (repeated_frame.h).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/run_command.h"
+
+namespace duet {
+namespace {
+
+using testing::data_path;
+using testing::run_duet;
+
+const std::string kLibrary =
+    std::string(DUET_TESTDATA_DIR) + "/../../libraries/cmu-salsa.toml --data-dir " DUET_DATA_DIR;
+
+// Take 60_05 with its frame 300 replaced by frame 299: the sensor sent a sample again.
+std::string write_with_repeated_frame(const std::string& path) {
+  std::ifstream in(data_path("cmu-salsa/bvh/60/60_05_scaled.bvh"));
+  std::vector<std::string> lines;
+  std::string line;
+  std::size_t first_frame = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("Frame Time", 0) == 0) first_frame = lines.size() + 1;
+    lines.push_back(line);
+  }
+  EXPECT_GT(first_frame, 0u);
+  lines[first_frame + 300] = lines[first_frame + 299];
+  std::ofstream out(path);
+  for (const std::string& l : lines) out << l << '\n';
+  return path;
+}
+
+TEST(CliFollowTrace, ARepeatedFrameIsMissingInTheTraceAndTheSummary) {
+  const std::string input =
+      write_with_repeated_frame(::testing::TempDir() + "cli_follow_repeated.bvh");
+  const std::string trace = ::testing::TempDir() + "cli_follow_repeated.csv";
+  const auto r = run_duet("follow --library " + kLibrary + " --input " + input +
+                          " -o /dev/null --trace " + trace);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("frames without evidence: 1 missing or repeated, 0 outliers set aside"),
+            std::string::npos)
+      << r.output;
+  std::ifstream in(trace);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line.substr(line.size() - 16), ",missing,outlier");
+  int row = 0, missing_rows = 0;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+    ASSERT_EQ(cells.size(), 12u) << line;
+    if (cells[10] == "1") {
+      ++missing_rows;
+      EXPECT_EQ(row, 300);
+      EXPECT_EQ(cells[6], "0");  // missing is not lost
+    }
+    ++row;
+  }
+  EXPECT_EQ(missing_rows, 1);
+}
+
+}  // namespace
+}  // namespace duet
