@@ -156,6 +156,8 @@ TEST(Recorder, SessionRecorderWritesEveryPushedFrame) {
     out.time_s = f / 60.0;
     out.follow.take = 0;
     out.follow.frame_in_take = f;
+    out.follow.missing = f == 100;
+    out.follow.outlier = f == 200;
     // A 64-frame ring: wait for the worker rather than lose frames in this test.
     while (!recorder.push(user, out)) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     ++pushed;
@@ -178,7 +180,19 @@ TEST(Recorder, SessionRecorderWritesEveryPushedFrame) {
   std::ifstream csv(recorder.follow_path());
   std::string line;
   int lines = 0;
-  while (std::getline(csv, line)) ++lines;
+  while (std::getline(csv, line)) {
+    if (lines == 0) {
+      EXPECT_EQ(line.substr(line.size() - 16), ",missing,outlier");
+    }
+    // Row f + 1 is frame f: missing on frame 100, outlier on frame 200, neither elsewhere.
+    if (lines > 0) {
+      const int f = lines - 1;
+      const std::string end =
+          std::string(",") + (f == 100 ? "1" : "0") + "," + (f == 200 ? "1" : "0");
+      EXPECT_EQ(line.substr(line.size() - 4), end) << line;
+    }
+    ++lines;
+  }
   EXPECT_EQ(lines, frames + 1);
 
   // A second session with the same stem does not overwrite the first.
