@@ -63,6 +63,7 @@ struct EvalArgs {
   std::optional<double> tempo_time_constant;
   bool fixed_band = false;
   bool no_outlier_gate = false;
+  std::optional<float> outlier_pause_fraction;
   std::optional<int> dtw_back, dtw_ahead;
   // Feature weights (FeatureSpec); unset keeps the defaults.
   std::optional<double> posture_weight, root_velocity_weight, effector_speed_weight,
@@ -223,6 +224,7 @@ int run_eval(EvalArgs& args) {
   if (args.tempo_time_constant) hmm.tempo_time_constant_s = *args.tempo_time_constant;
   if (args.fixed_band) hmm.tempo_adaptive = false;
   if (args.no_outlier_gate) hmm.gate_outliers = false;
+  if (args.outlier_pause_fraction) hmm.outlier_pause_fraction = *args.outlier_pause_fraction;
   if (args.jump_hold) hmm.jump_hold_s = *args.jump_hold;
   if (args.jump_tolerance) hmm.jump_tolerance_frames = *args.jump_tolerance;
   if (args.jump_settle) hmm.jump_settle_s = *args.jump_settle;
@@ -554,6 +556,11 @@ Command register_eval(CLI::App& app) {
   tuning->add_flag("--no-outlier-gate", args->no_outlier_gate,
                    "gate_outliers = false: a frame that would hand the pause state the majority "
                    "right after a followed frame is evidence like any other");
+  tuning
+      ->add_option("--outlier-pause-fraction", args->outlier_pause_fraction,
+                   "outlier_pause_fraction: the outlier gate sets a frame aside only when its best "
+                   "distance is beyond this share of the pause level")
+      ->check(non_negative_check());
   tuning
       ->add_option("--jump-hold", args->jump_hold,
                    "jump_hold_s: how long a far place must hold the posterior's maximum before "
