@@ -15,14 +15,12 @@ namespace duet {
 namespace {
 
 using testing::data_path;
+using testing::kSalsaLibrary;
 using testing::run_duet;
-
-const std::string kLibrary =
-    std::string(DUET_TESTDATA_DIR) + "/../../libraries/cmu-salsa.toml --data-dir " DUET_DATA_DIR;
 
 TEST(CliBeam, FollowWithTheBeamFollowsATakeWithoutLosingIt) {
   const std::string out = ::testing::TempDir() + "cli_beam_partner.bvh";
-  const auto r = run_duet("follow --library " + kLibrary + " --input " +
+  const auto r = run_duet("follow --library " + kSalsaLibrary + " --input " +
                           data_path("cmu-salsa/bvh/60/60_05_scaled.bvh") + " -o " + out +
                           " --beam");
   EXPECT_EQ(r.exit_code, 0) << r.output;
@@ -38,7 +36,7 @@ TEST(CliBeam, FollowsThroughAGrownLibraryReadFromItsCache) {
   std::remove(cache.c_str());
   for (const bool first : {true, false}) {
     SCOPED_TRACE(first ? "building the cache" : "reading the cache");
-    const auto r = run_duet("follow --library " + kLibrary + " --input " +
+    const auto r = run_duet("follow --library " + kSalsaLibrary + " --input " +
                             data_path("cmu-salsa/bvh/60/60_05_scaled.bvh") +
                             " -o /dev/null --beam --grow-library 40000 --model-cache " + cache +
                             " --trace " + trace);
@@ -69,7 +67,7 @@ TEST(CliBeam, FollowsThroughAGrownLibraryReadFromItsCache) {
 }
 
 TEST(CliBeam, ABeamForATrackerWithoutOneIsRefused) {
-  const auto r = run_duet("follow --library " + kLibrary + " --input " +
+  const auto r = run_duet("follow --library " + kSalsaLibrary + " --input " +
                           data_path("cmu-salsa/bvh/60/60_05_scaled.bvh") +
                           " -o /dev/null --beam --tracker left-to-right");
   EXPECT_NE(r.exit_code, 0);

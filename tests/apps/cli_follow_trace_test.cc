@@ -13,10 +13,8 @@ namespace duet {
 namespace {
 
 using testing::data_path;
+using testing::kSalsaLibrary;
 using testing::run_duet;
-
-const std::string kLibrary =
-    std::string(DUET_TESTDATA_DIR) + "/../../libraries/cmu-salsa.toml --data-dir " DUET_DATA_DIR;
 
 // Take 60_05 with its frame 300 replaced by frame 299: the sensor sent a sample again.
 std::string write_with_repeated_frame(const std::string& path) {
@@ -39,7 +37,7 @@ TEST(CliFollowTrace, ARepeatedFrameIsMissingInTheTraceAndTheSummary) {
   const std::string input =
       write_with_repeated_frame(::testing::TempDir() + "cli_follow_repeated.bvh");
   const std::string trace = ::testing::TempDir() + "cli_follow_repeated.csv";
-  const auto r = run_duet("follow --library " + kLibrary + " --input " + input +
+  const auto r = run_duet("follow --library " + kSalsaLibrary + " --input " + input +
                           " -o /dev/null --trace " + trace);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("frames without evidence: 1 missing or repeated, 0 outliers set aside"),

@@ -13,9 +13,6 @@ namespace duet::testing {
 namespace {
 
 const std::string kTake = data_path("cmu-salsa/bvh/60/60_07_scaled.bvh");
-const std::string kLibrary =
-    std::string(DUET_TESTDATA_DIR) + "/../../libraries/cmu-salsa.toml --data-dir " + DUET_DATA_DIR;
-
 std::string temp(const std::string& name) {
   return (std::filesystem::temp_directory_path() / ("duet_cli_head_hands_" + name)).string();
 }
@@ -35,7 +32,7 @@ TEST(CliHeadHands, ConvertThenFollowTheRecording) {
   EXPECT_EQ(read(csv).substr(0, 20), "time_s,head_x,head_y");
 
   CommandResult followed =
-      run_duet("follow --library " + kLibrary + " --input " + csv + " --trace " + trace);
+      run_duet("follow --library " + kSalsaLibrary + " --input " + csv + " --trace " + trace);
   ASSERT_EQ(followed.exit_code, 0) << followed.output;
   // Frame f of take 07 (library index 6) is template frame f.
   std::istringstream rows(read(trace));
@@ -56,7 +53,7 @@ TEST(CliHeadHands, ConvertThenFollowTheRecording) {
 }
 
 TEST(CliHeadHands, InputPointsOnAFullBodyTakeFollowsItsThreePoints) {
-  CommandResult followed = run_duet("follow --library " + kLibrary + " --input " + kTake +
+  CommandResult followed = run_duet("follow --library " + kSalsaLibrary + " --input " + kTake +
                                     " --input-fps 60 --input-points head,hands");
   EXPECT_EQ(followed.exit_code, 0) << followed.output;
   EXPECT_NE(followed.output.find("0 jumps"), std::string::npos) << followed.output;
@@ -71,7 +68,7 @@ TEST(CliHeadHands, OptionsThatCannotApplySaySo) {
   EXPECT_FALSE(std::filesystem::exists(csv));
 
   ASSERT_EQ(run_duet("convert " + kTake + " --points head,hands -o " + csv).exit_code, 0);
-  CommandResult full = run_duet("follow --library " + kLibrary + " --input " + csv +
+  CommandResult full = run_duet("follow --library " + kSalsaLibrary + " --input " + csv +
                                 " --input-points full");
   EXPECT_EQ(full.exit_code, 2);
   EXPECT_NE(full.output.find("has only a head and two hands"), std::string::npos) << full.output;
