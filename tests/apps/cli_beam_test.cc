@@ -20,9 +20,9 @@ using testing::run_duet;
 
 TEST(CliBeam, FollowWithTheBeamFollowsATakeWithoutLosingIt) {
   const std::string out = ::testing::TempDir() + "cli_beam_partner.bvh";
-  const auto r = run_duet("follow --library " + kSalsaLibrary + " --input " +
-                          data_path("cmu-salsa/bvh/60/60_05_scaled.bvh") + " -o " + out +
-                          " --beam");
+  const auto r =
+      run_duet("follow --library " + kSalsaLibrary + " --input " +
+               data_path("cmu-salsa/bvh/60/60_05_scaled.bvh") + " -o " + out + " --beam");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("followed 1678 frames"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("0 lost frames"), std::string::npos) << r.output;

@@ -68,8 +68,8 @@ TEST(CliHeadHands, OptionsThatCannotApplySaySo) {
   EXPECT_FALSE(std::filesystem::exists(csv));
 
   ASSERT_EQ(run_duet("convert " + kTake + " --points head,hands -o " + csv).exit_code, 0);
-  CommandResult full = run_duet("follow --library " + kSalsaLibrary + " --input " + csv +
-                                " --input-points full");
+  CommandResult full =
+      run_duet("follow --library " + kSalsaLibrary + " --input " + csv + " --input-points full");
   EXPECT_EQ(full.exit_code, 2);
   EXPECT_NE(full.output.find("has only a head and two hands"), std::string::npos) << full.output;
 
