@@ -321,12 +321,12 @@ bool BeamForward::sparse_emission(const float* phi, const CandidateSet& candidat
 
   // Accepted. An outlier's evidence is set aside, as in the exact step (FollowParams::
   // gate_outliers); the pause state's majority is settled above.
+  result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
+  result.lost = best > lost_sq;
   if (context.history_.is_outlier(params, pause > 0.5 * sum, best,
                                   exact_.noise_levels_.pause_distance_sq(context.frame_noise_))) {
     renormalise_without_evidence(context);
     result.outlier = true;
-    result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
-    result.lost = best > lost_sq;
     return true;
   }
   // The posterior over the merged states; those below the threshold leave the beam.
@@ -346,8 +346,6 @@ bool BeamForward::sparse_emission(const float* phi, const CandidateSet& candidat
   context.background_ = 0.0f;  // its emitted mass is left out (bounded above)
   if (static_cast<int>(context.beam_.size()) > beam_.max_states) context.full_next_ = true;
   result.log_likelihood = std::log(sum) + static_cast<double>(shift);
-  result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
-  result.lost = best > lost_sq;
   return true;
 }
 
@@ -389,30 +387,6 @@ void BeamForward::materialise(BeamContext& context) const noexcept {
     for (int i = 0; i < num_states; ++i) alpha[i] += background * resume_share(i);
   }
   context.background_ = 0.0f;
-}
-
-void BeamForward::full_emission(const float* phi, BeamContext& context,
-                                FollowResult& result) const noexcept {
-  const TemplateModel& model = *exact_.model_;
-  const FollowParams& params = exact_.params_;
-  const float best = follow_detail::emission_distances(model, phi, params.velocity_distance_cap,
-                                                       context.distance_sq_.data());
-  const double log_likelihood = follow_detail::weigh_and_normalise(
-      context.alpha_.data(), context.distance_sq_.data(), best,
-      exact_.noise_levels_.inv_two_sigma_sq(context.frame_noise_), model.num_states(),
-      exact_.noise_levels_.log_pause_emission(context.frame_noise_), params.jump_enabled,
-      context.scratch_.data());
-  result.outlier = context.history_.is_outlier(
-      params, context.scratch_[static_cast<std::size_t>(model.num_states())] > 0.5f, best,
-      exact_.noise_levels_.pause_distance_sq(context.frame_noise_));
-  if (result.outlier) {
-    follow_detail::normalise(context.alpha_.data(), model.num_states() + 1, model.num_states());
-  } else {
-    result.log_likelihood = log_likelihood;
-    context.alpha_.swap(context.scratch_);
-  }
-  result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
-  result.lost = best > exact_.noise_levels_.lost_ceiling_sq();
 }
 
 void BeamForward::rebuild_beam(BeamContext& context) const noexcept {
@@ -504,7 +478,10 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
       materialise(context);
       dense = true;
     }
-    if (dense) full_emission(phi.data(), context, result);
+    if (dense) {
+      exact_.emit_all_states(phi.data(), context.frame_noise_, context.history_, context.alpha_,
+                             context.scratch_, context.distance_sq_.data(), result);
+    }
   } else if (dense) {
     follow_detail::normalise(context.alpha_.data(), num_states + 1, num_states);
     result.best_distance_per_dim = -1.0f;

@@ -164,6 +164,29 @@ void HmmForward::transition(const float* alpha, const BandProbabilities& band,
   next[num_states] = into_pause;
 }
 
+float HmmForward::emit_all_states(const float* phi, float noise, const FollowerHistory& history,
+                                  std::vector<float>& alpha, std::vector<float>& scratch,
+                                  float* distance_sq, FollowResult& result) const noexcept {
+  const int num_states = model_->num_states();
+  const float best =
+      follow_detail::emission_distances(*model_, phi, params_.velocity_distance_cap, distance_sq);
+  const double log_likelihood = follow_detail::weigh_and_normalise(
+      alpha.data(), distance_sq, best, noise_levels_.inv_two_sigma_sq(noise), num_states,
+      noise_levels_.log_pause_emission(noise), params_.jump_enabled, scratch.data());
+  result.outlier = history.is_outlier(params_, scratch[static_cast<std::size_t>(num_states)] > 0.5f,
+                                      best, noise_levels_.pause_distance_sq(noise));
+  if (result.outlier) {
+    // Set aside like a dropped frame's evidence: the transitions conserve mass.
+    follow_detail::normalise(alpha.data(), num_states + 1, num_states);
+  } else {
+    result.log_likelihood = log_likelihood;
+    alpha.swap(scratch);
+  }
+  result.best_distance_per_dim = best / static_cast<float>(model_->num_dims());
+  result.lost = best > noise_levels_.lost_ceiling_sq();
+  return best;
+}
+
 FollowResult HmmForward::step(std::span<const float> features, double dt_s,
                               ForwardContext& context) const noexcept {
   const follow_detail::ScopedFlushDenormals flush_denormals;
@@ -192,30 +215,14 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   if (!result.missing) {
     const std::span<const float> phi =
         context.history_.noise_filter.apply(features, dt_s, result.sensor_noise_per_dim);
-    const float best = follow_detail::emission_distances(
-        model, phi.data(), params_.velocity_distance_cap, context.distance_sq_.data());
     const float noise = result.sensor_noise_per_dim;
-    const double log_likelihood = follow_detail::weigh_and_normalise(
-        context.alpha_.data(), context.distance_sq_.data(), best,
-        noise_levels_.inv_two_sigma_sq(noise), num_states, noise_levels_.log_pause_emission(noise),
-        params_.jump_enabled, context.scratch_.data());
-    result.outlier = context.history_.is_outlier(
-        params_, context.scratch_[static_cast<std::size_t>(num_states)] > 0.5f, best,
-        noise_levels_.pause_distance_sq(noise));
-    if (result.outlier) {
-      // Set aside like a dropped frame's evidence: the transitions conserve mass.
-      follow_detail::normalise(context.alpha_.data(), num_states + 1, num_states);
-    } else {
-      result.log_likelihood = log_likelihood;
-      context.alpha_.swap(context.scratch_);
-    }
-    unexplained =
-        best > noise_levels_.lost_distance_sq(noise, context.history_.explained_residual.level());
-    result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
+    const float best = emit_all_states(phi.data(), noise, context.history_, context.alpha_,
+                                       context.scratch_, context.distance_sq_.data(), result);
     // lost is completed below, once in_pause is known. The band's tempo and the jump gate go on
     // the fixed ceiling: taught only by frames within the noise-scaled level, the tempo lagged
     // on clean input at 1.4x (100% -> 98.8% within 100 ms).
-    result.lost = best > noise_levels_.lost_ceiling_sq();
+    unexplained =
+        best > noise_levels_.lost_distance_sq(noise, context.history_.explained_residual.level());
   } else {
     context.history_.noise_filter.miss(dt_s);
     // No evidence: the transitions conserve mass; renormalise only to stop float drift.

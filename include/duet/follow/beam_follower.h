@@ -173,7 +173,6 @@ class BeamForward {
   // A frame without evidence (missing, or an outlier set aside): the beam, the background and
   // the pause state renormalised together, as the transitions left them.
   void renormalise_without_evidence(BeamContext& context) const noexcept;
-  void full_emission(const float* phi, BeamContext& context, FollowResult& result) const noexcept;
   // After a full step: the states above the prune threshold become the beam, unless too many.
   void rebuild_beam(BeamContext& context) const noexcept;
   int sparse_argmax(const BeamContext& context) const noexcept;

@@ -18,8 +18,8 @@
 #include "duet/follow/follow_params.h"
 #include "duet/follow/follower_history.h"
 #include "duet/follow/noise_scaled_levels.h"
-#include "duet/follow/tempo_band.h"
 #include "duet/follow/template_model.h"
+#include "duet/follow/tempo_band.h"
 #include "duet/follow/tracker.h"
 
 namespace duet {
@@ -100,6 +100,15 @@ class HmmForward {
   HmmForward() = default;
   // alpha_{t-1} -> sum_j alpha_{t-1}(j) A(j -> i) for every i, in O(M) (the bracket of eq. 11).
   void transition(const float* alpha, const BandProbabilities& band, float* next) const noexcept;
+  // The emission of every state (eq. 7) and the outer factor of eq. 10/11 for the input phi at
+  // this sensor noise: alpha (M + 1, the prediction) becomes the posterior, through scratch (the
+  // two are swapped), and distance_sq (M) receives the distances. An outlier frame
+  // (FollowParams::gate_outliers, judged from history) keeps the prediction alone. Sets
+  // result.outlier, log_likelihood, best_distance_per_dim and lost (the fixed ceiling; the pause
+  // state's share is added by the caller) and returns the best squared distance.
+  float emit_all_states(const float* phi, float noise, const FollowerHistory& history,
+                        std::vector<float>& alpha, std::vector<float>& scratch, float* distance_sq,
+                        FollowResult& result) const noexcept;
 
   const TemplateModel* model_ = nullptr;
   FollowParams params_;
@@ -107,7 +116,7 @@ class HmmForward {
   float leave_ = 0.0f;
   TempoLimits tempo_limits_;
   float pause_stay_ = 0.0f;
-  std::vector<float> resume_;  // R_i, normalised; empty = uniform 1/M
+  std::vector<float> resume_;       // R_i, normalised; empty = uniform 1/M
   NoiseScaledLevels noise_levels_;  // the emission scale, pause level and lost distance
 };
 
