@@ -6,7 +6,10 @@
 namespace duet {
 
 PostureBias::PostureBias(int begin, int size, const PostureBiasParams& params)
-    : begin_(begin), params_(params), offset_(static_cast<std::size_t>(std::max(size, 0)), 0.0f) {}
+    : begin_(begin),
+      params_(params),
+      mean_(static_cast<std::size_t>(std::max(size, 0)), 0.0f),
+      offset_(mean_.size(), 0.0f) {}
 
 void PostureBias::correct(std::span<float> features) const noexcept {
   if (!params_.enabled) return;
@@ -16,27 +19,41 @@ void PostureBias::correct(std::span<float> features) const noexcept {
 }
 
 void PostureBias::learn(std::span<const float> corrected, std::span<const float> matched,
-                        double dt_s, float confidence) noexcept {
-  if (!params_.enabled || !(dt_s > 0.0) || !std::isfinite(dt_s) || !std::isfinite(confidence)) {
+                        double dt_s, float confidence, float sensor_noise) noexcept {
+  if (!params_.enabled || !(dt_s > 0.0) || !std::isfinite(dt_s) || !std::isfinite(confidence) ||
+      !std::isfinite(sensor_noise)) {
     return;
   }
+  for (std::size_t d = 0; d < offset_.size(); ++d) {
+    const std::size_t i = static_cast<std::size_t>(begin_) + d;
+    if (!std::isfinite(corrected[i] - matched[i])) return;
+  }
   // A running mean while little has been seen (the time constant grows with the time learnt), then
-  // a first-order low-pass: offset += a * residual, a = 1 - exp(-dt / tau). Frames the follower is
-  // unsure of count less, but still count: a rig far from the library's leaves every frame unsure
-  // until the offset is learnt.
+  // a first-order low-pass: mean += a * (residual - mean), a = 1 - exp(-dt / tau). Frames the
+  // follower is unsure of count less, but still count: a rig far from the library's leaves every
+  // frame unsure until the offset is learnt.
   const double weight = std::max(static_cast<double>(confidence), params_.min_weight);
   learnt_s_ += weight * dt_s;
   const double tau = std::min(params_.time_constant_s, learnt_s_);
   const auto rate = static_cast<float>(weight * (1.0 - std::exp(-dt_s / tau)));
+  // The running mean of white noise of variance s^2 has variance s^2 a / (2 - a).
+  const double mean_variance =
+      std::max(0.0, static_cast<double>(sensor_noise)) * rate / (2.0 - rate);
+  const double k_squared = params_.shrink_k * params_.shrink_k;
   for (std::size_t d = 0; d < offset_.size(); ++d) {
     const std::size_t i = static_cast<std::size_t>(begin_) + d;
-    const float residual = corrected[i] - matched[i];
-    if (!std::isfinite(residual)) return;
-    offset_[d] = std::clamp(offset_[d] + rate * residual, -params_.max_offset, params_.max_offset);
+    const float residual = corrected[i] + offset_[d] - matched[i];  // input - matched
+    mean_[d] = std::clamp(mean_[d] + rate * (residual - mean_[d]), -params_.max_offset,
+                          params_.max_offset);
+    const double mean_squared = static_cast<double>(mean_[d]) * mean_[d];
+    const double keep =
+        mean_squared > 0.0 ? std::max(0.0, 1.0 - k_squared * mean_variance / mean_squared) : 0.0;
+    offset_[d] = static_cast<float>(mean_[d] * keep);
   }
 }
 
 void PostureBias::reset() noexcept {
+  std::ranges::fill(mean_, 0.0f);
   std::ranges::fill(offset_, 0.0f);
   learnt_s_ = 0.0;
 }

@@ -70,7 +70,7 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
     bias_.learn(features_,
                 std::span<const float>(rows.row(result.state).data(),
                                        static_cast<std::size_t>(rows.cols())),
-                dt_s, result.confidence);
+                dt_s, result.confidence, result.sensor_noise_per_dim);
   }
   if (library_->grown()) report_captured_place(result);
   return result;

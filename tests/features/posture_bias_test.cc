@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 namespace duet {
@@ -48,6 +50,46 @@ TEST(PostureBias, UnsureFramesCountLessAndBadInputIsIgnored) {
   sure.learn(nan, matched, 1.0 / 60.0, 1.0f);
   sure.learn(matched, matched, -1.0, 1.0f);
   EXPECT_EQ(sure.offset()[0], before);
+}
+
+TEST(PostureBias, ANoiseSizedAverageIsNotAppliedButARigsOffsetUnderTheSameNoiseIs) {
+  // Issue 11: under a noisy sensor the running mean wanders by noise; subtracting that made the
+  // follower worse. The applied offset is shrunk by the mean's own uncertainty.
+  const float noise_sd = 0.3f;
+  PostureBias noise_only(0, 1, {}), rig(0, 1, {}), unshrunk(0, 1, [] {
+    PostureBiasParams params;
+    params.shrink_k = 0.0;
+    return params;
+  }());
+  const std::vector<float> matched = {0.0f};
+  std::uint32_t state = 12345u;
+  auto gaussian = [&state] {  // Box-Muller on a small LCG: the test's own noise, reproducible
+    auto uniform = [&state] {
+      state = state * 1664525u + 1013904223u;
+      return (static_cast<float>(state >> 8) + 0.5f) / 16777216.0f;
+    };
+    const float u = uniform(), v = uniform();
+    return std::sqrt(-2.0f * std::log(u)) * std::cos(6.2831853f * v);
+  };
+  float largest_noise_offset = 0.0f, largest_unshrunk = 0.0f;
+  for (int f = 0; f < 1800; ++f) {  // 60 s at 30 Hz
+    const float n = noise_sd * gaussian();
+    std::vector<float> a = {n}, b = {0.25f + n}, c = {n};
+    noise_only.correct(a);
+    noise_only.learn(a, matched, 1.0 / 30.0, 1.0f, noise_sd * noise_sd);
+    rig.correct(b);
+    rig.learn(b, matched, 1.0 / 30.0, 1.0f, noise_sd * noise_sd);
+    unshrunk.correct(c);
+    unshrunk.learn(c, matched, 1.0 / 30.0, 1.0f, noise_sd * noise_sd);
+    if (f >= 300) {
+      largest_noise_offset = std::max(largest_noise_offset, std::abs(noise_only.offset()[0]));
+      largest_unshrunk = std::max(largest_unshrunk, std::abs(unshrunk.offset()[0]));
+    }
+  }
+  EXPECT_LT(largest_noise_offset, 0.25f * largest_unshrunk);  // the mean wandered, little applied
+  EXPECT_GT(largest_unshrunk, 0.02f);
+  EXPECT_NEAR(rig.offset()[0], 0.25f, 0.05f);  // the rig's offset: applied
+  EXPECT_NEAR(rig.mean()[0], 0.25f, 0.05f);
 }
 
 TEST(PostureBias, ARunawayOffsetIsBounded) {

@@ -9,6 +9,13 @@
 // the residual between the (corrected) input and the template frame the follower has confidently
 // matched, and subtracted from later inputs, like cepstral mean normalisation in speech. On the
 // library's own rig the residual averages to about zero, so nothing changes there.
+//
+// Under a noisy sensor the average is itself noisy, and an offset of noise-level size made things
+// worse, not better: at 4 degrees per axis the follower with no offset at all was up to 5 points
+// closer to the truth (docs/features.md). So the offset applied is the average shrunk by its own
+// uncertainty, the sensor's white-noise variance (estimated online by the tracker) over the
+// average's effective number of frames: a rig's real offset, many standard errors from zero, is
+// applied whole; noise-sized averages are not applied at all.
 #pragma once
 
 #include <span>
@@ -26,6 +33,10 @@ struct PostureBiasParams {
   // lost distance. Learning from every frame let a walk's offset make it look like salsa (the
   // Bandai walk went from 98 % lost to 69 %); measured in docs/features.md.
   float max_learn_distance_per_dim = 0.005f;
+  // Per dimension the applied offset is mean * max(0, 1 - (k se / mean)^2), se^2 the variance
+  // of the running mean given the sensor's noise (James-Stein-like positive-part shrinkage).
+  // 2 / 3 / 4 / 6 swept in docs/features.md; 0 applies the mean as learnt.
+  double shrink_k = 4.0;
 };
 
 class PostureBias {
@@ -37,19 +48,25 @@ class PostureBias {
   // Subtracts the current offset from the posture dimensions. Allocates nothing.
   void correct(std::span<float> features) const noexcept;
   // Learns from one frame: `corrected` is what correct() returned, `matched` the template row the
-  // follower settled on, dt_s the time since the previous frame. Non-finite input is ignored.
+  // follower settled on, dt_s the time since the previous frame, sensor_noise the input's
+  // white-noise variance per posture dimension (FollowResult::sensor_noise_per_dim; 0 for a
+  // clean sensor). Non-finite input is ignored.
   void learn(std::span<const float> corrected, std::span<const float> matched, double dt_s,
-             float confidence) noexcept;
+             float confidence, float sensor_noise = 0.0f) noexcept;
   void reset() noexcept;
 
+  // What correct() subtracts: the running mean, shrunk by its uncertainty.
   std::span<const float> offset() const noexcept { return offset_; }
+  // The running mean of input - matched template itself.
+  std::span<const float> mean() const noexcept { return mean_; }
   const PostureBiasParams& params() const noexcept { return params_; }
 
  private:
   int begin_ = 0;
   PostureBiasParams params_;
-  std::vector<float> offset_;
-  double learnt_s_ = 0.0;  // weighted seconds learnt since reset
+  std::vector<float> mean_;    // running mean of input - matched template, per dimension
+  std::vector<float> offset_;  // mean_ shrunk by its uncertainty (params_.shrink_k)
+  double learnt_s_ = 0.0;      // weighted seconds learnt since reset
 };
 
 }  // namespace duet
