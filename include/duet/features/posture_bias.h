@@ -35,7 +35,7 @@ struct PostureBiasParams {
   float max_learn_distance_per_dim = 0.005f;
   // Per dimension the applied offset is mean * max(0, 1 - (k se / mean)^2), se^2 the variance
   // of the running mean given the sensor's noise (James-Stein-like positive-part shrinkage).
-  // 2 / 3 / 4 / 6 swept in docs/features.md; 0 applies the mean as learnt.
+  // 2 / 3 / 4 / 6 swept in docs/evaluation.md ("Results", session 8); 0 applies the mean as learnt.
   double shrink_k = 4.0;
 };
 
