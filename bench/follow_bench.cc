@@ -79,6 +79,15 @@ void BM_ForwardStep30Hz(benchmark::State& state) {
 }
 BENCHMARK(BM_ForwardStep30Hz)->Arg(27495)->Unit(benchmark::kMicrosecond);
 
+// Every frame after a 1 s tracking loss: 60 transitions, one emission (the cost of the first frame
+// after such a gap; FollowParams::max_steps_per_frame).
+void BM_ForwardStepAfterGap(benchmark::State& state) {
+  const TemplateModel model = random_model(static_cast<int>(state.range(0)));
+  HmmFollower hmm = HmmFollower::create(model, {}).value();
+  run(state, hmm, model, 1.0);
+}
+BENCHMARK(BM_ForwardStepAfterGap)->Arg(27495)->Unit(benchmark::kMicrosecond);
+
 void BM_NaiveForwardStep(benchmark::State& state) {
   const TemplateModel model = random_model(static_cast<int>(state.range(0)));
   NaiveHmmFollower naive = NaiveHmmFollower::create(model, {}).value();

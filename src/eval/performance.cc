@@ -409,10 +409,41 @@ Result<Performance> with_head_hands(Performance performance, const PointNoiseOpt
   return performance;
 }
 
+namespace {
+
+// Which frames fall into a tracking loss (FrameLossOptions::gap_every_s); empty when there are
+// none. Its own random stream, so performances without losses stay what they were.
+std::vector<bool> tracking_losses(const Performance& performance, const FrameLossOptions& options) {
+  const int frames = performance.frame_count();
+  if (!(options.gap_every_s > 0.0) || frames == 0) return {};
+  Rng rng(derive_seed(options.seed, 5));
+  std::exponential_distribution<double> wait(1.0 / options.gap_every_s);
+  const double low = std::max(options.gap_min_s, 0.0);
+  const double high = std::max(options.gap_max_s, low);
+  std::vector<bool> lost(static_cast<std::size_t>(frames), false);
+  const double first = performance.times_s.front();
+  const double last = performance.times_s.back();
+  double start = first + wait(rng);
+  int f = 1;  // the first frame is always kept
+  while (start <= last) {
+    const double end = start + uniform(rng, low, high);
+    for (; f < frames && performance.times_s[static_cast<std::size_t>(f)] < end; ++f) {
+      if (performance.times_s[static_cast<std::size_t>(f)] >= start) {
+        lost[static_cast<std::size_t>(f)] = true;
+      }
+    }
+    start = end + wait(rng);
+  }
+  return lost;
+}
+
+}  // namespace
+
 Performance with_frame_loss(Performance performance, const FrameLossOptions& options) {
   Rng rng(derive_seed(options.seed, 4));
   const int frames = performance.frame_count();
   const double period = 1.0 / performance.motion.frame_rate();
+  const std::vector<bool> lost = tracking_losses(performance, options);
   // Bursts of 1..3 frames (mean 2): a burst starts after a kept frame with probability p, so the
   // dropped fraction is 2p / (1 + 2p).
   const double f = std::clamp(options.drop_fraction, 0.0, 0.9);
@@ -420,6 +451,7 @@ Performance with_frame_loss(Performance performance, const FrameLossOptions& opt
   std::vector<int> kept;
   int dropping = 0;
   for (int k = 0; k < frames; ++k) {
+    if (!lost.empty() && lost[static_cast<std::size_t>(k)]) continue;
     if (k > 0 && dropping > 0) {
       --dropping;
       continue;

@@ -94,6 +94,13 @@ std::vector<EvalCase> standard_cases(const CaseSettings& settings) {
     c.recipe.loss.repeat_fraction = 0.03;
     c.recipe.body_scale = 1.1;
   }
+  {
+    // A sensor that loses the dancer now and then: a suit's occluded markers, a controller out of
+    // the headset's view. The dancer dances on through the loss.
+    EvalCase& c = add("dropouts", "the take with the noise, tracking lost for 0.3-1 s every 8 s");
+    c.recipe.noise = noise;
+    c.recipe.loss.gap_every_s = 8.0;
+  }
   // Describe the magnitudes actually used.
   for (EvalCase& c : cases) {
     if (c.name == "harsh") continue;

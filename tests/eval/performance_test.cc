@@ -382,6 +382,40 @@ TEST(Perturbations, RepeatedFramesShowThePreviousPoseAndPassTheJumpOn) {
   EXPECT_EQ(with_frame_loss(full, same).times_s, lossy.times_s);
 }
 
+TEST(Perturbations, TrackingLossesDropWholeSpansAndPassTheJumpOn) {
+  const Fixture f = make_fixture(1800);  // 30 s at 60 Hz
+  const SourceTake source = f.source();
+  const Performance full = improvise(std::span(&source, 1), improv_options(0.0)).value();
+  FrameLossOptions options;
+  options.gap_every_s = 4.0;
+  options.seed = 7;
+  ASSERT_TRUE(options.active());
+  const Performance lossy = with_frame_loss(full, options);
+  ASSERT_EQ(lossy.truth.size(), static_cast<std::size_t>(lossy.frame_count()));
+  EXPECT_DOUBLE_EQ(lossy.times_s.front(), full.times_s.front());  // the first frame is kept
+  // Every hole in the timeline is one loss of 0.3-1 s (no burst drops were asked for).
+  int gaps = 0;
+  double lost_s = 0.0;
+  for (std::size_t k = 1; k < lossy.times_s.size(); ++k) {
+    const double hole = lossy.times_s[k] - lossy.times_s[k - 1] - 1.0 / 60.0;
+    if (hole < 1e-9) continue;
+    ++gaps;
+    lost_s += hole;
+    EXPECT_GE(hole, 0.3 - 1.0 / 60.0 - 1e-9);
+    EXPECT_LE(hole, 1.0 + 1.0 / 60.0 + 1e-9);
+  }
+  // About 30 / (4 + 0.65) losses; what is kept is what is not lost.
+  EXPECT_GE(gaps, 3);
+  EXPECT_LE(gaps, 12);
+  EXPECT_NEAR(lost_s + lossy.frame_count() / 60.0, full.frame_count() / 60.0, 1e-6);
+  int full_jumps = 0, lossy_jumps = 0;
+  for (const TruthFrame& t : full.truth) full_jumps += t.jump ? 1 : 0;
+  for (const TruthFrame& t : lossy.truth) lossy_jumps += t.jump ? 1 : 0;
+  // A jump inside a loss passes its flag on (unless the loss ran to the end).
+  EXPECT_GE(lossy_jumps, full_jumps - 1);
+  EXPECT_LE(lossy_jumps, full_jumps);
+}
+
 TEST(EvalCases, HarshCaseAndNoiseSweepHaveIssue11sMagnitudes) {
   const std::vector<EvalCase> cases = standard_cases();
   const auto harsh = std::ranges::find(cases, std::string("harsh"), &EvalCase::name);

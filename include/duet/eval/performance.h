@@ -133,7 +133,9 @@ void record_true_wrists(Performance& performance);
 // [0, jitter_s]. Timestamps stay strictly increasing. A jump flag on a dropped frame moves to the
 // next kept frame. repeat_fraction of the kept frames (never the first) repeat the previous kept
 // frame's pose, as a sensor that sends a stale sample again does; their truth is the repeated
-// pose's (a jump flag moves on to the next frame).
+// pose's (a jump flag moves on to the next frame). Tracking losses (an occluded suit, a controller
+// out of the headset's view) drop every frame of spans of [gap_min_s, gap_max_s] seconds, one
+// every gap_every_s on average (exponential waits between them; never the first frame).
 struct FrameLossOptions {
   double drop_fraction = 0.0;
   double late_fraction = 0.0;
@@ -141,9 +143,13 @@ struct FrameLossOptions {
   double jitter_s = 0.0;
   std::uint64_t seed = 1;
   double repeat_fraction = 0.0;
+  double gap_every_s = 0.0;  // 0: no tracking losses
+  double gap_min_s = 0.3;
+  double gap_max_s = 1.0;
 
   bool active() const {
-    return drop_fraction > 0.0 || late_fraction > 0.0 || jitter_s > 0.0 || repeat_fraction > 0.0;
+    return drop_fraction > 0.0 || late_fraction > 0.0 || jitter_s > 0.0 || repeat_fraction > 0.0 ||
+           gap_every_s > 0.0;
   }
 };
 Performance with_frame_loss(Performance performance, const FrameLossOptions& options);

@@ -178,8 +178,12 @@ struct FollowParams {
   float outlier_pause_fraction = 0.5f;
 
   // Input at another rate: each input frame applies n = clamp(round(dt_s * template_fps), 1,
-  // max_steps_per_frame) template-rate transitions before its emission.
-  int max_steps_per_frame = 8;
+  // max_steps_per_frame) template-rate transitions before its emission. The cap also bounds a
+  // tracking loss: after a gap the dancer has danced on, and a band that could not follow them
+  // (8 steps, 0.13 s at 60 Hz) left them to the pause state, a reported jump at every loss of
+  // 0.3-1 s (the `dropouts` case: 4.5-7.3 false jumps a minute, 0 with 120). A frame after a
+  // 2 s gap then costs 120 band transitions (docs/follower.md, "Tracking losses").
+  int max_steps_per_frame = 120;
 
   // The paper's hand-set values [4.2]: self = next = 0.33, leave = resume = 0.165 (resume is
   // 1 - A_NN, so A_NN = 0.835). The paper gives no skip probability: skip = 0. Rows are
