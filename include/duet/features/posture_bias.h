@@ -11,11 +11,11 @@
 // library's own rig the residual averages to about zero, so nothing changes there.
 //
 // Under a noisy sensor the average is itself noisy, and an offset of noise-level size made things
-// worse, not better: at 4 degrees per axis the follower with no offset at all was up to 5 points
-// closer to the truth (docs/features.md). So the offset applied is the average shrunk by its own
-// uncertainty, the sensor's white-noise variance (estimated online by the tracker) over the
-// average's effective number of frames: a rig's real offset, many standard errors from zero, is
-// applied whole; noise-sized averages are not applied at all.
+// worse, not better: at 4 degrees per axis the follower with no offset at all was up to 2.9 points
+// closer to the truth on `noise` (docs/evaluation.md, "Results", session 8). So the offset applied
+// is the average shrunk by its own uncertainty, the sensor's white-noise variance (estimated
+// online by the tracker) over the average's effective number of frames: a rig's real offset, many
+// standard errors from zero, is applied whole; noise-sized averages are not applied at all.
 #pragma once
 
 #include <span>
