@@ -420,7 +420,8 @@ Command register_eval(CLI::App& app) {
                  "(or tempo), drift, improv, improv-pause, improv-library, noise, 30hz-noisy, "
                  "late-frames, body-size, room-place, partner-role, improv-30hz-noisy, harsh "
                  "(30 Hz, 4 deg per axis + 1 cm noise, 3% repeated frames, a 1.1x body), "
-                 "dropouts (the noise, and the sensor loses the dancer for 0.3-1 s every 8 s)")
+                 "120hz-noisy (a 120 Hz sensor with the noise), dropouts (the noise, and the "
+                 "sensor loses the dancer for 0.3-1 s every 8 s)")
       ->delimiter(',');
   app.add_flag("--noise-sweep", args->noise_sweep,
                "Also run noise-sweep-0 ... noise-sweep-5: improv-pause with 0 to 5 degrees of "

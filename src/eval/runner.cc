@@ -95,6 +95,13 @@ std::vector<EvalCase> standard_cases(const CaseSettings& settings) {
     c.recipe.body_scale = 1.1;
   }
   {
+    // A suit faster than the template (Perception Neuron, Xsens, Rokoko run at 100-240 Hz): more
+    // frames than template frames, each with its own noise.
+    EvalCase& c = add("120hz-noisy", "a 120 Hz sensor with the noise");
+    c.recipe.play.rate_hz = 120.0;
+    c.recipe.noise = noise;
+  }
+  {
     // A sensor that loses the dancer now and then: a suit's occluded markers, a controller out of
     // the headset's view. The dancer dances on through the loss.
     EvalCase& c = add("dropouts", "the take with the noise, tracking lost for 0.3-1 s every 8 s");

@@ -58,7 +58,8 @@ struct CaseSettings {
 // The standard cases, in report order: clean, tempo-slow, tempo-fast, drift, improv,
 // improv-pause, improv-library, noise, 30hz-noisy, late-frames, body-size, room-place,
 // partner-role, improv-30hz-noisy, harsh (issue 11's sensor: fixed magnitudes, not the settings),
-// dropouts (the noise, and tracking lost for 0.3-1 s every 8 s on average).
+// 120hz-noisy (a sensor faster than the template, with the noise), dropouts (the noise, and
+// tracking lost for 0.3-1 s every 8 s on average).
 std::vector<EvalCase> standard_cases(const CaseSettings& settings = {});
 
 // The noise sweep (`duet eval --noise-sweep`): noise-sweep-0 ... noise-sweep-5, improv-pause at
