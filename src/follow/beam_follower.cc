@@ -516,7 +516,9 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
     context.history_.tempo.update(context.history_.previous_state, result.state, result.steps, dt_s,
                                   band_move, exact_.tempo_limits_);
   }
-  result.tempo = context.history_.tempo.tempo();
+  context.history_.tempo.observe_rate(result.steps, dt_s, model.frame_rate_hz(),
+                                      exact_.tempo_limits_);
+  result.tempo = context.history_.tempo.dancer_tempo();
   context.history_.total_log_likelihood += result.log_likelihood;
   ++context.history_.frames;
   context.history_.previous_state = result.state;

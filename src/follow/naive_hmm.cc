@@ -145,7 +145,8 @@ FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s
     const bool band_move = !result.missing && !result.lost && !result.jumped;
     tempo_.update(previous_state_, result.state, result.steps, dt_s, band_move, tempo_limits_);
   }
-  result.tempo = tempo_.tempo();
+  tempo_.observe_rate(result.steps, dt_s, model.frame_rate_hz(), tempo_limits_);
+  result.tempo = tempo_.dancer_tempo();
   previous_state_ = result.state;
   previous_lost_ = result.lost;
   return result;

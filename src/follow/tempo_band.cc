@@ -56,4 +56,31 @@ void TempoEstimator::update(int previous_state, int state, int steps, double dt_
   tempo_ = static_cast<float>(std::clamp(next, double{limits.min_tempo}, double{limits.max_tempo}));
 }
 
+void TempoEstimator::observe_rate(int steps, double dt_s, double template_fps,
+                                  const TempoLimits& limits) noexcept {
+  if (steps < 1 || !(dt_s > 0.0) || !std::isfinite(dt_s) || !(template_fps > 0.0) ||
+      !std::isfinite(template_fps)) {
+    return;
+  }
+  const double frames = dt_s * template_fps;
+  if (!(mean_template_frames_ > 0.0)) {  // the first frame with a time sets both
+    mean_steps_ = steps;
+    mean_template_frames_ = frames;
+    return;
+  }
+  // Means of a ratio's two sides, not of the ratio: a late frame (1.4 periods, one step) and the
+  // early one after it (0.6, one step) average to one step per template frame.
+  const double weight = 1.0 - std::exp(-dt_s / limits.time_constant_s);
+  mean_steps_ += weight * (steps - mean_steps_);
+  mean_template_frames_ += weight * (frames - mean_template_frames_);
+}
+
+float TempoEstimator::dancer_tempo() const noexcept {
+  if (!(mean_template_frames_ > 0.0)) return tempo_;
+  // At the template's rate or slower one step is one template frame of time; only a sensor
+  // faster than the template makes more steps than frames of time.
+  const double steps_per_frame = std::max(mean_steps_ / mean_template_frames_, 1.0);
+  return static_cast<float>(tempo_ * steps_per_frame);
+}
+
 }  // namespace duet

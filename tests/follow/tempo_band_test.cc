@@ -94,6 +94,40 @@ TEST(TempoEstimator, IgnoresJumpsPausesAndBackwardMoves) {
   EXPECT_EQ(estimator.tempo(), learned);
 }
 
+TEST(TempoEstimator, ReportsTheDancersTempoAtAnySensorRate) {
+  const TempoLimits limits;
+  // 120 Hz on a 60 Hz template: one step per frame, a dancer at the template's tempo moves one
+  // template frame every other frame, 0.5 per step. The dancer's tempo is 1.
+  TempoEstimator fast;
+  int state = 100;
+  for (int t = 0; t < 1200; ++t) {
+    const int moved = t % 2;
+    fast.update(state, state + moved, 1, 1.0 / 120, true, limits);
+    fast.observe_rate(1, 1.0 / 120, 60.0, limits);
+    state += moved;
+  }
+  EXPECT_NEAR(fast.tempo(), 0.5f, 0.02f);
+  EXPECT_NEAR(fast.dancer_tempo(), 1.0f, 0.04f);
+  // 30 Hz (two steps a frame) and 60 Hz with late and early frames: a step is a template frame.
+  TempoEstimator slow, jittered;
+  for (int t = 0; t < 300; ++t) {
+    slow.update(t * 2, t * 2 + 2, 2, 1.0 / 30, true, limits);
+    slow.observe_rate(2, 1.0 / 30, 60.0, limits);
+    const double dt = t % 2 == 0 ? 1.4 / 60 : 0.6 / 60;  // late, then the early one after it
+    jittered.update(t, t + 1, 1, dt, true, limits);
+    jittered.observe_rate(1, dt, 60.0, limits);
+  }
+  EXPECT_FLOAT_EQ(slow.dancer_tempo(), slow.tempo());
+  EXPECT_NEAR(jittered.dancer_tempo(), jittered.tempo(), 0.02f);
+  // Bad timing teaches nothing; reset forgets the rate.
+  const float before = fast.dancer_tempo();
+  fast.observe_rate(1, std::nan(""), 60.0, limits);
+  fast.observe_rate(1, 0.0, 60.0, limits);
+  EXPECT_EQ(fast.dancer_tempo(), before);
+  fast.reset();
+  EXPECT_EQ(fast.dancer_tempo(), 1.0f);
+}
+
 TEST(TempoEstimator, StaysInItsRange) {
   TempoEstimator estimator;
   const TempoLimits limits{0.5, 0.4f, 1.8f};

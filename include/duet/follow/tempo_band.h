@@ -48,6 +48,8 @@ class TempoEstimator {
   void reset() noexcept {
     tempo_ = 1.0f;
     updates_ = 0;
+    mean_steps_ = 0.0;
+    mean_template_frames_ = 0.0;
   }
   // One decision: the estimate moved from previous_state to state in `steps` template-rate steps
   // over dt_s seconds of input; usable is false for frames that must not count (see above).
@@ -55,9 +57,25 @@ class TempoEstimator {
               const TempoLimits& limits) noexcept;
   float tempo() const noexcept { return tempo_; }
 
+  // Every frame: it applied `steps` transitions for dt_s seconds of input (dt_s * template_fps
+  // template frames). A sensor faster than the template applies one step per frame however short
+  // the frame, so tempo() counts per step, not per template frame of time: at 240 Hz on a 60 Hz
+  // template a dancer at the template's tempo moves 0.25 frames a step. Ignores a first frame
+  // (dt_s 0) and non-finite input.
+  void observe_rate(int steps, double dt_s, double template_fps,
+                    const TempoLimits& limits) noexcept;
+  // The dancer's tempo in template frames per template frame of input time (1 = the template's
+  // tempo) at any sensor rate: tempo() times the steps applied per template frame of input time
+  // (averages over the estimate's memory). What the partner's playhead and `/duet/tempo` need.
+  float dancer_tempo() const noexcept;
+
  private:
   float tempo_ = 1.0f;
   int updates_ = 0;  // band moves seen since reset, for the start-up average
+  // Averages of the steps applied per frame and of the template frames of input time per frame
+  // (observe_rate); their ratio is 1 at the template's rate or slower.
+  double mean_steps_ = 0.0;
+  double mean_template_frames_ = 0.0;
 };
 
 }  // namespace duet
