@@ -6,23 +6,19 @@
 #include <cstdlib>
 
 #include "duet/follow/hmm_follower.h"
-#include "duet/io/motion_file.h"
 #include "salsa_library.h"
 
 namespace duet {
 namespace {
 
 TEST(TrackingLossFollow, AfterASecondWithoutFramesTheDancerIsFoundAgainWithoutAJump) {
-  MotionLoadOptions options;
-  options.frame_rate = 60.0;
-  Result<LoadedMotion> take =
-      load_motion({test::kSalsaData + "/cmu-salsa/bvh/60/60_01_scaled.bvh"}, options);
-  ASSERT_TRUE(take) << take.error().message;
-  const Clip& clip = take.value().clip;
+  // Take 01 as the library loaded it (its take 0).
+  const LoadedMotion& take = test::salsa_library().takes()[0].template_motion;
+  const Clip& clip = take.clip;
   Result<HmmFollower> follower = HmmFollower::create(test::salsa_library().model(), FollowParams{});
   ASSERT_TRUE(follower) << follower.error().message;
   Result<FollowSession> session =
-      FollowSession::create(test::salsa_library(), clip.skeleton_ptr(), take.value().roles,
+      FollowSession::create(test::salsa_library(), clip.skeleton_ptr(), take.roles,
                             std::make_unique<HmmFollower>(std::move(follower).value()));
   ASSERT_TRUE(session) << session.error().message;
 
