@@ -16,9 +16,30 @@ float JumpGate::hold_s(const FollowParams& params, float sensor_noise_per_dim) n
   return std::max(params.jump_hold_s, ramp * params.noisy_jump_hold_s);
 }
 
+bool JumpGate::through_spell(const TemplateModel& model, const FollowParams& params,
+                             int previous_state, bool previous_lost,
+                             FollowResult& result) noexcept {
+  const bool adrift = !result.missing && result.state >= 0 && (result.lost || result.in_pause);
+  if (adrift && anchor_state_ < 0 && previous_state >= 0 && !previous_lost) {
+    anchor_state_ = previous_state;  // a spell begins: remember the place before it
+    steps_since_anchor_ = 0;
+  }
+  if (anchor_state_ < 0) return false;
+  steps_since_anchor_ += std::max(result.steps, 1);
+  result.jumped = false;
+  if (adrift || result.missing || result.state < 0) return true;
+  // Found again: a jump if out of reach of the place before the spell over the time it lasted.
+  result.jumped = settled(params) &&
+                  follow_detail::is_jump(model, anchor_state_, result.state, steps_since_anchor_);
+  anchor_state_ = -1;
+  forget_candidate();
+  return true;
+}
+
 void JumpGate::apply(const TemplateModel& model, const FollowParams& params, const float* posterior,
                      float total, int previous_state, bool previous_lost,
                      FollowResult& result) noexcept {
+  if (through_spell(model, params, previous_state, previous_lost, result)) return;
   // Right after a lost frame (a jump's first landing is often one: a poor match on the way in)
   // every move past the band is a jump again: the landing is refined, and the partner must
   // restart at the refined place (else it plays on from the poor one).

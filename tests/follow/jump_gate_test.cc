@@ -128,6 +128,47 @@ TEST(JumpGate, AfterALostFrameTheNewPlaceIsTakenAtOnce) {
   EXPECT_EQ(r.state, 150);
 }
 
+TEST(JumpGate, WhileLostTheWanderingMaximumIsNoJumpAndBeingFoundAgainElsewhereIsOne) {
+  const TemplateModel model = two_takes();
+  FollowParams params;
+  params.jump_settle_s = 0.0f;
+  params.jump_hold_s = 0.0f;
+  const auto adrift_at = [&](int state, bool in_pause) {
+    FollowResult r = maximum_at(model, {}, state);
+    r.lost = !in_pause;
+    r.in_pause = in_pause;
+    return r;
+  };
+  for (const bool found_far : {true, false}) {
+    JumpGate gate;
+    // Followed at 40, then five frames lost or in the pause state while the maximum hops
+    // between takes: none of them is a jump.
+    int previous = 40;
+    bool previous_lost = false;
+    for (const int state : {150, 20, 170, 60, 120}) {
+      const std::vector<float> p = posterior(state);
+      FollowResult r = adrift_at(state, state % 20 == 0);
+      gate.apply(model, params, p.data(), 1.0f, previous, previous_lost, r);
+      EXPECT_FALSE(r.jumped) << state;
+      EXPECT_EQ(r.state, state);  // the estimate is still the maximum
+      previous = state;
+      previous_lost = true;
+    }
+    // Found again: at 48, within reach of 40 after 6 frames (up to 52), no jump; at 160, one.
+    const int found = found_far ? 160 : 48;
+    const std::vector<float> p = posterior(found);
+    FollowResult r = maximum_at(model, p, found);
+    gate.apply(model, params, p.data(), 1.0f, previous, previous_lost, r);
+    EXPECT_EQ(r.jumped, found_far);
+    // The spell is over: the next frame is judged from the place found again.
+    const std::vector<float> next = posterior(found + 1);
+    r = maximum_at(model, next, found + 1);
+    r.jumped = false;
+    gate.apply(model, params, next.data(), 1.0f, found, false, r);
+    EXPECT_FALSE(r.jumped);
+  }
+}
+
 TEST(JumpGate, TheFirstPlacementIsRefinedWithoutJumpsUntilItHasSettled) {
   const TemplateModel model = two_takes();
   FollowParams params;

@@ -9,10 +9,14 @@
 // grows with the estimated noise (noisy_jump_hold_s), and once the old place's reach holds at most
 // jump_old_place_mass of the posterior (a look-alike's brief maximum leaves the old place its
 // evidence; a real jump does not).
-// After a lost frame (or in the pause state) the new place is taken at once. Until the estimate
-// has first settled (FollowParams::jump_settle_s of frames within reach with a window mass of at
-// least jump_settle_mass) a far move is the first placement being refined: no jump is reported
-// (half the false jumps left at 4 degrees per axis were those).
+// Adrift (lost, or the pause state holds the posterior) no place explains the input and the
+// maximum wanders between look-alike places from frame to frame (three points under noise: 29
+// jumps a minute, nearly all while lost): nothing is reported as a jump during the spell. The
+// first frame found again is a jump if it is out of reach of the place reported before the spell,
+// over the time the spell lasted. After a lost frame with no such place the new place is taken at
+// once. Until the estimate has first settled (FollowParams::jump_settle_s of frames within reach
+// with a window mass of at least jump_settle_mass) a far move is the first placement being
+// refined: no jump is reported (half the false jumps left at 4 degrees per axis were those).
 #pragma once
 
 #include "duet/follow/follow_params.h"
@@ -27,6 +31,8 @@ class JumpGate {
   void reset() noexcept {
     forget_candidate();
     settled_s_ = 0.0;
+    anchor_state_ = -1;
+    steps_since_anchor_ = 0;
   }
 
   // `result` holds the posterior's maximum (follow_detail::decide); on return it holds the state
@@ -49,6 +55,12 @@ class JumpGate {
     held_s_ = 0.0;
   }
 
+  // While adrift, and on the frame found again: decides the frame and returns true.
+  bool through_spell(const TemplateModel& model, const FollowParams& params, int previous_state,
+                     bool previous_lost, FollowResult& result) noexcept;
+
+  int anchor_state_ = -1;       // during a spell: the state reported before it
+  int steps_since_anchor_ = 0;  // template steps since then
   double settled_s_ = 0.0;    // how long (template time) the estimate has stayed within reach
   int candidate_state_ = -1;  // the far place that currently holds the maximum
   double held_s_ = 0.0;       // how long (template time) it has held it
