@@ -161,6 +161,8 @@ void LiveLoop::reset() noexcept {
   playhead_.reset();
   previous_take_ = -1;
   previous_frame_ = 0;
+  coasting_ = false;
+  lost_s_ = 0.0;
   has_previous_ = false;
   head_height_max_m_ = 0.0;
 }
@@ -186,6 +188,26 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
     take = std::max(previous_take_, 0);
     frame_in_take = previous_frame_;
   }
+  const double dt_s = has_previous_ ? frame.time_s - previous_time_s_ : 0.0;
+  // While the follower is lost its estimate wanders between look-alike places from frame to
+  // frame (a headset's three points under noise: 29 reported jumps a minute). After a short
+  // spell the partner dances on by itself from where it was, at the dancer's last tempo, and
+  // goes to the follower's place once the dancer is found again.
+  const bool timed = std::isfinite(dt_s) && dt_s > 0.0;
+  lost_s_ = result.lost ? lost_s_ + (timed ? dt_s : 0.0) : 0.0;
+  const bool coasting = result.lost && previous_take_ >= 0 &&
+                        (coasting_ || lost_s_ >= params_.playhead.coast_after_lost_s);
+  const bool found_again = coasting_ && !coasting;
+  if (coasting) {
+    take = previous_take_;
+    if (!coasting_) coast_frame_ = previous_frame_;
+    const double tempo = std::isfinite(result.tempo) && result.tempo > 0.0f ? result.tempo : 1.0;
+    const PartnerModel& coasted = models_[static_cast<std::size_t>(take)];
+    if (timed) coast_frame_ += tempo * dt_s * coasted.frame_rate();
+    coast_frame_ = std::clamp(coast_frame_, 0.0, static_cast<double>(coasted.frame_count() - 1));
+    frame_in_take = static_cast<int>(std::lround(coast_frame_));
+  }
+  coasting_ = coasting;
   const PartnerModel& model = models_[static_cast<std::size_t>(take)];
   const Clip& response = library_->takes()[static_cast<std::size_t>(take)].response_motion.clip;
   if (!head_hands_bodies_.empty()) place_head_hands_user(take, frame_in_take);
@@ -193,8 +215,13 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   PartnerSynthesisJob job;
   job.model = &model;
   job.params = &params_;
-  job.jumped = result.jumped || (previous_take_ >= 0 && take != previous_take_);
-  job.dt_s = has_previous_ ? frame.time_s - previous_time_s_ : 0.0;
+  // A jump for the partner: one the follower reports, another take, or a far move while the
+  // follower is lost or just found again (it reports no jump then: JumpGate).
+  constexpr int kFarFrames = 6;
+  const bool far = std::abs(frame_in_take - previous_frame_) > kFarFrames;
+  job.jumped = !coasting && (result.jumped || (previous_take_ >= 0 && take != previous_take_) ||
+                             ((found_again || result.lost) && far));
+  job.dt_s = dt_s;
   // The response at the playhead (smooth) or at the estimate itself.
   double position = frame_in_take;
   if (params_.smooth) {
@@ -231,6 +258,7 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
     (template_side(pair) == Side::kLeft ? out_.contact_left : out_.contact_right) = true;
   }
   out_.partner_take = take;
+  out_.partner_frame = job.frame;
 
   previous_take_ = take;
   previous_frame_ = frame_in_take;

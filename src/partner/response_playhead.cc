@@ -21,6 +21,7 @@ const char* PlayheadParams::validate() const noexcept {
   if (!(jitter_time_constant_s > 0.0) || !std::isfinite(jitter_time_constant_s)) {
     return "jitter_time_constant_s must be finite and > 0";
   }
+  if (!(coast_after_lost_s >= 0.0)) return "coast_after_lost_s must be >= 0";
   return "";
 }
 

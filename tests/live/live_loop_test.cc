@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include "duet/follow/hmm_follower.h"
 #include "duet/live/source_replay.h"
@@ -116,6 +118,61 @@ TEST(LiveLoop, WithoutCorrectionsThePartnerIsTheCapturedResponse) {
                 1e-9);
     }
   }
+}
+
+// Follows take 0 for 5 s, then one second of a pose no dance has (every joint turned a quarter
+// turn), and returns the partner's frame for each frame of that second.
+std::vector<LiveOutput> lost_second(const PartnerParams& params) {
+  LiveLoop loop = make_loop(params);
+  const Clip& user = fixture().user.clip;
+  for (int f = 0; f < 300; ++f) loop.step(frame_of(user, f));
+  const Quat contorted(Eigen::AngleAxisd(1.57, Vec3::UnitX()));
+  std::vector<LiveOutput> outputs;
+  for (int f = 300; f < 360; ++f) {
+    SourceFrame frame = frame_of(user, f);
+    for (std::size_t j = 1; j < frame.rotations_ls.size(); ++j) frame.rotations_ls[j] = contorted;
+    outputs.push_back(loop.step(frame));
+  }
+  return outputs;
+}
+
+TEST(LiveLoop, WhileTheFollowerIsLostThePartnerDancesOnByItself) {
+  // The follower is lost and its maximum wanders. After the first 0.1 s
+  // (PlayheadParams::coast_after_lost_s) the partner goes on from where it is, a frame at a time.
+  const std::vector<LiveOutput> outputs = lost_second(PartnerParams{});
+  int lost = 0;
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const LiveOutput& out = outputs[i];
+    ASSERT_TRUE(all_finite(out)) << "frame " << i;
+    EXPECT_EQ(out.partner_take, 0);
+    if (out.follow.lost) ++lost;
+    if (i > 10) {
+      EXPECT_FALSE(out.follow.jumped) << "frame " << i;
+      EXPECT_GE(out.partner_frame - outputs[i - 1].partner_frame, 0) << "frame " << i;
+      EXPECT_LE(out.partner_frame - outputs[i - 1].partner_frame, 2) << "frame " << i;
+    }
+  }
+  EXPECT_GE(lost, 50);
+  // At the dancer's tempo, about 1.
+  EXPECT_NEAR(outputs.back().partner_frame - outputs[10].partner_frame, 49, 6);
+
+  // Coasting from the first lost frame, the partner dances on from where the dancer was lost;
+  // never coasting, it follows the estimate to wherever it wanders.
+  const auto far_moves = [](const std::vector<LiveOutput>& run) {
+    int moves = 0;
+    for (std::size_t i = 1; i < run.size(); ++i) {
+      if (std::abs(run[i].partner_frame - run[i - 1].partner_frame) > 6) ++moves;
+    }
+    return moves;
+  };
+  PartnerParams at_once;
+  at_once.playhead.coast_after_lost_s = 0.0;
+  const std::vector<LiveOutput> coasted = lost_second(at_once);
+  EXPECT_EQ(far_moves(coasted), 0);
+  EXPECT_NEAR(coasted.back().partner_frame, 359, 6);
+  PartnerParams never;
+  never.playhead.coast_after_lost_s = std::numeric_limits<double>::infinity();
+  EXPECT_GT(far_moves(lost_second(never)), 0);
 }
 
 TEST(LiveLoop, SwitchesAndReset) {

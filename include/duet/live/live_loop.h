@@ -40,6 +40,7 @@ struct LiveOutput {
   bool contact_right = false;
   PartnerFrameInfo partner_info;
   int partner_take = 0;              // the take whose response the partner pose comes from
+  int partner_frame = 0;             // and its frame (the playhead's, rounded)
   bool partner_synthesised = false;  // false: the raw response pose (the job could not run)
 
   // World transforms of the user's skeleton (the source's) and of the partner's.
@@ -108,6 +109,9 @@ class LiveLoop {
   Pose shown_pose_;  // the response sampled at the playhead
   int previous_take_ = -1;
   int previous_frame_ = 0;
+  bool coasting_ = false;  // the follower was lost: the partner danced on by itself
+  double coast_frame_ = 0.0;
+  double lost_s_ = 0.0;  // where it danced on to (response frame)
   double previous_time_s_ = 0.0;
   bool has_previous_ = false;
 };

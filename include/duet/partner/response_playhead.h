@@ -31,6 +31,11 @@ struct PlayheadParams {
   double jitter_offset_factor = 3.0;
   double max_jitter_offset_frames = 3.0;
   double jitter_time_constant_s = 1.0;
+  // Once the follower has been lost this long (seconds) the partner dances on by itself from
+  // where it was, at the dancer's last tempo, instead of following an estimate that wanders
+  // between look-alike places (LiveLoop; docs/partner.md "Lost"). Shorter spells, such as the
+  // landing of a jump, are followed as they come. 0: from the first lost frame; inf: never.
+  double coast_after_lost_s = 0.1;
   // Empty when valid, else which value is wrong.
   const char* validate() const noexcept;
 };
