@@ -502,8 +502,12 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
     result.jumped =
         follow_detail::is_jump(model, context.history_.previous_state, result.state, result.steps);
   }
+  const bool unexplained =
+      !result.missing && result.best_distance_per_dim * static_cast<float>(model.num_dims()) >
+                             exact_.noise_levels_.lost_distance_sq(
+                                 context.frame_noise_, context.history_.explained_residual.level());
   context.history_.jump_gate.apply(model, params, alpha, 1.0f, context.history_.previous_state,
-                                   context.history_.previous_lost, result);
+                                   context.history_.previous_lost, result, unexplained);
   if (dense && !result.missing) rebuild_beam(context);
 
   result.lost = result.missing ? context.history_.previous_lost : (result.lost || result.in_pause);
@@ -524,10 +528,6 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   context.history_.previous_state = result.state;
   context.history_.previous_lost = result.lost;
   context.history_.previous_outlier = result.outlier;
-  const bool unexplained =
-      !result.missing && result.best_distance_per_dim * static_cast<float>(model.num_dims()) >
-                             exact_.noise_levels_.lost_distance_sq(
-                                 context.frame_noise_, context.history_.explained_residual.level());
   context.history_.explained_residual.update(
       result.best_distance_per_dim,
       !result.missing && !result.outlier && !result.in_pause && !result.jumped, dt_s);

@@ -234,7 +234,7 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   follow_detail::decide(model, alpha, 1.0f, alpha[num_states], context.history_.previous_state,
                         result.steps, params_.confidence_window_frames, result);
   context.history_.jump_gate.apply(model, params_, alpha, 1.0f, context.history_.previous_state,
-                                   context.history_.previous_lost, result);
+                                   context.history_.previous_lost, result, unexplained);
   result.lost = result.missing ? context.history_.previous_lost : (result.lost || result.in_pause);
   if (params_.calibrate_confidence) {
     result.confidence =

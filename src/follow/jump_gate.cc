@@ -16,30 +16,41 @@ float JumpGate::hold_s(const FollowParams& params, float sensor_noise_per_dim) n
   return std::max(params.jump_hold_s, ramp * params.noisy_jump_hold_s);
 }
 
-bool JumpGate::through_spell(const TemplateModel& model, const FollowParams& params,
-                             int previous_state, bool previous_lost,
+bool JumpGate::through_spell(const TemplateModel& model, const FollowParams& params, bool adrift,
                              FollowResult& result) noexcept {
-  const bool adrift = !result.missing && result.state >= 0 && (result.lost || result.in_pause);
-  if (adrift && anchor_state_ < 0 && previous_state >= 0 && !previous_lost) {
-    anchor_state_ = previous_state;  // a spell begins: remember the place before it
-    steps_since_anchor_ = 0;
-  }
-  if (anchor_state_ < 0) return false;
-  steps_since_anchor_ += std::max(result.steps, 1);
+  const bool unknown = result.missing || result.state < 0;
+  if (adrift && steady_state_ >= 0) in_spell_ = true;
+  if (!in_spell_) return false;
   result.jumped = false;
-  if (adrift || result.missing || result.state < 0) return true;
+  if (adrift || unknown) return true;
   // Found again: a jump if out of reach of the place before the spell over the time it lasted.
-  result.jumped = settled(params) &&
-                  follow_detail::is_jump(model, anchor_state_, result.state, steps_since_anchor_);
-  anchor_state_ = -1;
+  result.jumped =
+      settled(params) && follow_detail::is_jump(model, steady_state_, result.state,
+                                                steps_since_steady_ + std::max(result.steps, 1));
+  in_spell_ = false;
   forget_candidate();
   return true;
 }
 
 void JumpGate::apply(const TemplateModel& model, const FollowParams& params, const float* posterior,
-                     float total, int previous_state, bool previous_lost,
-                     FollowResult& result) noexcept {
-  if (through_spell(model, params, previous_state, previous_lost, result)) return;
+                     float total, int previous_state, bool previous_lost, FollowResult& result,
+                     bool unexplained) noexcept {
+  const bool adrift =
+      !result.missing && result.state >= 0 && (result.lost || result.in_pause || unexplained);
+  if (!through_spell(model, params, adrift, result)) {
+    decide(model, params, posterior, total, previous_state, previous_lost, result);
+  }
+  if (adrift || result.missing || result.state < 0) {
+    steps_since_steady_ += std::max(result.steps, 1);
+  } else {
+    steady_state_ = result.state;
+    steps_since_steady_ = 0;
+  }
+}
+
+void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
+                      const float* posterior, float total, int previous_state, bool previous_lost,
+                      FollowResult& result) noexcept {
   // Right after a lost frame (a jump's first landing is often one: a poor match on the way in)
   // every move past the band is a jump again: the landing is refined, and the partner must
   // restart at the refined place (else it plays on from the poor one).
@@ -64,8 +75,8 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
     return;
   }
   const float hold = hold_s(params, result.sensor_noise_per_dim);
-  if (previous_lost || result.in_pause || hold <= 0.0f) {
-    result.jumped = true;  // nothing to hold on to, or no delay asked for
+  if (previous_lost || result.in_pause) {
+    result.jumped = true;  // nothing to hold on to
     forget_candidate();
     return;
   }

@@ -141,14 +141,21 @@ TEST(JumpGate, WhileLostTheWanderingMaximumIsNoJumpAndBeingFoundAgainElsewhereIs
   };
   for (const bool found_far : {true, false}) {
     JumpGate gate;
-    // Followed at 40, then five frames lost or in the pause state while the maximum hops
-    // between takes: none of them is a jump.
+    // Followed at 40, then five frames lost, in the pause state or past the noise-scaled lost
+    // distance while the maximum hops between takes: none of them is a jump.
+    const std::vector<float> at40 = posterior(40);
+    FollowResult steady = maximum_at(model, at40, 40);
+    steady.jumped = false;
+    gate.apply(model, params, at40.data(), 1.0f, 39, false, steady);
+    ASSERT_FALSE(steady.jumped);
     int previous = 40;
     bool previous_lost = false;
     for (const int state : {150, 20, 170, 60, 120}) {
       const std::vector<float> p = posterior(state);
+      const bool unexplained = state == 170;
       FollowResult r = adrift_at(state, state % 20 == 0);
-      gate.apply(model, params, p.data(), 1.0f, previous, previous_lost, r);
+      if (unexplained) r.lost = false;
+      gate.apply(model, params, p.data(), 1.0f, previous, previous_lost, r, unexplained);
       EXPECT_FALSE(r.jumped) << state;
       EXPECT_EQ(r.state, state);  // the estimate is still the maximum
       previous = state;
@@ -260,11 +267,18 @@ TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
     EXPECT_EQ(r.jumped, k == 2) << k;
     previous = r.state;
   }
-  // The same excursion on a clean sensor is a jump at once.
+  // On a clean sensor there is no hold: a far place is a jump at once when the old place has
+  // lost its mass, but not while it keeps a tenth of it (a look-alike's brief maximum).
   JumpGate clean;
   p = posterior(150, 41);
   r = maximum_at(model, p, 150);
   clean.apply(model, params, p.data(), 1.0f, 40, false, r);
+  EXPECT_FALSE(r.jumped);
+  EXPECT_EQ(r.state, 41);
+  JumpGate clean_jump;
+  p = posterior(150);
+  r = maximum_at(model, p, 150);
+  clean_jump.apply(model, params, p.data(), 1.0f, 40, false, r);
   EXPECT_TRUE(r.jumped);
 }
 

@@ -142,11 +142,12 @@ struct FollowParams {
   // at once. Measured in docs/follower.md ("Jump decisions").
   float noisy_jump_hold_s = 0.04f;
   float noisy_jump_hold_level = 0.006f;
-  // While a hold applies, the far place is reported only once the old place has lost its
-  // evidence too: the posterior mass within the old place's reach (the band of the frame, plus
+  // A far place is reported only once the old place has lost its evidence too (with or without
+  // a hold): the posterior mass within the old place's reach (the band of the frame, plus
   // jump_tolerance_frames back) is at most this share. A look-alike place that briefly takes
   // the maximum leaves the old place much of its mass (median 0.06 on false jumps at 4 degrees
-  // per axis), a real jump next to none (0.000, 90th percentile 0.003). 1: the hold alone.
+  // per axis), a real jump next to none (0.000, 90th percentile 0.003). 1: no such test. Until
+  // session 9 it applied only while a hold did (docs/follower.md, "Jump decisions").
   float jump_old_place_mass = 0.05f;
   int jump_tolerance_frames = 6;
   // The first placement: after a start (or reset) the estimate's first moves are the follower

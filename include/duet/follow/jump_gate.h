@@ -31,17 +31,20 @@ class JumpGate {
   void reset() noexcept {
     forget_candidate();
     settled_s_ = 0.0;
-    anchor_state_ = -1;
-    steps_since_anchor_ = 0;
+    steady_state_ = -1;
+    steps_since_steady_ = 0;
+    in_spell_ = false;
   }
 
   // `result` holds the posterior's maximum (follow_detail::decide); on return it holds the state
   // to report, with take, frame, confidence and jumped set for it. `posterior` has M entries
   // (mass `total` over M + 1 with the pause state); `previous_state` is the state reported for
-  // the previous frame (-1 at the start). After a lost frame there is no place to hold on to: the
-  // maximum is taken at once. Allocates nothing.
+  // the previous frame (-1 at the start). The frame is adrift when result.lost (the fixed
+  // ceiling) or result.in_pause is set, or `unexplained` (past the noise-scaled lost distance).
+  // After a lost frame with no place before it the maximum is taken at once. Allocates nothing.
   void apply(const TemplateModel& model, const FollowParams& params, const float* posterior,
-             float total, int previous_state, bool previous_lost, FollowResult& result) noexcept;
+             float total, int previous_state, bool previous_lost, FollowResult& result,
+             bool unexplained = false) noexcept;
   // Whether the first placement has settled (FollowParams::jump_settle_s).
   bool settled(const FollowParams& params) const noexcept {
     return settled_s_ + 1e-6 >= params.jump_settle_s;
@@ -56,11 +59,15 @@ class JumpGate {
   }
 
   // While adrift, and on the frame found again: decides the frame and returns true.
-  bool through_spell(const TemplateModel& model, const FollowParams& params, int previous_state,
-                     bool previous_lost, FollowResult& result) noexcept;
+  bool through_spell(const TemplateModel& model, const FollowParams& params, bool adrift,
+                     FollowResult& result) noexcept;
+  // Any other frame.
+  void decide(const TemplateModel& model, const FollowParams& params, const float* posterior,
+              float total, int previous_state, bool previous_lost, FollowResult& result) noexcept;
 
-  int anchor_state_ = -1;       // during a spell: the state reported before it
-  int steps_since_anchor_ = 0;  // template steps since then
+  int steady_state_ = -1;       // the state reported on the last frame not adrift
+  int steps_since_steady_ = 0;  // template steps since then
+  bool in_spell_ = false;       // adrift since steady_state_
   double settled_s_ = 0.0;    // how long (template time) the estimate has stayed within reach
   int candidate_state_ = -1;  // the far place that currently holds the maximum
   double held_s_ = 0.0;       // how long (template time) it has held it
