@@ -55,6 +55,7 @@ struct EvalArgs {
   std::optional<float> jump_settle;
   std::optional<float> noisy_jump_hold;
   std::optional<float> jump_old_place_mass;
+  std::optional<float> jump_alike_distance;
   std::optional<float> jump_settle_mass;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
       pause_distance, lost_distance, velocity_cap, pause_noise_factor, lost_residual,
@@ -230,6 +231,7 @@ int run_eval(EvalArgs& args) {
   if (args.jump_settle) hmm.jump_settle_s = *args.jump_settle;
   if (args.noisy_jump_hold) hmm.noisy_jump_hold_s = *args.noisy_jump_hold;
   if (args.jump_old_place_mass) hmm.jump_old_place_mass = *args.jump_old_place_mass;
+  if (args.jump_alike_distance) hmm.jump_alike_distance_per_dim = *args.jump_alike_distance;
   if (args.jump_settle_mass) hmm.jump_settle_mass = *args.jump_settle_mass;
   if (Status s = hmm.validate(1); !s) return usage_error(s.error().message);
   if (args.dtw_back) options.dtw.window_back = *args.dtw_back;
@@ -332,7 +334,7 @@ int run_eval(EvalArgs& args) {
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
       "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s "
-      "(mass {}) noisy_jump_hold {} s jump_old_place_mass {}\n"
+      "(mass {}) noisy_jump_hold {} s jump_old_place_mass {} jump_alike_distance {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
       "lost_residual_factor {} emission_noise_factor {} emission_noise_allowance {} "
       "noise_filter_density {} noise_filter_allowance {}\n\n",
@@ -342,10 +344,10 @@ int run_eval(EvalArgs& args) {
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
       hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.jump_settle_mass,
-      hmm.noisy_jump_hold_s, hmm.jump_old_place_mass, hmm.pause_noise_factor,
-      hmm.lost_residual_per_dim, hmm.lost_noise_factor, hmm.lost_residual_factor,
-      hmm.emission_noise_factor, hmm.emission_noise_allowance, hmm.noise_filter_density,
-      hmm.noise_filter_allowance);
+      hmm.noisy_jump_hold_s, hmm.jump_old_place_mass, hmm.jump_alike_distance_per_dim,
+      hmm.pause_noise_factor, hmm.lost_residual_per_dim, hmm.lost_noise_factor,
+      hmm.lost_residual_factor, hmm.emission_noise_factor, hmm.emission_noise_allowance,
+      hmm.noise_filter_density, hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
   if (!non_dance.value().empty()) {
     fmt::print(
@@ -579,10 +581,14 @@ Command register_eval(CLI::App& app) {
       ->check(number_between(0.0, 10.0));
   tuning
       ->add_option("--jump-old-place-mass", args->jump_old_place_mass,
-                   "jump_old_place_mass: while a hold applies, a far place is reported only once "
-                   "the old place's reach holds at most this share of the posterior (1 for the "
-                   "hold alone)")
+                   "jump_old_place_mass: a far place is reported only once the old place's "
+                   "reach holds at most this share of the posterior (1 for no such test)")
       ->check(number_between(0.0, 1.0));
+  tuning
+      ->add_option("--jump-alike-distance", args->jump_alike_distance,
+                   "jump_alike_distance_per_dim: a far move between places whose template rows "
+                   "are within this distance per dimension is no jump (0 for none)")
+      ->check(CLI::NonNegativeNumber);
   tuning
       ->add_option("--jump-settle", args->jump_settle,
                    "jump_settle_s: after the start, moves of the estimate are the first placement "

@@ -27,6 +27,7 @@ FollowParams FollowParams::paper() {
   params.jump_settle_mass = 0.0f;
   params.noisy_jump_hold_s = 0.0f;
   params.jump_old_place_mass = 1.0f;
+  params.jump_alike_distance_per_dim = 0.0f;
   params.gate_outliers = false;
   params.pause_noise_factor = 0.0f;
   params.emission_noise_factor = 0.0f;
@@ -115,6 +116,10 @@ Status FollowParams::validate(int num_states) const {
   if (!(jump_old_place_mass >= 0.0f && jump_old_place_mass <= 1.0f)) {
     return params_error("jump_old_place_mass must be in [0, 1], got " +
                         std::to_string(jump_old_place_mass));
+  }
+  if (!(jump_alike_distance_per_dim >= 0.0f && std::isfinite(jump_alike_distance_per_dim))) {
+    return params_error("jump_alike_distance_per_dim must be finite and >= 0, got " +
+                        std::to_string(jump_alike_distance_per_dim));
   }
   if (!(noisy_jump_hold_level > 0.0f && std::isfinite(noisy_jump_hold_level))) {
     return params_error("noisy_jump_hold_level must be finite and > 0, got " +

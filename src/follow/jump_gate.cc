@@ -16,6 +16,15 @@ float JumpGate::hold_s(const FollowParams& params, float sensor_noise_per_dim) n
   return std::max(params.jump_hold_s, ramp * params.noisy_jump_hold_s);
 }
 
+bool JumpGate::looks_alike(const TemplateModel& model, const FollowParams& params, int from,
+                           int to) noexcept {
+  if (!(params.jump_alike_distance_per_dim > 0.0f) || from < 0 || to < 0) return false;
+  const FeatureView rows = model.features();
+  const float distance = (rows.row(from) - rows.row(to)).squaredNorm() /
+                         static_cast<float>(std::max(model.num_dims(), 1));
+  return distance <= params.jump_alike_distance_per_dim;
+}
+
 bool JumpGate::through_spell(const TemplateModel& model, const FollowParams& params, bool adrift,
                              FollowResult& result) noexcept {
   const bool unknown = result.missing || result.state < 0;
@@ -24,9 +33,10 @@ bool JumpGate::through_spell(const TemplateModel& model, const FollowParams& par
   result.jumped = false;
   if (adrift || unknown) return true;
   // Found again: a jump if out of reach of the place before the spell over the time it lasted.
-  result.jumped =
-      settled(params) && follow_detail::is_jump(model, steady_state_, result.state,
-                                                steps_since_steady_ + std::max(result.steps, 1));
+  result.jumped = settled(params) &&
+                  follow_detail::is_jump(model, steady_state_, result.state,
+                                         steps_since_steady_ + std::max(result.steps, 1)) &&
+                  !looks_alike(model, params, steady_state_, result.state);
   in_spell_ = false;
   forget_candidate();
   return true;
@@ -76,7 +86,8 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
   }
   const float hold = hold_s(params, result.sensor_noise_per_dim);
   if (previous_lost || result.in_pause) {
-    result.jumped = true;  // nothing to hold on to
+    result.jumped =
+        !looks_alike(model, params, previous_state, result.state);  // nothing to hold on to
     forget_candidate();
     return;
   }
@@ -99,7 +110,7 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
   }
   if (held_s_ + 1e-6 >= hold &&  // (3 frames of 1/60 s make 0.05 s)
       old_mass <= static_cast<double>(params.jump_old_place_mass) * total) {
-    result.jumped = true;
+    result.jumped = !looks_alike(model, params, previous_state, result.state);
     forget_candidate();
     return;
   }

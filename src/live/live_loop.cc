@@ -197,7 +197,6 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   lost_s_ = result.lost ? lost_s_ + (timed ? dt_s : 0.0) : 0.0;
   const bool coasting = result.lost && previous_take_ >= 0 &&
                         (coasting_ || lost_s_ >= params_.playhead.coast_after_lost_s);
-  const bool found_again = coasting_ && !coasting;
   if (coasting) {
     take = previous_take_;
     if (!coasting_) coast_frame_ = previous_frame_;
@@ -215,12 +214,14 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   PartnerSynthesisJob job;
   job.model = &model;
   job.params = &params_;
-  // A jump for the partner: one the follower reports, another take, or a far move while the
-  // follower is lost or just found again (it reports no jump then: JumpGate).
+  // A jump for the partner: one the follower reports, another take, or any move beyond the
+  // band's reach and the jitter tolerance that the follower does not call a jump (while lost or
+  // when found again, between look-alike places, or while the first placement settles: JumpGate).
   constexpr int kFarFrames = 6;
-  const bool far = std::abs(frame_in_take - previous_frame_) > kFarFrames;
+  const bool far =
+      std::abs(frame_in_take - previous_frame_) > kFarFrames + 2 * std::max(result.steps, 1);
   job.jumped = !coasting && (result.jumped || (previous_take_ >= 0 && take != previous_take_) ||
-                             ((found_again || result.lost) && far));
+                             (previous_take_ >= 0 && far));
   job.dt_s = dt_s;
   // The response at the playhead (smooth) or at the estimate itself.
   double position = frame_in_take;

@@ -9,9 +9,11 @@
 namespace duet {
 namespace {
 
-// Two takes of 100 frames at 60 Hz; features do not matter to the gate.
+// Two takes of 100 frames at 60 Hz, every frame unlike every other (the gate looks at the
+// features only to tell look-alike places).
 TemplateModel two_takes() {
   FeatureMatrix f = FeatureMatrix::Zero(200, 2);
+  for (int i = 0; i < 200; ++i) f(i, 0) = static_cast<float>(i);
   return std::move(TemplateModel::build(std::move(f), {0, 100}, 60.0, 0)).value();
 }
 
@@ -174,6 +176,32 @@ TEST(JumpGate, WhileLostTheWanderingMaximumIsNoJumpAndBeingFoundAgainElsewhereIs
     gate.apply(model, params, next.data(), 1.0f, found, false, r);
     EXPECT_FALSE(r.jumped);
   }
+}
+
+TEST(JumpGate, AMoveBetweenPlacesThatLookAlikeIsNoJump) {
+  // Both takes begin with ten frames of standing still, the same to within 0.001 per dimension.
+  FeatureMatrix f = FeatureMatrix::Zero(200, 2);
+  for (int i = 0; i < 200; ++i) {
+    f(i, 0) = i % 100 < 10 ? 0.03f * static_cast<float>(i / 100) : static_cast<float>(i);
+  }
+  const TemplateModel model =
+      std::move(TemplateModel::build(std::move(f), {0, 100}, 60.0, 0)).value();
+  FollowParams params;
+  params.jump_settle_s = 0.0f;
+  for (const auto& [to, jump] : {std::pair{105, false}, {150, true}}) {
+    JumpGate gate;
+    const std::vector<float> p = posterior(to);
+    FollowResult r = maximum_at(model, p, to);
+    gate.apply(model, params, p.data(), 1.0f, 5, false, r);
+    EXPECT_EQ(r.jumped, jump) << to;
+    EXPECT_EQ(r.state, to);  // the estimate moves there either way
+  }
+  params.jump_alike_distance_per_dim = 0.0f;  // off: every far move is a jump
+  JumpGate gate;
+  const std::vector<float> p = posterior(105);
+  FollowResult r = maximum_at(model, p, 105);
+  gate.apply(model, params, p.data(), 1.0f, 5, false, r);
+  EXPECT_TRUE(r.jumped);
 }
 
 TEST(JumpGate, TheFirstPlacementIsRefinedWithoutJumpsUntilItHasSettled) {

@@ -61,6 +61,10 @@ class JumpGate {
   // While adrift, and on the frame found again: decides the frame and returns true.
   bool through_spell(const TemplateModel& model, const FollowParams& params, bool adrift,
                      FollowResult& result) noexcept;
+  // Whether the template rows of two states look alike (FollowParams::jump_alike_distance_per_dim):
+  // a move between them is no jump.
+  static bool looks_alike(const TemplateModel& model, const FollowParams& params, int from,
+                          int to) noexcept;
   // Any other frame.
   void decide(const TemplateModel& model, const FollowParams& params, const float* posterior,
               float total, int previous_state, bool previous_lost, FollowResult& result) noexcept;
