@@ -177,7 +177,11 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
       r.step_us = elapsed_us(start, stop);
       const TruthFrame& truth = performance.truth[fs];
       CapturedDuetSampler& sampler = samplers.at(truth.take);
-      const Transform user_heading = body_heading_frame(out.user_positions_ws, performance.roles);
+      // The user's heading: the sensed body's, or for three points the real body's.
+      const Transform user_heading =
+          performance.true_headings_ws.empty()
+              ? body_heading_frame(out.user_positions_ws, performance.roles)
+              : performance.true_headings_ws[fs];
       sampler.compute(truth.template_frame, user_heading);
       r.spacing_error_m = std::abs(
           horizontal_distance_m(out.partner_positions_ws[0], user_heading.translation) -

@@ -12,6 +12,7 @@
 #include "duet/motion/head_hands.h"
 #include "duet/motion/limits.h"
 #include "duet/motion/retarget.h"
+#include "duet/partner/alignment.h"
 
 namespace duet {
 
@@ -357,6 +358,22 @@ void record_true_wrists(Performance& performance) {
   }
 }
 
+void record_true_headings(Performance& performance) {
+  const Clip& motion = performance.motion;
+  const Skeleton& skeleton = motion.skeleton();
+  const auto joints = static_cast<std::size_t>(skeleton.joint_count());
+  performance.true_headings_ws.clear();
+  if (performance.roles[Role::kLeftHip] < 0 || performance.roles[Role::kRightHip] < 0) return;
+  std::vector<Vec3> positions(joints);
+  std::vector<Quat> rotations(joints);
+  performance.true_headings_ws.reserve(static_cast<std::size_t>(motion.frame_count()));
+  for (int f = 0; f < motion.frame_count(); ++f) {
+    forward_kinematics(skeleton, motion.translations_ls(f), motion.rotations_ls(f), positions,
+                       rotations);
+    performance.true_headings_ws.push_back(body_heading_frame(positions, performance.roles));
+  }
+}
+
 Performance with_sensor_noise(Performance performance, const SensorNoiseOptions& options) {
   Rng rng(derive_seed(options.seed, 3));
   // RMS angle of a rotation vector with three N(0, s^2) components is s * sqrt(3).
@@ -480,6 +497,8 @@ Performance with_frame_loss(Performance performance, const FrameLossOptions& opt
     // A repeated frame is the sensor sending its last frame again; the real wrists moved on.
     if (!performance.true_wrists_ws.empty())
       out.true_wrists_ws.push_back(performance.true_wrists_ws[ks]);
+    if (!performance.true_headings_ws.empty())
+      out.true_headings_ws.push_back(performance.true_headings_ws[ks]);
     // Drawn only when asked for: performances without repeats stay what they were.
     const bool repeat =
         options.repeat_fraction > 0.0 && o > 0 && uniform(rng, 0.0, 1.0) < options.repeat_fraction;
@@ -571,6 +590,7 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     performance = std::move(moved).value();
   }
   if (recipe.noise.active() || recipe.head_hands) record_true_wrists(performance);
+  if (recipe.head_hands) record_true_headings(performance);
   if (recipe.noise.active()) {
     SensorNoiseOptions options = recipe.noise;
     options.seed = derive_seed(seed, 12);

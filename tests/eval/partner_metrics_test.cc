@@ -364,5 +364,45 @@ TEST(PartnerRun, RealTakeFollowedExactly) {
   EXPECT_GT(run.value().loop_step_us, 0.0);
 }
 
+// The same take delivered as three points (a headset and two controllers, no noise): the partner
+// is scored against the captured follower placed relative to the user's real body, whose heading
+// the three points alone do not give (Performance::true_headings_ws).
+TEST(PartnerRun, ThreePointsAreScoredAgainstTheRealBody) {
+  const std::string dir = std::string(DUET_DATA_DIR) + "/cmu-salsa/bvh/";
+  LibraryOptions options;
+  options.load.frame_rate = 60.0;
+  options.features.input_points = InputPoints::kHeadHands;
+  Result<DuetLibrary> library =
+      DuetLibrary::load({{{dir + "60/60_10_scaled.bvh"}, {dir + "61/61_10_scaled.bvh"}}}, options);
+  ASSERT_TRUE(library) << library.error().message;
+  const DuetLibrary& lib = library.value();
+  const DuetTake& take = lib.takes()[0];
+  const SourceTake source{0, &take.template_motion.clip, take.template_motion.roles};
+  Performance full = play(source, PlayOptions{});
+  record_true_headings(full);
+  ASSERT_EQ(full.true_headings_ws.size(), static_cast<std::size_t>(full.frame_count()));
+  Result<Performance> points = with_head_hands(std::move(full), PointNoiseOptions{});
+  ASSERT_TRUE(points) << points.error().message;
+  const Performance& performance = points.value();
+  ASSERT_EQ(performance.true_headings_ws.size(),
+            static_cast<std::size_t>(performance.frame_count()));
+
+  Result<HmmFollower> hmm = HmmFollower::create(lib.model(), FollowParams{});
+  ASSERT_TRUE(hmm);
+  const std::vector<PartnerConfig> configs = standard_partner_configs();
+  Result<PartnerPerformanceResult> run = run_partner_performance(
+      lib, performance, std::make_unique<HmmFollower>(std::move(hmm).value()), configs, {});
+  ASSERT_TRUE(run) << run.error().message;
+  std::map<std::string, PartnerMetrics> m;
+  for (std::size_t c = 0; c < configs.size(); ++c) {
+    m[configs[c].name] = run.value().configs[c].summary();
+  }
+  // Placed relative to a body made from three points: close to the captured follower, not metres
+  // off (530 cm when the heading was taken from the three points' roles).
+  EXPECT_LT(m["all"].mean_joint_error_cm, 10.0);
+  EXPECT_LT(m["align-only"].mean_joint_error_cm, 10.0);
+  EXPECT_LT(m["all"].median_spacing_error_cm, 5.0);
+}
+
 }  // namespace
 }  // namespace duet

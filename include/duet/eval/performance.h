@@ -52,6 +52,9 @@ struct Performance {
   // well as against the sensed ones. Empty when the sensor adds no noise (the sensed wrists are
   // the real ones).
   std::vector<std::array<Vec3, 2>> true_wrists_ws;
+  // The real body's heading frame (body_heading_frame), one per frame, for a performance reduced
+  // to three points (with_head_hands), whose roles name no hips to take it from; else empty.
+  std::vector<Transform> true_headings_ws;
 
   int frame_count() const { return motion.frame_count(); }
 };
@@ -126,6 +129,9 @@ Performance with_sensor_noise(Performance performance, const SensorNoiseOptions&
 // Records the wrists' world positions of the performance as it is now in true_wrists_ws (left
 // empty when the roles name no wrists): make_performance calls it before any noise is added.
 void record_true_wrists(Performance& performance);
+// Records the body's heading frame of every frame in true_headings_ws (empty when the roles name
+// no hips): make_performance calls it before reducing a performance to three points.
+void record_true_headings(Performance& performance);
 
 // A network or sensor that drops and delays frames. Frames are dropped in bursts of 1..3 (about
 // drop_fraction of all frames; the first frame is kept); late_fraction of the kept frames carry a
