@@ -32,10 +32,12 @@ bool JumpGate::through_spell(const TemplateModel& model, const FollowParams& par
   if (!in_spell_) return false;
   result.jumped = false;
   if (adrift || unknown) return true;
-  // Found again: a jump if out of reach of the place before the spell over the time it lasted.
+  // Found again: a jump if out of reach of the place before the spell over the time it lasted
+  // (a few frames back from it is jitter, as on any frame).
   result.jumped = settled(params) &&
                   follow_detail::is_jump(model, steady_state_, result.state,
-                                         steps_since_steady_ + std::max(result.steps, 1)) &&
+                                         steps_since_steady_ + std::max(result.steps, 1),
+                                         params.jump_tolerance_frames) &&
                   !looks_alike(model, params, steady_state_, result.state);
   in_spell_ = false;
   forget_candidate();
