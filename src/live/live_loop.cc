@@ -159,10 +159,7 @@ void LiveLoop::reset() noexcept {
   session_.reset();
   context_.reset();
   playhead_.reset();
-  previous_take_ = -1;
-  previous_frame_ = 0;
-  coasting_ = false;
-  lost_s_ = 0.0;
+  place_.reset();
   has_previous_ = false;
   head_height_max_m_ = 0.0;
 }
@@ -179,34 +176,10 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   user_pose_ = user_pose_from_world(out_.user_positions_ws, out_.user_rotations_ws, user_.roles);
   user_pose_.height_m = user_height_m_;
 
-  // Where the partner is in the library: the estimate, or where it was when there is none.
-  int take = result.take;
-  int frame_in_take = result.frame_in_take;
-  const int takes = static_cast<int>(models_.size());
-  if (take < 0 || take >= takes || frame_in_take < 0 ||
-      frame_in_take >= models_[static_cast<std::size_t>(take)].frame_count()) {
-    take = std::max(previous_take_, 0);
-    frame_in_take = previous_frame_;
-  }
   const double dt_s = has_previous_ ? frame.time_s - previous_time_s_ : 0.0;
-  // While the follower is lost its estimate wanders between look-alike places from frame to
-  // frame (a headset's three points under noise: 29 reported jumps a minute). After a short
-  // spell the partner dances on by itself from where it was, at the dancer's last tempo, and
-  // goes to the follower's place once the dancer is found again.
-  const bool timed = std::isfinite(dt_s) && dt_s > 0.0;
-  lost_s_ = result.lost ? lost_s_ + (timed ? dt_s : 0.0) : 0.0;
-  const bool coasting = result.lost && previous_take_ >= 0 &&
-                        (coasting_ || lost_s_ >= params_.playhead.coast_after_lost_s);
-  if (coasting) {
-    take = previous_take_;
-    if (!coasting_) coast_frame_ = previous_frame_;
-    const double tempo = std::isfinite(result.tempo) && result.tempo > 0.0f ? result.tempo : 1.0;
-    const PartnerModel& coasted = models_[static_cast<std::size_t>(take)];
-    if (timed) coast_frame_ += tempo * dt_s * coasted.frame_rate();
-    coast_frame_ = std::clamp(coast_frame_, 0.0, static_cast<double>(coasted.frame_count() - 1));
-    frame_in_take = static_cast<int>(std::lround(coast_frame_));
-  }
-  coasting_ = coasting;
+  const PartnerPlaceStep place = place_.next(result, dt_s, models_, params_.playhead);
+  const int take = place.take;
+  const int frame_in_take = place.frame;
   const PartnerModel& model = models_[static_cast<std::size_t>(take)];
   const Clip& response = library_->takes()[static_cast<std::size_t>(take)].response_motion.clip;
   if (!head_hands_bodies_.empty()) place_head_hands_user(take, frame_in_take);
@@ -214,14 +187,7 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   PartnerSynthesisJob job;
   job.model = &model;
   job.params = &params_;
-  // A jump for the partner: one the follower reports, another take, or any move beyond the
-  // band's reach and the jitter tolerance that the follower does not call a jump (while lost or
-  // when found again, between look-alike places, or while the first placement settles: JumpGate).
-  constexpr int kFarFrames = 6;
-  const bool far =
-      std::abs(frame_in_take - previous_frame_) > kFarFrames + 2 * std::max(result.steps, 1);
-  job.jumped = !coasting && (result.jumped || (previous_take_ >= 0 && take != previous_take_) ||
-                             (previous_take_ >= 0 && far));
+  job.jumped = place.jumped;
   job.dt_s = dt_s;
   // The response at the playhead (smooth) or at the estimate itself.
   double position = frame_in_take;
@@ -261,8 +227,6 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   out_.partner_take = take;
   out_.partner_frame = job.frame;
 
-  previous_take_ = take;
-  previous_frame_ = frame_in_take;
   if (std::isfinite(frame.time_s)) {
     previous_time_s_ = frame.time_s;
     has_previous_ = true;

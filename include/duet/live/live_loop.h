@@ -16,6 +16,7 @@
 #include "duet/base/result.h"
 #include "duet/live/duet_library.h"
 #include "duet/live/follow_session.h"
+#include "duet/live/partner_place.h"
 #include "duet/live/source_frame.h"
 #include "duet/partner/head_hands_body.h"
 #include "duet/partner/partner_synthesis.h"
@@ -107,11 +108,7 @@ class LiveLoop {
   double head_height_max_m_ = 0.0;           // the highest the user's head has been
   ResponsePlayhead playhead_;
   Pose shown_pose_;  // the response sampled at the playhead
-  int previous_take_ = -1;
-  int previous_frame_ = 0;
-  bool coasting_ = false;  // the follower was lost: the partner danced on by itself
-  double coast_frame_ = 0.0;
-  double lost_s_ = 0.0;  // where it danced on to (response frame)
+  PartnerPlace place_;  // where in the library the partner dances
   double previous_time_s_ = 0.0;
   bool has_previous_ = false;
 };

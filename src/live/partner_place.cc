@@ -1,0 +1,44 @@
+#include "duet/live/partner_place.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+namespace duet {
+
+PartnerPlaceStep PartnerPlace::next(const FollowResult& result, double dt_s,
+                                    std::span<const PartnerModel> models,
+                                    const PlayheadParams& params) noexcept {
+  PartnerPlaceStep step{result.take, result.frame_in_take, false, false};
+  // No estimate (or one outside the library): where the partner was.
+  const int takes = static_cast<int>(models.size());
+  if (step.take < 0 || step.take >= takes || step.frame < 0 ||
+      step.frame >= models[static_cast<std::size_t>(step.take)].frame_count()) {
+    step.take = std::max(take_, 0);
+    step.frame = frame_;
+  }
+  const bool timed = std::isfinite(dt_s) && dt_s > 0.0;
+  lost_s_ = result.lost ? lost_s_ + (timed ? dt_s : 0.0) : 0.0;
+  step.coasting = result.lost && take_ >= 0 && (coasting_ || lost_s_ >= params.coast_after_lost_s);
+  if (step.coasting) {
+    step.take = take_;
+    if (!coasting_) coast_frame_ = frame_;
+    const double tempo = std::isfinite(result.tempo) && result.tempo > 0.0f ? result.tempo : 1.0;
+    const PartnerModel& model = models[static_cast<std::size_t>(step.take)];
+    if (timed) coast_frame_ += tempo * dt_s * model.frame_rate();
+    coast_frame_ = std::clamp(coast_frame_, 0.0, static_cast<double>(model.frame_count() - 1));
+    step.frame = static_cast<int>(std::lround(coast_frame_));
+  }
+  coasting_ = step.coasting;
+  // A jump for the partner: one the follower reports, another take, or any move beyond the
+  // band's reach and the jitter tolerance that the follower does not call a jump (while lost or
+  // when found again, between look-alike places, or while the first placement settles: JumpGate).
+  constexpr int kFarFrames = 6;
+  const bool far = std::abs(step.frame - frame_) > kFarFrames + 2 * std::max(result.steps, 1);
+  step.jumped = !step.coasting && (result.jumped || (take_ >= 0 && (step.take != take_ || far)));
+  take_ = step.take;
+  frame_ = step.frame;
+  return step;
+}
+
+}  // namespace duet
