@@ -339,39 +339,43 @@ Result<Performance> improvise(std::span<const SourceTake> sources,
                         {options.sway_m, options.sway_deg});
 }
 
-void record_true_wrists(Performance& performance) {
-  const Clip& motion = performance.motion;
+namespace {
+
+// Calls visit(world positions) for every frame of the performance's motion, in order.
+template <typename Visit>
+void for_each_world_pose(const Clip& motion, Visit&& visit) {
   const Skeleton& skeleton = motion.skeleton();
   const auto joints = static_cast<std::size_t>(skeleton.joint_count());
+  std::vector<Vec3> positions(joints);
+  std::vector<Quat> rotations(joints);
+  for (int f = 0; f < motion.frame_count(); ++f) {
+    forward_kinematics(skeleton, motion.translations_ls(f), motion.rotations_ls(f), positions,
+                       rotations);
+    visit(std::span<const Vec3>(positions));
+  }
+}
+
+}  // namespace
+
+void record_true_wrists(Performance& performance) {
   const int left = performance.roles[Role::kLeftWrist],
             right = performance.roles[Role::kRightWrist];
   performance.true_wrists_ws.clear();
   if (left < 0 || right < 0) return;
-  std::vector<Vec3> positions(joints);
-  std::vector<Quat> rotations(joints);
-  performance.true_wrists_ws.reserve(static_cast<std::size_t>(motion.frame_count()));
-  for (int f = 0; f < motion.frame_count(); ++f) {
-    forward_kinematics(skeleton, motion.translations_ls(f), motion.rotations_ls(f), positions,
-                       rotations);
+  performance.true_wrists_ws.reserve(static_cast<std::size_t>(performance.frame_count()));
+  for_each_world_pose(performance.motion, [&](std::span<const Vec3> positions) {
     performance.true_wrists_ws.push_back(
         {positions[static_cast<std::size_t>(left)], positions[static_cast<std::size_t>(right)]});
-  }
+  });
 }
 
 void record_true_headings(Performance& performance) {
-  const Clip& motion = performance.motion;
-  const Skeleton& skeleton = motion.skeleton();
-  const auto joints = static_cast<std::size_t>(skeleton.joint_count());
   performance.true_headings_ws.clear();
   if (performance.roles[Role::kLeftHip] < 0 || performance.roles[Role::kRightHip] < 0) return;
-  std::vector<Vec3> positions(joints);
-  std::vector<Quat> rotations(joints);
-  performance.true_headings_ws.reserve(static_cast<std::size_t>(motion.frame_count()));
-  for (int f = 0; f < motion.frame_count(); ++f) {
-    forward_kinematics(skeleton, motion.translations_ls(f), motion.rotations_ls(f), positions,
-                       rotations);
+  performance.true_headings_ws.reserve(static_cast<std::size_t>(performance.frame_count()));
+  for_each_world_pose(performance.motion, [&](std::span<const Vec3> positions) {
     performance.true_headings_ws.push_back(body_heading_frame(positions, performance.roles));
-  }
+  });
 }
 
 Performance with_sensor_noise(Performance performance, const SensorNoiseOptions& options) {

@@ -317,12 +317,18 @@ TEST(PartnerMetricsAccumulator, SteadinessAndTheTransitionAfterAJump) {
 
 // The whole run on a real take: the user dances 60_10 exactly, so the true response is the
 // captured follower placed relative to the user and the raw pose (align only) matches it.
-TEST(PartnerRun, RealTakeFollowedExactly) {
+// The duet of take 60_10 alone, with the given input points.
+Result<DuetLibrary> take_60_10(InputPoints points) {
   const std::string dir = std::string(DUET_DATA_DIR) + "/cmu-salsa/bvh/";
   LibraryOptions options;
   options.load.frame_rate = 60.0;
-  Result<DuetLibrary> library =
-      DuetLibrary::load({{{dir + "60/60_10_scaled.bvh"}, {dir + "61/61_10_scaled.bvh"}}}, options);
+  options.features.input_points = points;
+  return DuetLibrary::load({{{dir + "60/60_10_scaled.bvh"}, {dir + "61/61_10_scaled.bvh"}}},
+                           options);
+}
+
+TEST(PartnerRun, RealTakeFollowedExactly) {
+  Result<DuetLibrary> library = take_60_10(InputPoints::kFullBody);
   ASSERT_TRUE(library) << library.error().message;
   const DuetLibrary& lib = library.value();
   const DuetTake& take = lib.takes()[0];
@@ -368,12 +374,7 @@ TEST(PartnerRun, RealTakeFollowedExactly) {
 // is scored against the captured follower placed relative to the user's real body, whose heading
 // the three points alone do not give (Performance::true_headings_ws).
 TEST(PartnerRun, ThreePointsAreScoredAgainstTheRealBody) {
-  const std::string dir = std::string(DUET_DATA_DIR) + "/cmu-salsa/bvh/";
-  LibraryOptions options;
-  options.load.frame_rate = 60.0;
-  options.features.input_points = InputPoints::kHeadHands;
-  Result<DuetLibrary> library =
-      DuetLibrary::load({{{dir + "60/60_10_scaled.bvh"}, {dir + "61/61_10_scaled.bvh"}}}, options);
+  Result<DuetLibrary> library = take_60_10(InputPoints::kHeadHands);
   ASSERT_TRUE(library) << library.error().message;
   const DuetLibrary& lib = library.value();
   const DuetTake& take = lib.takes()[0];

@@ -33,8 +33,9 @@ struct PlayheadParams {
   double jitter_time_constant_s = 1.0;
   // Once the follower has been lost this long (seconds) the partner dances on by itself from
   // where it was, at the dancer's last tempo, instead of following an estimate that wanders
-  // between look-alike places (LiveLoop; docs/partner.md "Lost"). Shorter spells, such as the
-  // landing of a jump, are followed as they come. 0: from the first lost frame; inf: never.
+  // between look-alike places (PartnerPlace; docs/partner.md "While the follower is lost").
+  // Shorter spells, such as the landing of a jump, are followed as they come. 0: from the first
+  // lost frame; inf: never.
   double coast_after_lost_s = 0.1;
   // Empty when valid, else which value is wrong.
   const char* validate() const noexcept;
