@@ -423,7 +423,8 @@ Command register_eval(CLI::App& app) {
                  "late-frames, body-size, room-place, partner-role, improv-30hz-noisy, harsh "
                  "(30 Hz, 4 deg per axis + 1 cm noise, 3% repeated frames, a 1.1x body), "
                  "120hz-noisy (a 120 Hz sensor with the noise), dropouts (the noise, and the "
-                 "sensor loses the dancer for 0.3-1 s every 8 s)")
+                 "sensor loses the dancer for 0.3-1 s every 8 s), suit-drift (an inertial "
+                 "suit: the noise, and every joint off by a calibration error and a slow drift)")
       ->delimiter(',');
   app.add_flag("--noise-sweep", args->noise_sweep,
                "Also run noise-sweep-0 ... noise-sweep-5: improv-pause with 0 to 5 degrees of "
@@ -482,6 +483,14 @@ Command register_eval(CLI::App& app) {
       ->add_option("--body-scale", args->settings.body_scale,
                    "Body size factor of the body-size case (default 1.15)")
       ->check(number_between(0.1, 10.0));
+  cases
+      ->add_option("--suit-bias-deg", args->settings.suit_bias_deg,
+                   "Calibration error per joint of the suit-drift case, RMS degrees (default 5)")
+      ->check(number_between(0.0, 45.0));
+  cases
+      ->add_option("--suit-drift-deg", args->settings.suit_drift_deg,
+                   "Slow drift per joint of the suit-drift case, RMS degrees (default 5)")
+      ->check(number_between(0.0, 45.0));
   cases
       ->add_option("--improv-duration", args->settings.improvise_duration_s,
                    "Length of the improvised performances in s (default: the take's length)")

@@ -378,6 +378,52 @@ void record_true_headings(Performance& performance) {
   });
 }
 
+namespace {
+
+// SensorNoiseOptions' slow errors: per joint a constant offset plus a drifting one, as rotation
+// vectors, advanced frame by frame with the performance's timestamps.
+class SlowRotationErrors {
+ public:
+  SlowRotationErrors(const SensorNoiseOptions& options, int joints)
+      : rng_(derive_seed(options.seed, 7)),
+        drift_sigma_(deg_to_rad(options.drift_deg) / std::sqrt(3.0)),
+        drift_time_s_(std::max(options.drift_time_s, 1e-3)),
+        bias_(static_cast<std::size_t>(joints), Vec3::Zero()),
+        drift_(static_cast<std::size_t>(joints), Vec3::Zero()) {
+    std::normal_distribution<double> bias(0.0, deg_to_rad(options.bias_deg) / std::sqrt(3.0));
+    std::normal_distribution<double> drift(0.0, drift_sigma_);
+    for (std::size_t j = 0; j < bias_.size(); ++j) {
+      if (options.bias_deg > 0.0) bias_[j] = Vec3(bias(rng_), bias(rng_), bias(rng_));
+      // Start from the stationary distribution: the drift is already there at the first frame.
+      if (drift_sigma_ > 0.0) drift_[j] = Vec3(drift(rng_), drift(rng_), drift(rng_));
+    }
+  }
+
+  bool active() const {
+    return drift_sigma_ > 0.0 ||
+           std::any_of(bias_.begin(), bias_.end(), [](const Vec3& b) { return !b.isZero(); });
+  }
+
+  // Moves the drift on by dt seconds (exact discretisation of the Ornstein-Uhlenbeck process).
+  void advance(double dt_s) {
+    if (!(drift_sigma_ > 0.0) || !(dt_s > 0.0)) return;
+    const double keep = std::exp(-dt_s / drift_time_s_);
+    std::normal_distribution<double> step(0.0, drift_sigma_ * std::sqrt(1.0 - keep * keep));
+    for (Vec3& d : drift_) d = keep * d + Vec3(step(rng_), step(rng_), step(rng_));
+  }
+
+  Vec3 error(std::size_t joint) const { return bias_[joint] + drift_[joint]; }
+
+ private:
+  Rng rng_;
+  double drift_sigma_;
+  double drift_time_s_;
+  std::vector<Vec3> bias_;
+  std::vector<Vec3> drift_;
+};
+
+}  // namespace
+
 Performance with_sensor_noise(Performance performance, const SensorNoiseOptions& options) {
   Rng rng(derive_seed(options.seed, 3));
   // RMS angle of a rotation vector with three N(0, s^2) components is s * sqrt(3).
@@ -385,13 +431,19 @@ Performance with_sensor_noise(Performance performance, const SensorNoiseOptions&
   std::normal_distribution<double> position(0.0, options.position_m);
   Clip& motion = performance.motion;
   const Skeleton& skeleton = motion.skeleton();
+  SlowRotationErrors slow(options, skeleton.joint_count());
   for (int f = 0; f < motion.frame_count(); ++f) {
     auto translations = motion.translations_ls(f);
     auto rotations = motion.rotations_ls(f);
+    if (f > 0 && static_cast<std::size_t>(f) < performance.times_s.size()) {
+      const auto k = static_cast<std::size_t>(f);
+      slow.advance(performance.times_s[k] - performance.times_s[k - 1]);
+    }
     for (int j = 0; j < skeleton.joint_count(); ++j) {
       const Joint& joint = skeleton.joints[static_cast<std::size_t>(j)];
       if (joint.end_site) continue;
       const auto i = static_cast<std::size_t>(j);
+      if (slow.active()) rotations[i] = (rotations[i] * exp_map(slow.error(i))).normalized();
       if (options.rotation_deg > 0.0) {
         const Vec3 v(angle(rng), angle(rng), angle(rng));
         rotations[i] = (rotations[i] * exp_map(v)).normalized();

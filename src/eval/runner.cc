@@ -108,6 +108,17 @@ std::vector<EvalCase> standard_cases(const CaseSettings& settings) {
     c.recipe.noise = noise;
     c.recipe.loss.gap_every_s = 8.0;
   }
+  {
+    // An inertial suit's slow errors: every joint off by its calibration and drifting, as
+    // SensorNoiseOptions describes; the white noise on top.
+    EvalCase& c = add("suit-drift", fmt::format("an inertial suit: every joint off by {:g} deg of "
+                                                "calibration and {:g} deg of drift (10 s), with "
+                                                "the noise",
+                                                settings.suit_bias_deg, settings.suit_drift_deg));
+    c.recipe.noise = noise;
+    c.recipe.noise.bias_deg = settings.suit_bias_deg;
+    c.recipe.noise.drift_deg = settings.suit_drift_deg;
+  }
   // Describe the magnitudes actually used.
   for (EvalCase& c : cases) {
     if (c.name == "harsh") continue;
@@ -376,9 +387,10 @@ Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const Templ
 
 Result<std::vector<FrameEstimate>> follow_performance(const DuetLibrary& library,
                                                       const Performance& performance,
-                                                      std::unique_ptr<Tracker> tracker) {
-  Result<FollowSession> created = FollowSession::create(library, performance.motion.skeleton_ptr(),
-                                                        performance.roles, std::move(tracker));
+                                                      std::unique_ptr<Tracker> tracker,
+                                                      const PostureBiasParams& bias) {
+  Result<FollowSession> created = FollowSession::create(
+      library, performance.motion.skeleton_ptr(), performance.roles, std::move(tracker), bias);
   if (!created) return created.error();
   FollowSession& session = created.value();
   std::vector<FrameEstimate> estimates;

@@ -64,7 +64,8 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
       (!same_take || std::abs(result.state - previous_state_) > kFarFrames);
   previous_state_ = result.state;
   if (!result.jumped && !stepped_back && !moved_unreported && !result.missing && !result.in_pause &&
-      result.best_distance_per_dim <= bias_.params().max_learn_distance_per_dim &&
+      result.best_distance_per_dim <=
+          bias_.params().learn_distance_limit(result.sensor_noise_per_dim) &&
       result.state >= 0 && result.state < library_->model().num_states()) {
     const auto& rows = library_->model().features();
     bias_.learn(features_,

@@ -315,6 +315,62 @@ TEST(Perturbations, SensorNoiseMovesTheRootOnlyWhenEveryJointHasPositionChannels
   EXPECT_GT(root_moved / clean.frame_count(), 0.005);
 }
 
+TEST(Perturbations, ASuitsCalibrationIsConstantAndItsDriftWandersSlowly) {
+  // Bias alone: every frame of a joint is off by the same rotation, of the requested RMS size over
+  // the joints. Drift alone: the error moves, slowly (10 s), and has the requested RMS size.
+  const Fixture f = make_fixture(1800);
+  const Performance clean = play(f.source(), {});
+  SensorNoiseOptions bias_only;
+  bias_only.bias_deg = 5.0;
+  bias_only.seed = 3;
+  SensorNoiseOptions drift_only;
+  drift_only.drift_deg = 5.0;
+  drift_only.drift_time_s = 2.0;  // 30 s of take: 15 time constants, so the RMS settles
+  drift_only.seed = 3;
+  const Performance biased = with_sensor_noise(clean, bias_only);
+  const Performance drifting = with_sensor_noise(clean, drift_only);
+  // The error of joint i at frame k as a rotation vector (clean^-1 * noisy).
+  auto error = [&](const Performance& p, int k, std::size_t i) {
+    return log_map(clean.motion.rotations_ls(k)[i].conjugate() * p.motion.rotations_ls(k)[i]);
+  };
+  double bias_sq = 0.0, drift_sq = 0.0, drift_step_sq = 0.0;
+  long long n = 0, steps = 0;
+  for (int j = 0; j < clean.motion.joint_count(); ++j) {
+    const auto i = static_cast<std::size_t>(j);
+    if (clean.motion.skeleton().joints[i].end_site) continue;
+    const Vec3 first = error(biased, 0, i);
+    for (int k = 0; k < clean.frame_count(); ++k) {
+      EXPECT_LT((error(biased, k, i) - first).norm(), 1e-9) << "joint " << j << " frame " << k;
+      bias_sq += first.squaredNorm();
+      drift_sq += error(drifting, k, i).squaredNorm();
+      ++n;
+      if (k > 0) {
+        drift_step_sq += (error(drifting, k, i) - error(drifting, k - 1, i)).squaredNorm();
+        ++steps;
+      }
+    }
+  }
+  const double bias_rms = rad_to_deg(std::sqrt(bias_sq / static_cast<double>(n)));
+  const double drift_rms = rad_to_deg(std::sqrt(drift_sq / static_cast<double>(n)));
+  const double drift_step_rms = rad_to_deg(std::sqrt(drift_step_sq / static_cast<double>(steps)));
+  EXPECT_NEAR(bias_rms, 5.0, 1.5);  // over a handful of joints
+  EXPECT_GT(bias_rms, 0.5);
+  EXPECT_NEAR(drift_rms, 5.0, 1.5);
+  // An Ornstein-Uhlenbeck step over dt has RMS sigma sqrt(1 - exp(-2 dt / tau)): 0.64 degrees at
+  // 60 Hz and tau 2 s. White noise of the same size would step by sqrt(2) x 5 = 7 degrees.
+  EXPECT_NEAR(drift_step_rms, 5.0 * std::sqrt(1.0 - std::exp(-2.0 / 60.0 / 2.0)), 0.1);
+  for (std::size_t k = 0; k < clean.truth.size(); ++k) {
+    EXPECT_EQ(clean.truth[k].template_frame, drifting.truth[k].template_frame);
+  }
+  // Without slow errors the white noise is what it was: the slow errors have their own stream.
+  SensorNoiseOptions white{3.0, 0.01, 11};
+  SensorNoiseOptions white_and_bias = white;
+  white_and_bias.bias_deg = 2.0;
+  const Performance a = with_sensor_noise(clean, white);
+  const Performance b = with_sensor_noise(clean, white_and_bias);
+  EXPECT_EQ(a.motion.translations_ls(7)[0], b.motion.translations_ls(7)[0]);
+}
+
 // Frames flagged as the start of a jump in a performance's truth.
 int count_jumps(const Performance& performance) {
   return static_cast<int>(
@@ -442,6 +498,13 @@ TEST(EvalCases, HarshCaseAndNoiseSweepHaveIssue11sMagnitudes) {
     EXPECT_EQ(c.recipe.noise.active(), deg > 0);
     EXPECT_TRUE(c.recipe.improvise);
   }
+
+  // The inertial suit: the default noise plus its calibration error and drift.
+  const auto suit = std::ranges::find(cases, std::string("suit-drift"), &EvalCase::name);
+  ASSERT_NE(suit, cases.end());
+  EXPECT_DOUBLE_EQ(suit->recipe.noise.rotation_deg, CaseSettings{}.noise_rotation_deg);
+  EXPECT_DOUBLE_EQ(suit->recipe.noise.bias_deg, 5.0);
+  EXPECT_DOUBLE_EQ(suit->recipe.noise.drift_deg, 5.0);
 }
 
 TEST(Perturbations, BodyScaleAndRoomPlacementLeaveTheFeaturesThatShouldNotChange) {

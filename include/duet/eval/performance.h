@@ -118,12 +118,23 @@ Result<Performance> improvise(std::span<const SourceTake> sources, const Improvi
 // rotation vector has independent normal components (RMS angle rotation_deg), and the root's
 // position channels get independent normal noise (per-axis standard deviation position_m; other
 // joints' position channels hold bone lengths, which a sensor does not shake).
+//
+// An inertial suit (Perception Neuron, Xsens, Rokoko) also errs slowly: its calibration leaves
+// every joint's rotation off by a constant (bias_deg, RMS angle, drawn once per joint), and its
+// sensors drift (drift_deg, RMS angle of a random rotation per joint that wanders with time
+// constant drift_time_s: an Ornstein-Uhlenbeck process per axis, in the performance's time).
+// Both come after the joint's rotation and before the white noise, from their own random stream.
 struct SensorNoiseOptions {
   double rotation_deg = 0.0;
   double position_m = 0.0;
   std::uint64_t seed = 1;
+  double bias_deg = 0.0;
+  double drift_deg = 0.0;
+  double drift_time_s = 10.0;
 
-  bool active() const { return rotation_deg > 0.0 || position_m > 0.0; }
+  bool active() const {
+    return rotation_deg > 0.0 || position_m > 0.0 || bias_deg > 0.0 || drift_deg > 0.0;
+  }
 };
 Performance with_sensor_noise(Performance performance, const SensorNoiseOptions& options);
 // Records the wrists' world positions of the performance as it is now in true_wrists_ws (left

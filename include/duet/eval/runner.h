@@ -16,6 +16,7 @@
 #include "duet/eval/partner_metrics.h"
 #include "duet/eval/partner_run.h"
 #include "duet/eval/performance.h"
+#include "duet/features/posture_bias.h"
 #include "duet/follow/follow_params.h"
 #include "duet/follow/online_dtw.h"
 #include "duet/follow/tracker.h"
@@ -53,13 +54,16 @@ struct CaseSettings {
   double low_rate_hz = 30.0;
   double body_scale = 1.15;
   double improvise_duration_s = 0.0;  // 0 = the performed take's duration
+  double suit_bias_deg = 5.0;         // suit-drift: calibration error per joint, RMS angle
+  double suit_drift_deg = 5.0;        // suit-drift: drift per joint, RMS angle (10 s time constant)
 };
 
 // The standard cases, in report order: clean, tempo-slow, tempo-fast, drift, improv,
 // improv-pause, improv-library, noise, 30hz-noisy, late-frames, body-size, room-place,
 // partner-role, improv-30hz-noisy, harsh (issue 11's sensor: fixed magnitudes, not the settings),
 // 120hz-noisy (a sensor faster than the template, with the noise), dropouts (the noise, and
-// tracking lost for 0.3-1 s every 8 s on average).
+// tracking lost for 0.3-1 s every 8 s on average), suit-drift (an inertial suit: the noise, and
+// every joint off by a calibration error and a slow drift).
 std::vector<EvalCase> standard_cases(const CaseSettings& settings = {});
 
 // The noise sweep (`duet eval --noise-sweep`): noise-sweep-0 ... noise-sweep-5, improv-pause at
@@ -176,7 +180,8 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
 // Runs one tracker over one performance through a FollowSession, timing every step.
 Result<std::vector<FrameEstimate>> follow_performance(const DuetLibrary& library,
                                                       const Performance& performance,
-                                                      std::unique_ptr<Tracker> tracker);
+                                                      std::unique_ptr<Tracker> tracker,
+                                                      const PostureBiasParams& bias = {});
 
 // The tracker of a kind on a model (kNaiveHmm is built too, but only fits small models). index:
 // the beam's jump candidate index for this model when one exists (DuetLibrary::candidate_index);

@@ -25,14 +25,25 @@ namespace duet {
 
 struct PostureBiasParams {
   bool enabled = true;
-  double time_constant_s = 4.0;  // the average's time constant (seconds of confident frames)
+  // The average's time constant (seconds of confident frames). Short enough to follow an inertial
+  // suit's drift (4 -> 2 s in session 10; the shrinkage below keeps the white noise out).
+  double time_constant_s = 2.0;
   double min_weight = 0.2;       // a frame's weight is the follower's confidence, at least this
   float max_offset = 2.0f;       // per dimension, in standardised units (a runaway guard)
   // Frames whose best template match is further than this (squared standardised distance per
-  // dimension, as FollowResult::best_distance_per_dim) teach nothing: a tenth of the follower's
-  // lost distance. Learning from every frame let a walk's offset make it look like salsa (the
-  // Bandai walk went from 98 % lost to 69 %); measured in docs/features.md.
-  float max_learn_distance_per_dim = 0.005f;
+  // dimension, as FollowResult::best_distance_per_dim) teach nothing. Learning from every frame
+  // let a walk's offset make it look like salsa (the Bandai walk went from 98 % lost to 69 %);
+  // measured in docs/features.md. On a steady sensor a frame this far is the offset itself (an
+  // inertial suit's calibration and drift reach 0.005-0.01); as the sensor's white noise rises
+  // to noisy_learn_level the limit falls to max_learn_distance_noisy_per_dim, since there the
+  // larger distances are noise and a match a frame or two off (docs/evaluation.md, "Results",
+  // session 10).
+  float max_learn_distance_per_dim = 0.01f;
+  float max_learn_distance_noisy_per_dim = 0.005f;
+  float noisy_learn_level =
+      0.004f;  // sensor noise per dimension (FollowResult::sensor_noise_per_dim)
+  // The limit above for a sensor whose white-noise variance per dimension is sensor_noise.
+  float learn_distance_limit(float sensor_noise) const noexcept;
   // Per dimension the applied offset is mean * max(0, 1 - (k se / mean)^2), se^2 the variance
   // of the running mean given the sensor's noise (James-Stein-like positive-part shrinkage).
   // 2 / 3 / 4 / 6 swept in docs/evaluation.md ("Results", session 8); 0 applies the mean as learnt.
