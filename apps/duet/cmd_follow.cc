@@ -43,7 +43,7 @@ struct FollowArgs {
 // The partner's motion on another skeleton (--partner-rig): retargeted and written in that rig
 // file's units, so the user's own avatar can play it.
 Status write_partner_on_rig(const FollowArgs& args, const Clip& partner,
-                            const JointRoles& partner_roles) {
+                            const JointRoles& partner_roles, UpAxis user_up) {
   Result<std::vector<std::string>> paths = split_motion_argument(args.partner_rig);
   if (!paths) return Error{"--partner-rig: " + paths.error().message};
   MotionLoadOptions options;
@@ -55,6 +55,7 @@ Status write_partner_on_rig(const FollowArgs& args, const Clip& partner,
   Result<Clip> moved = retarget_clip(partner, partner_roles, rig.value().clip.skeleton_ptr(),
                                      rig.value().roles, {}, "the partner", args.partner_rig);
   if (!moved) return Error{"--partner-rig: " + moved.error().message};
+  turn_world(moved.value(), rotation_to_y_up(user_up).conjugate());  // into the user's world
   return write_bvh(moved.value(), args.output_path,
                    BvhWriteOptions::in_file_units(readable_metres_per_unit(
                        moved.value().skeleton(), rig.value().metres_per_unit)));
@@ -87,21 +88,24 @@ std::optional<double> lost_as_other_role(const FollowArgs& args, const Clip& use
 // The BVH files are written in the units of the files they come from (the partner in the
 // response takes', the user in the input's), so every duet command reads them back at the same
 // scale and a viewer shows them as it shows the originals. An ASF+AMC source (read in metres) is
-// written in its convention's BVH units, the ones a BVH with its joint names is read in.
-Status write_outputs(const FollowArgs& args, const std::string& trace, const Clip& partner,
-                     double partner_metres_per_unit, const Clip& user,
-                     double user_metres_per_unit) {
+// written in its convention's BVH units, the ones a BVH with its joint names is read in. Both are
+// written in the input's world: a Z-up input gets a Z-up partner (LoadedMotion::up_axis).
+Status write_outputs(const FollowArgs& args, const std::string& trace, Clip partner,
+                     double partner_metres_per_unit, Clip user, const LoadedMotion& input) {
   if (!args.trace_path.empty()) {
     if (Status s = write_file_atomically(args.trace_path, trace); !s) return s;
   }
+  const Quat to_user_world = rotation_to_y_up(input.up_axis).conjugate();
   if (!args.output_path.empty() && args.partner_rig.empty()) {
+    turn_world(partner, to_user_world);
     const BvhWriteOptions units = BvhWriteOptions::in_file_units(
         readable_metres_per_unit(partner.skeleton(), partner_metres_per_unit));
     if (Status s = write_bvh(partner, args.output_path, units); !s) return s;
   }
   if (!args.user_output_path.empty()) {
+    turn_world(user, to_user_world);
     const BvhWriteOptions units = BvhWriteOptions::in_file_units(
-        readable_metres_per_unit(user.skeleton(), user_metres_per_unit));
+        readable_metres_per_unit(user.skeleton(), input.metres_per_unit));
     if (Status s = write_bvh(user, args.user_output_path, units); !s) return s;
   }
   return Ok{};
@@ -203,13 +207,14 @@ int run_follow(const FollowArgs& args) {
 
   if (Status s =
           write_outputs(args, trace, partner, library->takes()[0].response_motion.metres_per_unit,
-                        user, input.value().metres_per_unit);
+                        user, input.value());
       !s) {
     fmt::print(stderr, "duet follow: {}\n", s.error().message);
     return kExitFailure;
   }
   if (!args.partner_rig.empty() && !args.output_path.empty()) {
-    if (Status s = write_partner_on_rig(args, partner, library->takes()[0].response_motion.roles);
+    if (Status s = write_partner_on_rig(args, partner, library->takes()[0].response_motion.roles,
+                                        input.value().up_axis);
         !s) {
       fmt::print(stderr, "duet follow: {}\n", s.error().message);
       return kExitFailure;

@@ -62,10 +62,12 @@ int run_inspect(const InspectArgs& args) {
 
   Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity());
   Vec3 high = -low;
+  // In the file's own world (the clip was turned to Y-up on loading).
+  const Quat to_file_world = rotation_to_y_up(motion.up_axis).conjugate();
   const std::vector<Vec3> positions = world_positions(clip);
   for (const Vec3& p : positions) {
-    low = low.cwiseMin(p);
-    high = high.cwiseMax(p);
+    low = low.cwiseMin(to_file_world * p);
+    high = high.cwiseMax(to_file_world * p);
   }
   if (positions.empty()) low = high = Vec3::Zero();
 
@@ -83,6 +85,9 @@ int run_inspect(const InspectArgs& args) {
     doc["units"] = {{"name", motion.units_name},
                     {"source", motion.units_source},
                     {"warning", motion.units_warning}};
+    doc["up_axis"] = {{"axis", std::string(up_axis_name(motion.up_axis))},
+                      {"source", motion.up_source},
+                      {"warning", motion.up_warning}};
     if (body.valid()) {
       doc["body_m"] = {{"standing_height", body.standing_height_m},
                        {"leg_length", body.leg_length_m},
@@ -122,6 +127,10 @@ int run_inspect(const InspectArgs& args) {
              motion.units_name.empty() ? fmt::format("{:.6g} m", motion.metres_per_unit)
                                        : motion.units_name,
              motion.units_source.empty() ? "" : ", " + motion.units_source);
+  fmt::print("up axis:     {}{}{}\n", up_axis_name(motion.up_axis),
+             motion.up_source.empty() ? "" : ", " + motion.up_source,
+             motion.up_axis == UpAxis::kPosY ? "" : " (turned to +Y for following)");
+  if (!motion.up_warning.empty()) fmt::print("             {}\n", motion.up_warning);
   if (body.valid()) {
     fmt::print("height:      {:.2f} m estimated (legs {:.2f} m, arms {:.2f} m, trunk {:.2f} m)\n",
                body.standing_height_m, body.leg_length_m, body.arm_length_m,

@@ -59,6 +59,15 @@ std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostCon
                                    : input.units_name,
           input.units_source, input.units_warning.empty() ? "" : " — " + input.units_warning));
     }
+    // The up axis: the body could not tell it, or it was given.
+    if (!input.up_warning.empty()) {
+      causes.push_back(
+          fmt::format("up axis: {}; if the file is Z-up, pass --input-up z", input.up_warning));
+    } else if (input.up_source == "given (--up)") {
+      causes.push_back(fmt::format(
+          "up axis: {} was given (--input-up); `duet inspect {}` reads it from the body",
+          up_axis_name(input.up_axis), input.description));
+    }
     // The rig: roles found without a known convention may be wrong.
     if (input.roles.convention == "names" || input.roles.convention == "hierarchy") {
       causes.push_back(fmt::format(

@@ -20,11 +20,23 @@ void add_motion_file_options(CLI::App& app, MotionFileOptions& options, const st
                  "Skeleton map JSON naming the joint of each role, instead of detecting the roles "
                  "(see docs/skeleton-maps.md)")
       ->check(CLI::ExistingFile);
+  app.add_option("--" + prefix + "up", options.up,
+                 "The file's up axis: auto (default: read from the body, feet to head), y, z, x, "
+                 "-y, -z or -x. A Z-up file (3ds Max, Motive, some Blender exports) is turned to "
+                 "Y-up for following and its outputs are written back in its own world")
+      ->check([](const std::string& text) -> std::string {
+        UpAxis axis;
+        if (text == "auto" || parse_up_axis(text, axis)) return {};
+        return "expected auto, y, z, x, -y, -z or -x, got '" + text + "'";
+      });
 }
 
 bool make_load_options(const MotionFileOptions& options, MotionLoadOptions& load_options) {
   load_options.frame_rate = options.fps;
   load_options.metres_per_unit = options.scale;
+  if (UpAxis axis; !options.up.empty() && options.up != "auto" && parse_up_axis(options.up, axis)) {
+    load_options.up_axis = axis;
+  }
   if (!options.map_path.empty()) {
     SkeletonMap map;
     std::string error;

@@ -13,6 +13,7 @@ struct MotionFileOptions {
   std::optional<double> fps;    // --fps: override the file's frame rate
   std::optional<double> scale;  // --scale: metres per file unit
   std::string map_path;         // --map: a skeleton map JSON file
+  std::string up;               // --up: the file's up axis ("auto" or empty: read from the body)
 };
 
 void add_motion_file_options(CLI::App& app, MotionFileOptions& options,

@@ -153,6 +153,26 @@ Result<LoadedMotion> load_points_csv(const std::string& path, const MotionLoadOp
   return loaded;
 }
 
+// The file's up axis: given, else read from the body; the clip is turned to Y-up.
+void decide_up_axis(const MotionLoadOptions& options, bool have_roles, LoadedMotion& loaded) {
+  if (options.up_axis) {
+    loaded.up_axis = *options.up_axis;
+    loaded.up_source = "given (--up)";
+  } else if (have_roles) {
+    const UpAxisDetection detection = detect_up_axis(loaded.clip, loaded.roles);
+    if (detection.problem.empty()) {
+      loaded.up_axis = detection.axis;
+      loaded.up_source = "read from the body";
+    } else {
+      loaded.up_source = "assumed (+Y)";
+      loaded.up_warning = detection.problem + "; +Y assumed (--up sets it)";
+    }
+  } else {
+    loaded.up_source = "assumed (+Y)";
+  }
+  if (loaded.up_axis != UpAxis::kPosY) turn_world(loaded.clip, rotation_to_y_up(loaded.up_axis));
+}
+
 }  // namespace
 
 Result<LoadedMotion> load_motion(const std::vector<std::string>& paths,
@@ -230,6 +250,7 @@ Result<LoadedMotion> load_motion(const std::vector<std::string>& paths,
     }
     loaded.clip.scale_lengths(loaded.metres_per_unit);
   }
+  decide_up_axis(options, have_roles, loaded);
   if (have_roles) {
     loaded.body = measure_body(loaded.clip.skeleton(), loaded.roles, 1.0);
     const double height = loaded.body.standing_height_m;

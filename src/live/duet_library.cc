@@ -82,7 +82,10 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
     if (progress) progress(static_cast<int>(k), static_cast<int>(pairs.size()), leader_word);
     Result<LoadedMotion> leader = load_motion(pair.leader, options.load);
     if (!leader) return leader.error();
-    Result<LoadedMotion> partner = load_motion(pair.partner, options.load);
+    // The two dancers share one capture volume: the partner's file is in the leader's world.
+    MotionLoadOptions partner_load = options.load;
+    if (!partner_load.up_axis) partner_load.up_axis = leader.value().up_axis;
+    Result<LoadedMotion> partner = load_motion(pair.partner, partner_load);
     if (!partner) return partner.error();
     const std::string what =
         "pair " + std::to_string(k + 1) + " (" + leader_word + ", " + partner_word + ")";

@@ -2,11 +2,15 @@
 // written on the handshake rig, and the exit code that says most of the input was lost.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "apps/run_command.h"
+#include "duet/io/bvh.h"
 #include "duet/io/motion_file.h"
 #include "duet/motion/body_space.h"
+#include "duet/motion/forward_kinematics.h"
+#include "duet/motion/up_axis.h"
 
 namespace duet {
 namespace {
@@ -88,6 +92,70 @@ TEST(CliFollowRigs, DancingThePartnersPartIsNamedAsTheLikelyCause) {
                data_path("cmu-salsa/bvh/61/61_03_scaled.bvh") + " --input-fps 60");
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("--role partner"), std::string::npos) << r.output;
+}
+
+// The first `frames` frames of take `trial`'s leader, its world turned so that `up` is up, written
+// as a BVH file in the take's units.
+std::filesystem::path write_take_with_up(const std::string& trial, UpAxis up, int frames,
+                                         const std::string& name) {
+  MotionLoadOptions options;
+  options.frame_rate = 60.0;
+  Result<LoadedMotion> take =
+      load_motion({data_path("cmu-salsa/bvh/60/60_" + trial + "_scaled.bvh")}, options);
+  EXPECT_TRUE(take) << take.error().message;
+  const Clip& whole = take.value().clip;
+  Clip clip(whole.skeleton_ptr(), whole.frame_rate(), frames);
+  for (int f = 0; f < frames; ++f) {
+    std::ranges::copy(whole.translations_ls(f), clip.translations_ls(f).begin());
+    std::ranges::copy(whole.rotations_ls(f), clip.rotations_ls(f).begin());
+  }
+  turn_world(clip, rotation_to_y_up(up).conjugate());
+  const std::filesystem::path path = temp_file(name);
+  EXPECT_TRUE(
+      write_bvh(clip, path.string(), BvhWriteOptions::in_file_units(take.value().metres_per_unit)));
+  return path;
+}
+
+TEST(CliFollowRigs, AZUpFileIsFollowedAndAnsweredInItsOwnWorld) {
+  // 3ds Max, Motive and some Blender exports are Z-up. The same 15 s of take 01, Y-up and Z-up:
+  // the Z-up one was 100 % lost before the up axis was read from the body.
+  const std::filesystem::path y_up = write_take_with_up("01", UpAxis::kPosY, 900, "yup.bvh");
+  const std::filesystem::path z_up = write_take_with_up("01", UpAxis::kPosZ, 900, "zup.bvh");
+  const std::filesystem::path partner_y = temp_file("partner_y.bvh");
+  const std::filesystem::path partner_z = temp_file("partner_z.bvh");
+  const testing::CommandResult followed_y =
+      run_duet("follow" + two_pairs() + " --input " + y_up.string() + " -o " + partner_y.string());
+  const testing::CommandResult followed_z =
+      run_duet("follow" + two_pairs() + " --input " + z_up.string() + " -o " + partner_z.string());
+  ASSERT_EQ(followed_y.exit_code, 0) << followed_y.output;
+  ASSERT_EQ(followed_z.exit_code, 0) << followed_z.output;
+  EXPECT_NE(followed_z.output.find(" 0 lost frames"), std::string::npos) << followed_z.output;
+
+  // The partner comes back in the input's world: Z-up, and once turned, the Y-up run's partner.
+  Result<LoadedMotion> answer_y = load_motion({partner_y.string()});
+  Result<LoadedMotion> answer_z = load_motion({partner_z.string()});
+  ASSERT_TRUE(answer_y) << answer_y.error().message;
+  ASSERT_TRUE(answer_z) << answer_z.error().message;
+  EXPECT_EQ(answer_y.value().up_axis, UpAxis::kPosY);
+  EXPECT_EQ(answer_z.value().up_axis, UpAxis::kPosZ);
+  EXPECT_EQ(answer_z.value().up_source, "read from the body");
+  const std::vector<Vec3> a = world_positions(answer_y.value().clip);
+  const std::vector<Vec3> b = world_positions(answer_z.value().clip);
+  ASSERT_EQ(a.size(), b.size());
+  double largest = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) largest = std::max(largest, (a[i] - b[i]).norm());
+  EXPECT_LT(largest, 0.002) << "metres";
+
+  const testing::CommandResult inspected = run_duet("inspect " + z_up.string());
+  EXPECT_NE(inspected.output.find("up axis:     +Z, read from the body"), std::string::npos)
+      << inspected.output;
+  // Told the wrong axis, it is lost, and the cause says what was given.
+  const testing::CommandResult told_wrong =
+      run_duet("follow" + two_pairs() + " --input " + z_up.string() + " --input-up y");
+  EXPECT_EQ(told_wrong.exit_code, 3) << told_wrong.output;
+  EXPECT_NE(told_wrong.output.find("up axis: +Y was given"), std::string::npos)
+      << told_wrong.output;
+  for (const auto& path : {y_up, z_up, partner_y, partner_z}) std::filesystem::remove(path);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "duet/motion/clip.h"
 #include "duet/motion/role_detection.h"
 #include "duet/motion/skeleton_map.h"
+#include "duet/motion/up_axis.h"
 
 namespace duet {
 
@@ -22,6 +23,8 @@ struct MotionLoadOptions {
   // When false, a skeleton whose roles cannot all be found still loads (for duet inspect):
   // `roles` then holds -1 for the missing roles and `role_detection.problem` says why.
   bool require_roles = true;
+  // The file's up axis (--up); read from the body when not given (motion/up_axis.h).
+  std::optional<UpAxis> up_axis;
 };
 
 struct LoadedMotion {
@@ -36,6 +39,14 @@ struct LoadedMotion {
   std::string units_warning;  // non-empty when the units are doubtful (body height implausible)
   BodyDimensions body;        // in metres; invalid (zeros) when roles are missing
   std::string description;    // "a.bvh" or "a.asf + b.amc"
+  // The file's up axis. `clip` is always Y-up: a file with another up axis was turned by
+  // rotation_to_y_up(up_axis) on loading, and what is written back into its world (the user's
+  // own output, the partner in the user's world) is turned back.
+  UpAxis up_axis = UpAxis::kPosY;
+  // How the up axis was decided: "read from the body", "given (--up)", or "assumed (+Y)" when
+  // the body could not tell (up_warning then says why).
+  std::string up_source;
+  std::string up_warning;
 };
 
 // Known units per convention: the DAZ-style salsa BVH are about 0.768 units per metre; CMU

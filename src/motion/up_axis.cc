@@ -1,0 +1,146 @@
+#include "duet/motion/up_axis.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <vector>
+
+#include "duet/math/rotation.h"
+#include "duet/motion/forward_kinematics.h"
+
+namespace duet {
+namespace {
+
+struct AxisInfo {
+  UpAxis axis;
+  std::string_view name;
+  Vec3 vector;
+};
+
+const std::array<AxisInfo, 6>& axes() {
+  static const std::array<AxisInfo, 6> table = {{
+      {UpAxis::kPosY, "+Y", Vec3::UnitY()},
+      {UpAxis::kNegY, "-Y", -Vec3::UnitY()},
+      {UpAxis::kPosZ, "+Z", Vec3::UnitZ()},
+      {UpAxis::kNegZ, "-Z", -Vec3::UnitZ()},
+      {UpAxis::kPosX, "+X", Vec3::UnitX()},
+      {UpAxis::kNegX, "-X", -Vec3::UnitX()},
+  }};
+  return table;
+}
+
+const AxisInfo& info(UpAxis axis) { return axes()[static_cast<std::size_t>(axis)]; }
+
+// Most a dancer's mean feet-to-head direction may lean from the axis it is read as.
+constexpr double kMostOffAxisDeg = 35.0;
+// Least length of the mean of unit directions: below it the body pointed too many ways.
+constexpr double kLeastConsistency = 0.5;
+
+}  // namespace
+
+std::string_view up_axis_name(UpAxis axis) { return info(axis).name; }
+
+Vec3 up_axis_vector(UpAxis axis) { return info(axis).vector; }
+
+bool parse_up_axis(std::string_view text, UpAxis& axis) {
+  std::string t;
+  for (const char c : text) t += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  if (t.size() == 1) t = "+" + t;
+  for (const AxisInfo& a : axes()) {
+    if (t == a.name) {
+      axis = a.axis;
+      return true;
+    }
+  }
+  return false;
+}
+
+Quat rotation_to_y_up(UpAxis axis) {
+  switch (axis) {
+    case UpAxis::kPosY:
+      return Quat::Identity();
+    case UpAxis::kNegY:
+      return Quat(Eigen::AngleAxisd(kPi, Vec3::UnitX()));
+    case UpAxis::kPosZ:
+      return Quat(Eigen::AngleAxisd(-kPi / 2.0, Vec3::UnitX()));
+    case UpAxis::kNegZ:
+      return Quat(Eigen::AngleAxisd(kPi / 2.0, Vec3::UnitX()));
+    case UpAxis::kPosX:
+      return Quat(Eigen::AngleAxisd(kPi / 2.0, Vec3::UnitZ()));
+    case UpAxis::kNegX:
+      return Quat(Eigen::AngleAxisd(-kPi / 2.0, Vec3::UnitZ()));
+  }
+  return Quat::Identity();
+}
+
+UpAxisDetection detect_up_axis(const Clip& clip, const JointRoles& roles, int max_frames) {
+  UpAxisDetection result;
+  const int head = roles[Role::kHead];
+  const int left_ankle = roles[Role::kLeftAnkle];
+  const int right_ankle = roles[Role::kRightAnkle];
+  const int joints = clip.joint_count();
+  if (head < 0 || left_ankle < 0 || right_ankle < 0 || head >= joints || left_ankle >= joints ||
+      right_ankle >= joints) {
+    result.problem = "no head and ankle roles to read the up axis from";
+    return result;
+  }
+  if (clip.frame_count() == 0) {
+    result.problem = "no frames to read the up axis from";
+    return result;
+  }
+  const int samples = std::clamp(clip.frame_count(), 1, std::max(max_frames, 1));
+  std::vector<Vec3> positions(static_cast<std::size_t>(joints));
+  std::vector<Quat> rotations(static_cast<std::size_t>(joints));
+  Vec3 sum = Vec3::Zero();
+  int counted = 0;
+  for (int s = 0; s < samples; ++s) {
+    const int f = static_cast<int>(static_cast<long long>(s) * clip.frame_count() / samples);
+    forward_kinematics(clip.skeleton(), clip.translations_ls(f), clip.rotations_ls(f), positions,
+                       rotations);
+    const Vec3 feet = 0.5 * (positions[static_cast<std::size_t>(left_ankle)] +
+                             positions[static_cast<std::size_t>(right_ankle)]);
+    const Vec3 up = positions[static_cast<std::size_t>(head)] - feet;
+    const double length = up.norm();
+    if (!(length > 0.0) || !std::isfinite(length)) continue;
+    sum += up / length;
+    ++counted;
+  }
+  if (counted == 0) {
+    result.problem = "the head and the ankles are at the same place on every frame";
+    return result;
+  }
+  const Vec3 mean = sum / counted;
+  if (mean.norm() < kLeastConsistency) {
+    result.problem = fmt::format(
+        "the body points no consistent way from the feet to the head (mean length {:.2f} of 1)",
+        mean.norm());
+    return result;
+  }
+  const Vec3 direction = mean.normalized();
+  const AxisInfo* best = &axes()[0];
+  for (const AxisInfo& a : axes()) {
+    if (direction.dot(a.vector) > direction.dot(best->vector)) best = &a;
+  }
+  result.axis = best->axis;
+  result.off_axis_deg = rad_to_deg(std::acos(std::clamp(direction.dot(best->vector), -1.0, 1.0)));
+  if (result.off_axis_deg > kMostOffAxisDeg) {
+    result.problem = fmt::format(
+        "the body's feet-to-head direction is {:.0f} degrees from the nearest axis ({}): no up "
+        "axis stands out",
+        result.off_axis_deg, best->name);
+  }
+  return result;
+}
+
+void turn_world(Clip& clip, const Quat& rotation) {
+  if (clip.joint_count() == 0) return;
+  for (int f = 0; f < clip.frame_count(); ++f) {
+    clip.rotations_ls(f)[0] = (rotation * clip.rotations_ls(f)[0]).normalized();
+    clip.translations_ls(f)[0] = rotation * clip.translations_ls(f)[0];
+  }
+}
+
+}  // namespace duet
