@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "duet/motion/forward_kinematics.h"
+#include "duet/motion/up_axis.h"
 
 namespace duet {
 
@@ -506,16 +507,21 @@ RoleDetection detect_roles_by_hierarchy(const Skeleton& skeleton) {
                          : "no legs: no joint where two legs and a spine branch (each a chain "
                            "of three or more joints)");
   }
+  // The rest pose's up: the spine's direction from the hips to the chest, to the nearest axis. A
+  // Y-up rig stands along +Y; a Z-up one (3ds Max, Motive) along +Z.
+  const Vec3 up = up_axis_vector(nearest_axis(tree.rest[at(chest)] - tree.rest[at(hips)]));
   // The legs: besides the spine (the biggest branch), the two that reach lowest in the rest pose.
-  auto lowest_y = [&](int root) {
-    double y = tree.rest[at(root)].y();
+  auto lowest = [&](int root) {
+    double height = tree.rest[at(root)].dot(up);
     for (int j = root; j < n; ++j) {
-      if (j == root || tree.is_ancestor(root, j)) y = std::min(y, tree.rest[at(j)].y());
+      if (j == root || tree.is_ancestor(root, j)) {
+        height = std::min(height, tree.rest[at(j)].dot(up));
+      }
     }
-    return y;
+    return height;
   };
   std::vector<int> legs(branches.begin() + 1, branches.end());
-  std::sort(legs.begin(), legs.end(), [&](int a, int b) { return lowest_y(a) < lowest_y(b); });
+  std::sort(legs.begin(), legs.end(), [&](int a, int b) { return lowest(a) < lowest(b); });
   legs.resize(2);
 
   // A leg: thigh and shin are its two longest consecutive bones along its longest chain.
@@ -578,7 +584,7 @@ RoleDetection detect_roles_by_hierarchy(const Skeleton& skeleton) {
       j = next;
     }
     const Vec3 v = tree.rest[at(j)] - tree.rest[at(chest)];
-    return v.y() - std::hypot(v.x(), v.z());
+    return v.dot(up) - (v - v.dot(up) * up).norm();
   };
   std::sort(forks.begin(), forks.end(), [&](int a, int b) { return rise(a) > rise(b); });
   const int neck_branch = forks[0];
@@ -611,16 +617,16 @@ RoleDetection detect_roles_by_hierarchy(const Skeleton& skeleton) {
     }
   }
 
-  // Left = up x forward (Y up), forward = where the toes point: a body facing +Z has its left
-  // at +X.
+  // Left = up x forward, forward = where the toes point, on the floor: a Y-up body facing +Z has
+  // its left at +X.
   Vec3 forward = (tree.rest[at(leg_a.toe)] - tree.rest[at(leg_a.ankle)]) +
                  (tree.rest[at(leg_b.toe)] - tree.rest[at(leg_b.ankle)]);
-  forward.y() = 0.0;
+  forward -= forward.dot(up) * up;
   const double leg_scale = (tree.rest[at(leg_a.ankle)] - tree.rest[at(leg_a.knee)]).norm();
   if (!(forward.norm() > 0.1 * leg_scale)) {
     return fail("cannot tell left from right: the toes point nowhere in the rest pose");
   }
-  const Vec3 leftward = Vec3::UnitY().cross(forward.normalized());
+  const Vec3 leftward = up.cross(forward.normalized());
   const double leg_side = (tree.rest[at(leg_a.thigh)] - tree.rest[at(leg_b.thigh)]).dot(leftward);
   const double arm_side =
       (tree.rest[at(arm_a.elbow)] - tree.rest[at(arm_b.elbow)]).dot(leftward);

@@ -76,6 +76,14 @@ Quat rotation_to_y_up(UpAxis axis) {
   return Quat::Identity();
 }
 
+UpAxis nearest_axis(const Vec3& direction) {
+  const AxisInfo* best = &axes()[0];
+  for (const AxisInfo& a : axes()) {
+    if (direction.dot(a.vector) > direction.dot(best->vector)) best = &a;
+  }
+  return best->axis;
+}
+
 UpAxisDetection detect_up_axis(const Clip& clip, const JointRoles& roles, int max_frames) {
   UpAxisDetection result;
   const int head = roles[Role::kHead];
@@ -120,10 +128,7 @@ UpAxisDetection detect_up_axis(const Clip& clip, const JointRoles& roles, int ma
     return result;
   }
   const Vec3 direction = mean.normalized();
-  const AxisInfo* best = &axes()[0];
-  for (const AxisInfo& a : axes()) {
-    if (direction.dot(a.vector) > direction.dot(best->vector)) best = &a;
-  }
+  const AxisInfo* best = &info(nearest_axis(direction));
   result.axis = best->axis;
   result.off_axis_deg = rad_to_deg(std::acos(std::clamp(direction.dot(best->vector), -1.0, 1.0)));
   if (result.off_axis_deg > kMostOffAxisDeg) {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "duet/io/bvh.h"
+#include "duet/motion/up_axis.h"
 
 namespace duet {
 namespace {
@@ -196,8 +197,10 @@ TEST(RoleDetection, SidePrefixesAndBipedNames) {
                "");
 }
 
-// Every joint renamed j0, j1, ...: the roles must come out as the same joints.
-void expect_same_roles_anonymised(const std::string& file, const std::string& convention) {
+// Every joint renamed j0, j1, ...: the roles must come out as the same joints. `turn` turns the
+// rest pose (every offset), as a rig exported Z-up stands along +Z.
+void expect_same_roles_anonymised(const std::string& file, const std::string& convention,
+                                  const Quat& turn = Quat::Identity()) {
   Result<Clip> clip = read_bvh(file);
   ASSERT_TRUE(clip) << clip.error().message;
   Skeleton s = clip.value().skeleton();
@@ -207,6 +210,8 @@ void expect_same_roles_anonymised(const std::string& file, const std::string& co
   ASSERT_EQ(named.convention, convention);
   for (int j = 0; j < s.joint_count(); ++j) {
     s.joints[static_cast<std::size_t>(j)].name = "j" + std::to_string(j);
+    s.joints[static_cast<std::size_t>(j)].offset =
+        turn * s.joints[static_cast<std::size_t>(j)].offset;
   }
   JointRoles anonymous;
   ASSERT_TRUE(detect_roles(s, anonymous, error)) << error;
@@ -226,6 +231,19 @@ TEST(RoleDetection, AnonymisedSalsaSkeletonFromTheHierarchy) {
 TEST(RoleDetection, AnonymisedHandshakeSkeletonFromTheHierarchy) {
   expect_same_roles_anonymised(std::string(DUET_DATA_DIR) + "/cmu-handshake/18_01.bvh",
                                "cmu-bvh");
+}
+
+TEST(RoleDetection, AnonymisedRigsStandingAlongZOrXFromTheHierarchy) {
+  // A Z-up export's rest pose stands along +Z: its up is the spine's direction, not +Y (before,
+  // the salsa rig turned Z-up had its left and right swapped and was followed 100 % lost).
+  for (const UpAxis up : {UpAxis::kPosZ, UpAxis::kNegZ, UpAxis::kPosX}) {
+    SCOPED_TRACE(std::string(up_axis_name(up)));
+    const Quat turn = rotation_to_y_up(up).conjugate();
+    expect_same_roles_anonymised(std::string(DUET_DATA_DIR) + "/cmu-salsa/bvh/60/60_01_scaled.bvh",
+                                 "daz", turn);
+    expect_same_roles_anonymised(std::string(DUET_DATA_DIR) + "/cmu-handshake/18_01.bvh", "cmu-bvh",
+                                 turn);
+  }
 }
 
 TEST(RoleDetection, MirroredAnonymousRigSwapsSides) {

@@ -23,6 +23,8 @@ bool parse_up_axis(std::string_view text, UpAxis& axis);
 Vec3 up_axis_vector(UpAxis axis);
 // The world rotation that takes `axis` to +Y (about X for the Y and Z axes, about Z for X).
 Quat rotation_to_y_up(UpAxis axis);
+// The signed axis nearest to `direction` (+Y for a zero vector).
+UpAxis nearest_axis(const Vec3& direction);
 
 struct UpAxisDetection {
   UpAxis axis = UpAxis::kPosY;
