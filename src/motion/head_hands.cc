@@ -5,6 +5,7 @@
 #include "duet/math/rotation.h"
 #include "duet/motion/body_space.h"
 #include "duet/motion/forward_kinematics.h"
+#include "duet/motion/up_axis.h"
 
 namespace duet {
 
@@ -44,11 +45,22 @@ Result<Quat> rest_pose_correction(const Skeleton& skeleton, const JointRoles& ro
   std::vector<Quat> rotations(n, Quat::Identity()), world_rotations(n);
   for (std::size_t j = 0; j < n; ++j) translations[j] = skeleton.joints[j].offset;
   forward_kinematics(skeleton, translations, rotations, positions, world_rotations);
+  // A rig exported Z-up stands along +Z in its rest pose: find its up (feet to head, to the
+  // nearest axis), stand it on +Y to read its heading, and turn the frame back.
+  Quat to_y_up = Quat::Identity();
+  const int head = roles[Role::kHead], left = roles[Role::kLeftAnkle],
+            right = roles[Role::kRightAnkle];
+  if (head >= 0 && left >= 0 && right >= 0) {
+    const Vec3 feet = 0.5 * (positions[static_cast<std::size_t>(left)] +
+                             positions[static_cast<std::size_t>(right)]);
+    to_y_up = rotation_to_y_up(nearest_axis(positions[static_cast<std::size_t>(head)] - feet));
+    for (Vec3& p : positions) p = to_y_up * p;
+  }
   const double yaw = body_heading_yaw(positions, roles);
   if (!std::isfinite(yaw)) {
     return Error{"the rest pose has no heading (hip joints at one place?)"};
   }
-  return yaw_rotation(yaw);
+  return to_y_up.conjugate() * yaw_rotation(yaw);
 }
 
 Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
 
 #include "duet/eval/performance.h"
@@ -13,6 +14,7 @@
 #include "duet/live/live_loop.h"
 #include "duet/math/rotation.h"
 #include "duet/motion/head_hands.h"
+#include "duet/motion/up_axis.h"
 #include "live/salsa_library.h"
 
 namespace duet::test {
@@ -70,6 +72,36 @@ TEST(HeadHandsFeatures, SameNumbersFromTheFullBodyAndFromItsThreePoints) {
   EXPECT_LT((a.leftCols(posture) - b.leftCols(posture)).cwiseAbs().maxCoeff(), 1e-3);
   EXPECT_LT((a.rightCols(a.cols() - posture) - b.rightCols(a.cols() - posture)).cwiseAbs().maxCoeff(),
             1e-2);
+}
+
+TEST(HeadHandsFeatures, ARigWhoseRestPoseStandsAlongZGivesTheSameNumbers) {
+  // A rig exported Z-up: every rest offset turned to stand along +Z, every rotation expressed in
+  // it, then the world turned to Y-up as load_motion does. The three points' canonical frame
+  // comes from the rest pose's heading, which must be read with the rest pose's own up.
+  const LoadedMotion take = load_take("60_07");
+  const Quat z_up = rotation_to_y_up(UpAxis::kPosZ).conjugate();  // takes +Y to +Z
+  auto skeleton = std::make_shared<Skeleton>(take.clip.skeleton());
+  for (Joint& joint : skeleton->joints) joint.offset = z_up * joint.offset;
+  Clip turned(skeleton, take.clip.frame_rate(), take.clip.frame_count());
+  for (int f = 0; f < turned.frame_count(); ++f) {
+    for (int j = 0; j < turned.joint_count(); ++j) {
+      const auto i = static_cast<std::size_t>(j);
+      turned.rotations_ls(f)[i] = z_up * take.clip.rotations_ls(f)[i] * z_up.conjugate();
+      turned.translations_ls(f)[i] = z_up * take.clip.translations_ls(f)[i];
+    }
+  }
+  turn_world(turned, rotation_to_y_up(UpAxis::kPosZ));
+  FeatureSpec spec;
+  spec.input_points = InputPoints::kHeadHands;
+  Result<FeatureExtractor> original =
+      FeatureExtractor::create(take.clip.skeleton_ptr(), take.roles, spec);
+  Result<FeatureExtractor> z_rig = FeatureExtractor::create(skeleton, take.roles, spec);
+  ASSERT_TRUE(original) << original.error().message;
+  ASSERT_TRUE(z_rig) << z_rig.error().message;
+  const FeatureMatrix a = original.value().extract_clip(take.clip);
+  const FeatureMatrix b = z_rig.value().extract_clip(turned);
+  ASSERT_EQ(a.rows(), b.rows());
+  EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-6);
 }
 
 TEST(HeadHandsFeatures, IndependentOfThePlaceInTheRoomAndOfBodySize) {
