@@ -397,12 +397,10 @@ class SlowRotationErrors {
       // Start from the stationary distribution: the drift is already there at the first frame.
       if (drift_sigma_ > 0.0) drift_[j] = Vec3(drift(rng_), drift(rng_), drift(rng_));
     }
+    active_ = options.bias_deg > 0.0 || drift_sigma_ > 0.0;
   }
 
-  bool active() const {
-    return drift_sigma_ > 0.0 ||
-           std::any_of(bias_.begin(), bias_.end(), [](const Vec3& b) { return !b.isZero(); });
-  }
+  bool active() const { return active_; }
 
   // Moves the drift on by dt seconds (exact discretisation of the Ornstein-Uhlenbeck process).
   void advance(double dt_s) {
@@ -420,6 +418,7 @@ class SlowRotationErrors {
   double drift_time_s_;
   std::vector<Vec3> bias_;
   std::vector<Vec3> drift_;
+  bool active_ = false;
 };
 
 }  // namespace
