@@ -55,7 +55,7 @@ Status write_partner_on_rig(const FollowArgs& args, const Clip& partner,
   Result<Clip> moved = retarget_clip(partner, partner_roles, rig.value().clip.skeleton_ptr(),
                                      rig.value().roles, {}, "the partner", args.partner_rig);
   if (!moved) return Error{"--partner-rig: " + moved.error().message};
-  turn_world(moved.value(), rotation_to_y_up(user_up).conjugate());  // into the user's world
+  turn_to_file_world(moved.value(), user_up);  // into the user's world
   return write_bvh(moved.value(), args.output_path,
                    BvhWriteOptions::in_file_units(readable_metres_per_unit(
                        moved.value().skeleton(), rig.value().metres_per_unit)));
@@ -90,23 +90,30 @@ std::optional<double> lost_as_other_role(const FollowArgs& args, const Clip& use
 // scale and a viewer shows them as it shows the originals. An ASF+AMC source (read in metres) is
 // written in its convention's BVH units, the ones a BVH with its joint names is read in. Both are
 // written in the input's world: a Z-up input gets a Z-up partner (LoadedMotion::up_axis).
-Status write_outputs(const FollowArgs& args, const std::string& trace, Clip partner,
-                     double partner_metres_per_unit, Clip user, const LoadedMotion& input) {
+Status write_outputs(const FollowArgs& args, const std::string& trace, const Clip& partner,
+                     double partner_metres_per_unit, const Clip& user, const LoadedMotion& input) {
   if (!args.trace_path.empty()) {
     if (Status s = write_file_atomically(args.trace_path, trace); !s) return s;
   }
-  const Quat to_user_world = rotation_to_y_up(input.up_axis).conjugate();
+  // A clip in the input's world, and its file units; copied only when it has to be turned.
+  auto write_in_input_world = [&](const Clip& clip, double metres_per_unit,
+                                  const std::string& path) -> Status {
+    const BvhWriteOptions units =
+        BvhWriteOptions::in_file_units(readable_metres_per_unit(clip.skeleton(), metres_per_unit));
+    if (input.up_axis == UpAxis::kPosY) return write_bvh(clip, path, units);
+    Clip turned = clip;
+    turn_to_file_world(turned, input.up_axis);
+    return write_bvh(turned, path, units);
+  };
   if (!args.output_path.empty() && args.partner_rig.empty()) {
-    turn_world(partner, to_user_world);
-    const BvhWriteOptions units = BvhWriteOptions::in_file_units(
-        readable_metres_per_unit(partner.skeleton(), partner_metres_per_unit));
-    if (Status s = write_bvh(partner, args.output_path, units); !s) return s;
+    if (Status s = write_in_input_world(partner, partner_metres_per_unit, args.output_path); !s) {
+      return s;
+    }
   }
   if (!args.user_output_path.empty()) {
-    turn_world(user, to_user_world);
-    const BvhWriteOptions units = BvhWriteOptions::in_file_units(
-        readable_metres_per_unit(user.skeleton(), input.metres_per_unit));
-    if (Status s = write_bvh(user, args.user_output_path, units); !s) return s;
+    if (Status s = write_in_input_world(user, input.metres_per_unit, args.user_output_path); !s) {
+      return s;
+    }
   }
   return Ok{};
 }

@@ -63,7 +63,7 @@ std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostCon
     if (!input.up_warning.empty()) {
       causes.push_back(
           fmt::format("up axis: {}; if the file is Z-up, pass --input-up z", input.up_warning));
-    } else if (input.up_source == "given (--up)") {
+    } else if (input.up_source == kUpAxisGiven) {
       causes.push_back(fmt::format(
           "up axis: {} was given (--input-up); `duet inspect {}` reads it from the body",
           up_axis_name(input.up_axis), input.description));

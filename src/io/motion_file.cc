@@ -157,7 +157,7 @@ Result<LoadedMotion> load_points_csv(const std::string& path, const MotionLoadOp
 void decide_up_axis(const MotionLoadOptions& options, bool have_roles, LoadedMotion& loaded) {
   if (options.up_axis) {
     loaded.up_axis = *options.up_axis;
-    loaded.up_source = "given (--up)";
+    loaded.up_source = kUpAxisGiven;
   } else if (have_roles) {
     const UpAxisDetection detection = detect_up_axis(loaded.clip, loaded.roles);
     if (detection.problem.empty()) {

@@ -48,12 +48,8 @@ Result<Quat> rest_pose_correction(const Skeleton& skeleton, const JointRoles& ro
   // A rig exported Z-up stands along +Z in its rest pose: find its up (feet to head, to the
   // nearest axis), stand it on +Y to read its heading, and turn the frame back.
   Quat to_y_up = Quat::Identity();
-  const int head = roles[Role::kHead], left = roles[Role::kLeftAnkle],
-            right = roles[Role::kRightAnkle];
-  if (head >= 0 && left >= 0 && right >= 0) {
-    const Vec3 feet = 0.5 * (positions[static_cast<std::size_t>(left)] +
-                             positions[static_cast<std::size_t>(right)]);
-    to_y_up = rotation_to_y_up(nearest_axis(positions[static_cast<std::size_t>(head)] - feet));
+  if (has_feet_and_head(roles, skeleton.joint_count())) {
+    to_y_up = rotation_to_y_up(nearest_axis(feet_to_head(positions, roles)));
     for (Vec3& p : positions) p = to_y_up * p;
   }
   const double yaw = body_heading_yaw(positions, roles);

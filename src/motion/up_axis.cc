@@ -84,14 +84,23 @@ UpAxis nearest_axis(const Vec3& direction) {
   return best->axis;
 }
 
+bool has_feet_and_head(const JointRoles& roles, int joints) {
+  for (const Role role : {Role::kHead, Role::kLeftAnkle, Role::kRightAnkle}) {
+    if (roles[role] < 0 || roles[role] >= joints) return false;
+  }
+  return true;
+}
+
+Vec3 feet_to_head(std::span<const Vec3> positions, const JointRoles& roles) {
+  const Vec3 feet = 0.5 * (positions[static_cast<std::size_t>(roles[Role::kLeftAnkle])] +
+                           positions[static_cast<std::size_t>(roles[Role::kRightAnkle])]);
+  return positions[static_cast<std::size_t>(roles[Role::kHead])] - feet;
+}
+
 UpAxisDetection detect_up_axis(const Clip& clip, const JointRoles& roles, int max_frames) {
   UpAxisDetection result;
-  const int head = roles[Role::kHead];
-  const int left_ankle = roles[Role::kLeftAnkle];
-  const int right_ankle = roles[Role::kRightAnkle];
   const int joints = clip.joint_count();
-  if (head < 0 || left_ankle < 0 || right_ankle < 0 || head >= joints || left_ankle >= joints ||
-      right_ankle >= joints) {
+  if (!has_feet_and_head(roles, joints)) {
     result.problem = "no head and ankle roles to read the up axis from";
     return result;
   }
@@ -108,9 +117,7 @@ UpAxisDetection detect_up_axis(const Clip& clip, const JointRoles& roles, int ma
     const int f = static_cast<int>(static_cast<long long>(s) * clip.frame_count() / samples);
     forward_kinematics(clip.skeleton(), clip.translations_ls(f), clip.rotations_ls(f), positions,
                        rotations);
-    const Vec3 feet = 0.5 * (positions[static_cast<std::size_t>(left_ankle)] +
-                             positions[static_cast<std::size_t>(right_ankle)]);
-    const Vec3 up = positions[static_cast<std::size_t>(head)] - feet;
+    const Vec3 up = feet_to_head(positions, roles);
     const double length = up.norm();
     if (!(length > 0.0) || !std::isfinite(length)) continue;
     sum += up / length;
@@ -146,6 +153,10 @@ void turn_world(Clip& clip, const Quat& rotation) {
     clip.rotations_ls(f)[0] = (rotation * clip.rotations_ls(f)[0]).normalized();
     clip.translations_ls(f)[0] = rotation * clip.translations_ls(f)[0];
   }
+}
+
+void turn_to_file_world(Clip& clip, UpAxis up) {
+  if (up != UpAxis::kPosY) turn_world(clip, rotation_to_y_up(up).conjugate());
 }
 
 }  // namespace duet

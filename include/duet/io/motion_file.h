@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "duet/base/result.h"
@@ -27,6 +28,9 @@ struct MotionLoadOptions {
   std::optional<UpAxis> up_axis;
 };
 
+// LoadedMotion::up_source when MotionLoadOptions::up_axis gave the axis.
+inline constexpr std::string_view kUpAxisGiven = "given (--up)";
+
 struct LoadedMotion {
   Clip clip;             // in metres
   JointRoles roles;      // which joint plays each role
@@ -43,8 +47,8 @@ struct LoadedMotion {
   // rotation_to_y_up(up_axis) on loading, and what is written back into its world (the user's
   // own output, the partner in the user's world) is turned back.
   UpAxis up_axis = UpAxis::kPosY;
-  // How the up axis was decided: "read from the body", "given (--up)", or "assumed (+Y)" when
-  // the body could not tell (up_warning then says why).
+  // How the up axis was decided: "read from the body", kUpAxisGiven, or "assumed (+Y)" when the
+  // body could not tell (up_warning then says why).
   std::string up_source;
   std::string up_warning;
 };

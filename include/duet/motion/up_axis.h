@@ -6,6 +6,7 @@
 #pragma once
 
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -26,6 +27,12 @@ Quat rotation_to_y_up(UpAxis axis);
 // The signed axis nearest to `direction` (+Y for a zero vector).
 UpAxis nearest_axis(const Vec3& direction);
 
+// Whether `roles` name a head and both ankles within a skeleton of `joints` joints.
+bool has_feet_and_head(const JointRoles& roles, int joints);
+// From the ankles' midpoint to the head joint, in the space of `positions` (one per joint; the
+// roles must pass has_feet_and_head): up, for a body that stands.
+Vec3 feet_to_head(std::span<const Vec3> positions, const JointRoles& roles);
+
 struct UpAxisDetection {
   UpAxis axis = UpAxis::kPosY;
   // Angle between the body's mean feet-to-head direction and the axis, degrees (how upright the
@@ -45,5 +52,8 @@ UpAxisDetection detect_up_axis(const Clip& clip, const JointRoles& roles, int ma
 // frame. The skeleton (rest offsets) is unchanged, so a clip turned by R and then by R^-1 is the
 // clip it was.
 void turn_world(Clip& clip, const Quat& rotation);
+// Turns a Y-up clip into the world of a file whose up axis is `up`: the inverse of the turn
+// load_motion applies (nothing for +Y). For outputs written back into a file's own world.
+void turn_to_file_world(Clip& clip, UpAxis up);
 
 }  // namespace duet
