@@ -88,7 +88,7 @@ int run_convert(const ConvertArgs& args) {
   if (!args.points.empty()) return write_points(loaded.value(), clip, args.output);
   // The BVH keeps the source's world: a Z-up file stays Z-up (the points CSV above is Y-up, as
   // headsets report).
-  turn_to_file_world(clip, loaded.value().up_axis);
+  turn_to_file_world(clip, loaded.value().file_to_y_up());
   // A BVH cannot say its units: by default write the ones the reader will infer for this
   // skeleton (the source's, or its convention's), so the file reads back at its true size.
   const double readable_units_per_metre =

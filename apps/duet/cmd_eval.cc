@@ -424,7 +424,8 @@ Command register_eval(CLI::App& app) {
                  "(30 Hz, 4 deg per axis + 1 cm noise, 3% repeated frames, a 1.1x body), "
                  "120hz-noisy (a 120 Hz sensor with the noise), dropouts (the noise, and the "
                  "sensor loses the dancer for 0.3-1 s every 8 s), suit-drift (an inertial "
-                 "suit: the noise, and every joint off by a calibration error and a slow drift)")
+                 "suit: the noise, and every joint off by a calibration error and a slow drift), "
+                 "tilted (the noise in a tilted world, as a camera pitched down sees it)")
       ->delimiter(',');
   app.add_flag("--noise-sweep", args->noise_sweep,
                "Also run noise-sweep-0 ... noise-sweep-5: improv-pause with 0 to 5 degrees of "
@@ -491,6 +492,10 @@ Command register_eval(CLI::App& app) {
       ->add_option("--suit-drift-deg", args->settings.suit_drift_deg,
                    "Slow drift per joint of the suit-drift case, RMS degrees (default 5)")
       ->check(number_between(0.0, 45.0));
+  cases
+      ->add_option("--tilt-deg", args->settings.tilt_deg,
+                   "How far the tilted case's world is tilted, degrees (default 12)")
+      ->check(number_between(0.0, 30.0));
   cases
       ->add_option("--improv-duration", args->settings.improvise_duration_s,
                    "Length of the improvised performances in s (default: the take's length)")

@@ -43,7 +43,7 @@ struct FollowArgs {
 // The partner's motion on another skeleton (--partner-rig): retargeted and written in that rig
 // file's units, so the user's own avatar can play it.
 Status write_partner_on_rig(const FollowArgs& args, const Clip& partner,
-                            const JointRoles& partner_roles, UpAxis user_up) {
+                            const JointRoles& partner_roles, const Quat& user_to_y_up) {
   Result<std::vector<std::string>> paths = split_motion_argument(args.partner_rig);
   if (!paths) return Error{"--partner-rig: " + paths.error().message};
   MotionLoadOptions options;
@@ -55,7 +55,7 @@ Status write_partner_on_rig(const FollowArgs& args, const Clip& partner,
   Result<Clip> moved = retarget_clip(partner, partner_roles, rig.value().clip.skeleton_ptr(),
                                      rig.value().roles, {}, "the partner", args.partner_rig);
   if (!moved) return Error{"--partner-rig: " + moved.error().message};
-  turn_to_file_world(moved.value(), user_up);  // into the user's world
+  turn_to_file_world(moved.value(), user_to_y_up);  // into the user's world
   return write_bvh(moved.value(), args.output_path,
                    BvhWriteOptions::in_file_units(readable_metres_per_unit(
                        moved.value().skeleton(), rig.value().metres_per_unit)));
@@ -89,7 +89,8 @@ std::optional<double> lost_as_other_role(const FollowArgs& args, const Clip& use
 // response takes', the user in the input's), so every duet command reads them back at the same
 // scale and a viewer shows them as it shows the originals. An ASF+AMC source (read in metres) is
 // written in its convention's BVH units, the ones a BVH with its joint names is read in. Both are
-// written in the input's world: a Z-up input gets a Z-up partner (LoadedMotion::up_axis).
+// written in the input's world: a Z-up input gets a Z-up partner, a tilted one a tilted partner
+// (LoadedMotion::file_to_y_up).
 Status write_outputs(const FollowArgs& args, const std::string& trace, const Clip& partner,
                      double partner_metres_per_unit, const Clip& user, const LoadedMotion& input) {
   if (!args.trace_path.empty()) {
@@ -100,9 +101,10 @@ Status write_outputs(const FollowArgs& args, const std::string& trace, const Cli
                                   const std::string& path) -> Status {
     const BvhWriteOptions units =
         BvhWriteOptions::in_file_units(readable_metres_per_unit(clip.skeleton(), metres_per_unit));
-    if (input.up_axis == UpAxis::kPosY) return write_bvh(clip, path, units);
+    const Quat to_y_up = input.file_to_y_up();
+    if (to_y_up.vec().squaredNorm() == 0.0) return write_bvh(clip, path, units);
     Clip turned = clip;
-    turn_to_file_world(turned, input.up_axis);
+    turn_to_file_world(turned, to_y_up);
     return write_bvh(turned, path, units);
   };
   if (!args.output_path.empty() && args.partner_rig.empty()) {
@@ -221,7 +223,7 @@ int run_follow(const FollowArgs& args) {
   }
   if (!args.partner_rig.empty() && !args.output_path.empty()) {
     if (Status s = write_partner_on_rig(args, partner, library->takes()[0].response_motion.roles,
-                                        input.value().up_axis);
+                                        input.value().file_to_y_up());
         !s) {
       fmt::print(stderr, "duet follow: {}\n", s.error().message);
       return kExitFailure;

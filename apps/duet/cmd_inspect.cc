@@ -63,7 +63,7 @@ int run_inspect(const InspectArgs& args) {
   Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity());
   Vec3 high = -low;
   // In the file's own world (the clip was turned to Y-up on loading).
-  const Quat to_file_world = rotation_to_y_up(motion.up_axis).conjugate();
+  const Quat to_file_world = motion.file_to_y_up().conjugate();
   const std::vector<Vec3> positions = world_positions(clip);
   for (const Vec3& p : positions) {
     low = low.cwiseMin(to_file_world * p);
@@ -87,6 +87,7 @@ int run_inspect(const InspectArgs& args) {
                     {"warning", motion.units_warning}};
     doc["up_axis"] = {{"axis", std::string(up_axis_name(motion.up_axis))},
                       {"source", motion.up_source},
+                      {"levelled_by_deg", motion.tilt_deg},
                       {"warning", motion.up_warning}};
     if (body.valid()) {
       doc["body_m"] = {{"standing_height", body.standing_height_m},

@@ -132,7 +132,7 @@ int run_retarget(const RetargetArgs& args) {
   }
   // In the source's world (a Z-up source gives a Z-up output) and the rig file's units; an ASF
   // rig (read in metres) in its convention's BVH units.
-  turn_to_file_world(out, source.value().up_axis);
+  turn_to_file_world(out, source.value().file_to_y_up());
   const double written_metres_per_unit = readable_metres_per_unit(*target, rig_metres_per_unit);
   Status written =
       write_bvh(out, args.output, BvhWriteOptions::in_file_units(written_metres_per_unit));

@@ -12,6 +12,7 @@
 #include "duet/motion/head_hands.h"
 #include "duet/motion/limits.h"
 #include "duet/motion/retarget.h"
+#include "duet/motion/up_axis.h"
 #include "duet/partner/alignment.h"
 
 namespace duet {
@@ -599,6 +600,23 @@ Performance with_room_placement(Performance performance, double yaw_rad, const V
   return performance;
 }
 
+Performance with_world_tilt(Performance performance, double tilt_deg) {
+  turn_world(performance.motion, Quat(Eigen::AngleAxisd(deg_to_rad(tilt_deg), Vec3::UnitX())));
+  return performance;
+}
+
+Quat level_as_loaded(Performance& performance) {
+  const UpAxisDetection detection = detect_up_axis(performance.motion, performance.roles);
+  if (detection.axis != UpAxis::kPosY) return Quat::Identity();
+  const Quat level = levelling_rotation(detection);
+  if (level.vec().squaredNorm() == 0.0) return level;
+  turn_world(performance.motion, level);
+  for (std::array<Vec3, 2>& wrists : performance.true_wrists_ws) {
+    for (Vec3& wrist : wrists) wrist = level * wrist;
+  }
+  return level;
+}
+
 Result<Performance> with_rig(Performance performance, std::shared_ptr<const Skeleton> rig,
                              const JointRoles& rig_roles) {
   Result<Clip> moved = retarget_clip(performance.motion, performance.roles, rig, rig_roles);
@@ -639,6 +657,9 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     performance =
         with_room_placement(std::move(performance), recipe.room_yaw_rad, recipe.room_offset_m);
   }
+  if (recipe.world_tilt_deg != 0.0) {
+    performance = with_world_tilt(std::move(performance), recipe.world_tilt_deg);
+  }
   if (recipe.rig) {
     Result<Performance> moved = with_rig(std::move(performance), recipe.rig, recipe.rig_roles);
     if (!moved) return moved.error();
@@ -651,6 +672,7 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     options.seed = derive_seed(seed, 12);
     performance = with_sensor_noise(std::move(performance), options);
   }
+  if (!recipe.head_hands) level_as_loaded(performance);
   if (recipe.head_hands) {
     PointNoiseOptions options = recipe.point_noise;
     options.seed = derive_seed(seed, 14);

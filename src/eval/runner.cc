@@ -119,6 +119,15 @@ std::vector<EvalCase> standard_cases(const CaseSettings& settings) {
     c.recipe.noise.bias_deg = settings.suit_bias_deg;
     c.recipe.noise.drift_deg = settings.suit_drift_deg;
   }
+  {
+    // A camera pitched down (a depth camera on a shelf, a phone for a pose estimator) sees a
+    // tilted floor; the performance is levelled as loading a file levels it (level_as_loaded).
+    EvalCase& c = add("tilted", fmt::format("the noise, in a world tilted by {:g} deg (a camera "
+                                            "pitched down), levelled as a loaded file is",
+                                            settings.tilt_deg));
+    c.recipe.noise = noise;
+    c.recipe.world_tilt_deg = settings.tilt_deg;
+  }
   // Describe the magnitudes actually used.
   for (EvalCase& c : cases) {
     if (c.name == "harsh") continue;

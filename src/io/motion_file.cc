@@ -11,6 +11,7 @@
 #include "duet/io/asf_amc.h"
 #include "duet/io/bvh.h"
 #include "duet/io/points_csv.h"
+#include "duet/math/rotation.h"
 #include "duet/motion/head_hands.h"
 
 namespace duet {
@@ -153,7 +154,10 @@ Result<LoadedMotion> load_points_csv(const std::string& path, const MotionLoadOp
   return loaded;
 }
 
-// The file's up axis: given, else read from the body; the clip is turned to Y-up.
+double turn_angle_deg(const Quat& turn) { return rad_to_deg(log_map(turn).norm()); }
+
+// The file's up axis: given, else read from the body, and a tilted world levelled; the clip is
+// turned to Y-up.
 void decide_up_axis(const MotionLoadOptions& options, bool have_roles, LoadedMotion& loaded) {
   if (options.up_axis) {
     loaded.up_axis = *options.up_axis;
@@ -163,6 +167,11 @@ void decide_up_axis(const MotionLoadOptions& options, bool have_roles, LoadedMot
     if (detection.problem.empty()) {
       loaded.up_axis = detection.axis;
       loaded.up_source = "read from the body";
+      loaded.level = levelling_rotation(detection);
+      if (turn_angle_deg(loaded.level) > 0.0) {
+        loaded.up_source += fmt::format("; a tilted floor, levelled by {:.1f} degrees",
+                                        turn_angle_deg(loaded.level));
+      }
     } else {
       loaded.up_source = "assumed (+Y)";
       loaded.up_warning = detection.problem + "; +Y assumed (--up sets it)";
@@ -170,7 +179,10 @@ void decide_up_axis(const MotionLoadOptions& options, bool have_roles, LoadedMot
   } else {
     loaded.up_source = "assumed (+Y)";
   }
-  if (loaded.up_axis != UpAxis::kPosY) turn_world(loaded.clip, rotation_to_y_up(loaded.up_axis));
+  if (options.level) loaded.level = options.level->normalized();
+  loaded.tilt_deg = turn_angle_deg(loaded.level);
+  const Quat turn = loaded.file_to_y_up();
+  if (turn.vec().squaredNorm() > 0.0) turn_world(loaded.clip, turn);
 }
 
 }  // namespace

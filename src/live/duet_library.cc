@@ -84,7 +84,10 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
     if (!leader) return leader.error();
     // The two dancers share one capture volume: the partner's file is in the leader's world.
     MotionLoadOptions partner_load = options.load;
-    if (!partner_load.up_axis) partner_load.up_axis = leader.value().up_axis;
+    if (!partner_load.up_axis) {
+      partner_load.up_axis = leader.value().up_axis;
+      partner_load.level = leader.value().level;
+    }
     Result<LoadedMotion> partner = load_motion(pair.partner, partner_load);
     if (!partner) return partner.error();
     const std::string what =

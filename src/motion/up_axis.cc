@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "duet/math/rotation.h"
+#include "duet/motion/floor_plane.h"
 #include "duet/motion/forward_kinematics.h"
 
 namespace duet {
@@ -38,6 +39,14 @@ const AxisInfo& info(UpAxis axis) { return axes()[static_cast<std::size_t>(axis)
 constexpr double kMostOffAxisDeg = 35.0;
 // Least length of the mean of unit directions: below it the body pointed too many ways.
 constexpr double kLeastConsistency = 0.5;
+
+// The middle of both feet: ankles and toes, or the ankles alone.
+Vec3 mid_foot(std::span<const Vec3> positions, const JointRoles& roles, bool with_toes) {
+  const auto at = [&](Role role) { return positions[static_cast<std::size_t>(roles[role])]; };
+  const Vec3 ankles = 0.5 * (at(Role::kLeftAnkle) + at(Role::kRightAnkle));
+  return with_toes ? Vec3(0.5 * ankles + 0.25 * (at(Role::kLeftToe) + at(Role::kRightToe)))
+                   : ankles;
+}
 
 }  // namespace
 
@@ -108,20 +117,29 @@ UpAxisDetection detect_up_axis(const Clip& clip, const JointRoles& roles, int ma
     result.problem = "no frames to read the up axis from";
     return result;
   }
+  const bool with_toes = roles[Role::kLeftToe] >= 0 && roles[Role::kLeftToe] < joints &&
+                         roles[Role::kRightToe] >= 0 && roles[Role::kRightToe] < joints;
   const int samples = std::clamp(clip.frame_count(), 1, std::max(max_frames, 1));
   std::vector<Vec3> positions(static_cast<std::size_t>(joints));
   std::vector<Quat> rotations(static_cast<std::size_t>(joints));
   Vec3 sum = Vec3::Zero();
   int counted = 0;
+  std::vector<std::array<Vec3, 2>> toes;  // the floor's evidence (fit_floor), in the file's world
+  toes.reserve(static_cast<std::size_t>(samples));
+  const std::array<Role, 2> toe_roles = with_toes ? std::array{Role::kLeftToe, Role::kRightToe}
+                                                  : std::array{Role::kLeftAnkle, Role::kRightAnkle};
   for (int s = 0; s < samples; ++s) {
     const int f = static_cast<int>(static_cast<long long>(s) * clip.frame_count() / samples);
     forward_kinematics(clip.skeleton(), clip.translations_ls(f), clip.rotations_ls(f), positions,
                        rotations);
-    const Vec3 up = feet_to_head(positions, roles);
+    const Vec3 up = positions[static_cast<std::size_t>(roles[Role::kHead])] -
+                    mid_foot(positions, roles, with_toes);
     const double length = up.norm();
     if (!(length > 0.0) || !std::isfinite(length)) continue;
     sum += up / length;
     ++counted;
+    toes.push_back({positions[static_cast<std::size_t>(roles[toe_roles[0]])],
+                    positions[static_cast<std::size_t>(roles[toe_roles[1]])]});
   }
   if (counted == 0) {
     result.problem = "the head and the ankles are at the same place on every frame";
@@ -135,6 +153,8 @@ UpAxisDetection detect_up_axis(const Clip& clip, const JointRoles& roles, int ma
     return result;
   }
   const Vec3 direction = mean.normalized();
+  result.mean_up = direction;
+  result.span_s = clip.duration();
   const AxisInfo* best = &info(nearest_axis(direction));
   result.axis = best->axis;
   result.off_axis_deg = rad_to_deg(std::acos(std::clamp(direction.dot(best->vector), -1.0, 1.0)));
@@ -143,7 +163,18 @@ UpAxisDetection detect_up_axis(const Clip& clip, const JointRoles& roles, int ma
         "the body's feet-to-head direction is {:.0f} degrees from the nearest axis ({}): no up "
         "axis stands out",
         result.off_axis_deg, best->name);
+    return result;
   }
+  // The floor, in the world turned to Y-up: the lower toe of each sampled frame.
+  const Quat to_y_up = rotation_to_y_up(result.axis);
+  std::vector<Vec3> floor_points;
+  floor_points.reserve(toes.size());
+  for (const std::array<Vec3, 2>& pair : toes) {
+    const Vec3 a = to_y_up * pair[0];
+    const Vec3 b = to_y_up * pair[1];
+    floor_points.push_back(a.y() <= b.y() ? a : b);
+  }
+  result.floor_up = fit_floor(floor_points, to_y_up * direction, result.span_s).up;
   return result;
 }
 
@@ -155,8 +186,27 @@ void turn_world(Clip& clip, const Quat& rotation) {
   }
 }
 
-void turn_to_file_world(Clip& clip, UpAxis up) {
-  if (up != UpAxis::kPosY) turn_world(clip, rotation_to_y_up(up).conjugate());
+double tilt_from_vertical_deg(const Vec3& mean_up) {
+  const double length = mean_up.norm();
+  if (!(length > 0.0) || !std::isfinite(length)) return 0.0;
+  return rad_to_deg(std::acos(std::clamp(mean_up.y() / length, -1.0, 1.0)));
+}
+
+Quat levelling_rotation(const Vec3& mean_up, double from_deg) {
+  const double tilt = tilt_from_vertical_deg(mean_up);
+  if (!(tilt > from_deg)) return Quat::Identity();
+  return Quat::FromTwoVectors(mean_up.normalized(), Vec3::UnitY()).normalized();
+}
+
+Quat levelling_rotation(const UpAxisDetection& detection) {
+  if (!detection.problem.empty() || !(detection.span_s >= kLevelLeastSpanS)) {
+    return Quat::Identity();
+  }
+  return levelling_rotation(detection.floor_up);
+}
+
+void turn_to_file_world(Clip& clip, const Quat& file_to_y_up) {
+  if (file_to_y_up.vec().squaredNorm() > 0.0) turn_world(clip, file_to_y_up.conjugate());
 }
 
 }  // namespace duet

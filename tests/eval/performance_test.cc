@@ -505,6 +505,46 @@ TEST(EvalCases, HarshCaseAndNoiseSweepHaveIssue11sMagnitudes) {
   EXPECT_DOUBLE_EQ(suit->recipe.noise.rotation_deg, CaseSettings{}.noise_rotation_deg);
   EXPECT_DOUBLE_EQ(suit->recipe.noise.bias_deg, 5.0);
   EXPECT_DOUBLE_EQ(suit->recipe.noise.drift_deg, 5.0);
+
+  // A camera pitched down: the noise, in a tilted world.
+  const auto tilted = std::ranges::find(cases, std::string("tilted"), &EvalCase::name);
+  ASSERT_NE(tilted, cases.end());
+  EXPECT_DOUBLE_EQ(tilted->recipe.world_tilt_deg, 12.0);
+  EXPECT_TRUE(tilted->recipe.noise.active());
+}
+
+TEST(Perturbations, ATiltedWorldIsLevelledAsALoadedFileIsAndTheRealWristsTurnWithIt) {
+  const Fixture f = make_fixture(300);
+  const SourceTake source = f.source();
+  PerformanceRecipe recipe;
+  recipe.noise = {3.0, 0.01, 0};
+  recipe.world_tilt_deg = 12.0;
+  const Result<Performance> made = make_performance({&source, 1}, recipe, 5);
+  ASSERT_TRUE(made) << made.error().message;
+  const Performance& tilted = made.value();
+  // Levelled to the floor the toes touch, as load_motion levels a file.
+  EXPECT_LT(tilt_from_vertical_deg(detect_up_axis(tilted.motion, tilted.roles).floor_up), 1.0);
+  // The real wrists are in that levelled world: within the noise of the sensed ones. Left in the
+  // tilted world they would be 12 degrees (about 20 cm at a wrist) away.
+  ASSERT_EQ(tilted.true_wrists_ws.size(), static_cast<std::size_t>(tilted.frame_count()));
+  const int wrist = tilted.roles[Role::kLeftWrist];
+  double sum = 0.0;
+  std::vector<Vec3> positions(static_cast<std::size_t>(tilted.motion.joint_count()));
+  std::vector<Quat> rotations(positions.size());
+  for (int frame = 0; frame < tilted.frame_count(); ++frame) {
+    forward_kinematics(tilted.motion.skeleton(), tilted.motion.translations_ls(frame),
+                       tilted.motion.rotations_ls(frame), positions, rotations);
+    sum += (positions[static_cast<std::size_t>(wrist)] -
+            tilted.true_wrists_ws[static_cast<std::size_t>(frame)][0])
+               .norm();
+  }
+  EXPECT_LT(sum / tilted.frame_count(), 0.08) << "metres, mean";
+
+  // The turn level_as_loaded finds is the tilt (this dancer leans little); a level world is left
+  // alone.
+  Performance again = with_world_tilt(tilted, 12.0);
+  EXPECT_NEAR(rad_to_deg(log_map(level_as_loaded(again)).norm()), 12.0, 0.5);
+  EXPECT_TRUE(level_as_loaded(again).vec().isZero(0.0));
 }
 
 TEST(Perturbations, BodyScaleAndRoomPlacementLeaveTheFeaturesThatShouldNotChange) {

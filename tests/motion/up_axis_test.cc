@@ -68,7 +68,8 @@ TEST(UpAxis, SaysWhenTheBodyCannotTell) {
   const JointRoles roles = daz_roles(*skeleton);
   // A body standing in its rest pose, leaning 45 degrees between two axes on every frame.
   Clip leaning(skeleton, 60.0, 120);
-  EXPECT_NEAR(detect_up_axis(leaning, roles).off_axis_deg, 0.0, 1e-9);
+  // Upright: the head above the middle of the feet, but for the toes' reach forwards.
+  EXPECT_LT(detect_up_axis(leaning, roles).off_axis_deg, 5.0);
   turn_world(leaning, Quat(Eigen::AngleAxisd(deg_to_rad(45.0), Vec3::UnitX())));
   const UpAxisDetection read = detect_up_axis(leaning, roles);
   EXPECT_FALSE(read.problem.empty());
@@ -87,6 +88,46 @@ TEST(UpAxis, SaysWhenTheBodyCannotTell) {
   }
   const UpAxisDetection flipped = detect_up_axis(flipping, roles);
   EXPECT_NE(flipped.problem.find("no consistent way"), std::string::npos) << flipped.problem;
+}
+
+TEST(UpAxis, ATiltedFloorIsLevelledAboutAHorizontalAxisAndASmallLeanIsLeftAlone) {
+  // A body standing in its rest pose on a floor tilted 12 degrees about a horizontal axis.
+  auto skeleton = make_role_skeleton();
+  const JointRoles roles = daz_roles(*skeleton);
+  Clip standing(skeleton, 60.0, 360);
+  const Vec3 upright = detect_up_axis(standing, roles).mean_up;
+  const Quat tilt(Eigen::AngleAxisd(deg_to_rad(12.0), Vec3(1.0, 0.0, 2.0).normalized()));
+  turn_world(standing, tilt);
+  const UpAxisDetection read = detect_up_axis(standing, roles);
+  ASSERT_TRUE(read.problem.empty()) << read.problem;
+  EXPECT_EQ(read.axis, UpAxis::kPosY);
+  EXPECT_LT((read.mean_up - tilt * upright).norm(), 1e-12);
+  EXPECT_DOUBLE_EQ(read.span_s, 6.0);
+  const Quat level = levelling_rotation(read);
+  EXPECT_NEAR(rad_to_deg(log_map(level).norm()), tilt_from_vertical_deg(read.mean_up), 1e-9);
+  EXPECT_NEAR(log_map(level).normalized().dot(Vec3::UnitY()), 0.0, 1e-12);  // headings kept
+  turn_world(standing, level);
+  EXPECT_NEAR(tilt_from_vertical_deg(detect_up_axis(standing, roles).mean_up), 0.0, 1e-9);
+  // Under kLevelLeastSpanS of motion the mean is no evidence of a tilt: nothing is turned.
+  Clip short_clip(skeleton, 60.0, 240);
+  turn_world(short_clip, tilt);
+  EXPECT_TRUE(levelling_rotation(detect_up_axis(short_clip, roles)).vec().isZero(0.0));
+
+  // A lean under kLevelFromDeg is the dancer's own: nothing is turned. Nor for no direction.
+  const Vec3 leaning = Quat(Eigen::AngleAxisd(deg_to_rad(2.0), Vec3::UnitZ())) * Vec3::UnitY();
+  EXPECT_TRUE(levelling_rotation(leaning).vec().isZero(0.0));
+  EXPECT_TRUE(levelling_rotation(Vec3::Zero()).vec().isZero(0.0));
+  EXPECT_TRUE(levelling_rotation(Vec3(std::nan(""), 1.0, 0.0)).vec().isZero(0.0));
+
+  // A Y-up clip turned into a file's world (an up axis and a tilt) and back is what it was.
+  const Clip dance = make_dance(skeleton, 60.0, 120);
+  const Quat file_to_y_up = level * rotation_to_y_up(UpAxis::kPosZ);
+  Clip in_file = dance;
+  turn_world(in_file, file_to_y_up);
+  turn_to_file_world(in_file, file_to_y_up);
+  const std::vector<Vec3> a = world_positions(dance);
+  const std::vector<Vec3> b = world_positions(in_file);
+  for (std::size_t i = 0; i < a.size(); ++i) ASSERT_LT((a[i] - b[i]).norm(), 1e-9) << i;
 }
 
 }  // namespace

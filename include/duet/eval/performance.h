@@ -178,6 +178,15 @@ Performance with_body_scale(Performance performance, double factor);
 // Another place and facing in the room: the root is turned by yaw_rad about the vertical axis
 // through the world origin, then moved by offset_m.
 Performance with_room_placement(Performance performance, double yaw_rad, const Vec3& offset_m);
+// The world seen by a sensor whose floor is not level (a depth camera pitched down, a pose
+// estimator's camera frame): every frame turned by `tilt_deg` about the X axis.
+Performance with_world_tilt(Performance performance, double tilt_deg);
+// What loading a file does to a full-body performance's world (load_motion: motion/up_axis.h):
+// a floor tilted more than kLevelFromDeg over at least kLevelLeastSpanS, read from the body, is
+// levelled; the recorded real
+// wrists turn with it. Returns the levelling turn (the identity when nothing was levelled, and
+// for a performance with no feet and head, as a three-point CSV has none).
+Quat level_as_loaded(Performance& performance);
 
 // The same performance danced on another rig (a user's suit, avatar or another studio's skeleton):
 // retargeted (duet::retarget_clip: role directions, stride-scaled root, feet on the floor) onto
@@ -198,7 +207,8 @@ struct PointNoiseOptions {
 Result<Performance> with_head_hands(Performance performance, const PointNoiseOptions& noise);
 
 // A composition of the above, applied in this order: play or improvise (at rate_hz), body scale,
-// room placement, another rig, sensor noise, head and hands, frame loss. Each stage's seed is
+// room placement, world tilt, another rig, sensor noise, levelling as a loaded file is levelled
+// (full body only), head and hands, frame loss. Each stage's seed is
 // derived from `seed`.
 struct PerformanceRecipe {
   bool improvise = false;
@@ -207,6 +217,7 @@ struct PerformanceRecipe {
   double body_scale = 1.0;
   double room_yaw_rad = 0.0;
   Vec3 room_offset_m = Vec3::Zero();
+  double world_tilt_deg = 0.0;          // the sensor's world tilted (with_world_tilt)
   std::shared_ptr<const Skeleton> rig;  // null: the library's own rig
   JointRoles rig_roles;
   std::string rig_name;      // for reports ("asf", "bandai", ...)

@@ -56,6 +56,7 @@ struct CaseSettings {
   double improvise_duration_s = 0.0;  // 0 = the performed take's duration
   double suit_bias_deg = 5.0;         // suit-drift: calibration error per joint, RMS angle
   double suit_drift_deg = 5.0;        // suit-drift: drift per joint, RMS angle (10 s time constant)
+  double tilt_deg = 12.0;             // tilted: how far the sensor's world is tilted
 };
 
 // The standard cases, in report order: clean, tempo-slow, tempo-fast, drift, improv,
@@ -63,7 +64,8 @@ struct CaseSettings {
 // partner-role, improv-30hz-noisy, harsh (issue 11's sensor: fixed magnitudes, not the settings),
 // 120hz-noisy (a sensor faster than the template, with the noise), dropouts (the noise, and
 // tracking lost for 0.3-1 s every 8 s on average), suit-drift (an inertial suit: the noise, and
-// every joint off by a calibration error and a slow drift).
+// every joint off by a calibration error and a slow drift), tilted (the noise, in a world tilted as
+// a pitched camera sees it; levelled as a loaded file is).
 std::vector<EvalCase> standard_cases(const CaseSettings& settings = {});
 
 // The noise sweep (`duet eval --noise-sweep`): noise-sweep-0 ... noise-sweep-5, improv-pause at

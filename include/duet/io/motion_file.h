@@ -24,8 +24,12 @@ struct MotionLoadOptions {
   // When false, a skeleton whose roles cannot all be found still loads (for duet inspect):
   // `roles` then holds -1 for the missing roles and `role_detection.problem` says why.
   bool require_roles = true;
-  // The file's up axis (--up); read from the body when not given (motion/up_axis.h).
+  // The file's up axis (--up); read from the body when not given (motion/up_axis.h). A given
+  // axis is taken as exact: the world is not levelled.
   std::optional<UpAxis> up_axis;
+  // The levelling turn to apply after the up axis's (a library partner's file shares the
+  // leader's world); by default read from the body with the up axis.
+  std::optional<Quat> level;
 };
 
 // LoadedMotion::up_source when MotionLoadOptions::up_axis gave the axis.
@@ -47,6 +51,12 @@ struct LoadedMotion {
   // rotation_to_y_up(up_axis) on loading, and what is written back into its world (the user's
   // own output, the partner in the user's world) is turned back.
   UpAxis up_axis = UpAxis::kPosY;
+  // A tilted world levelled after the up axis's turn (motion/up_axis.h, levelling_rotation):
+  // the turn, and the tilt it removed in degrees (0 and the identity for a level world).
+  Quat level = Quat::Identity();
+  double tilt_deg = 0.0;
+  // The whole turn applied on loading; turn_to_file_world(clip, file_to_y_up()) undoes it.
+  Quat file_to_y_up() const { return (level * rotation_to_y_up(up_axis)).normalized(); }
   // How the up axis was decided: "read from the body", kUpAxisGiven, or "assumed (+Y)" when the
   // body could not tell (up_warning then says why).
   std::string up_source;

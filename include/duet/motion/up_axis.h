@@ -38,22 +38,53 @@ struct UpAxisDetection {
   // Angle between the body's mean feet-to-head direction and the axis, degrees (how upright the
   // dancer stood in that world); meaningful only when `problem` is empty.
   double off_axis_deg = 0.0;
+  // The body's mean direction (unit) from the middle of the feet (ankles and toes, the ankles
+  // alone when the roles name no toes) to the head, in the clip's world; meaningful only when
+  // `problem` is empty. A standing body's head is above its mid-foot, ahead of its ankles.
+  Vec3 mean_up = Vec3::UnitY();
+  double span_s = 0.0;  // how long a stretch of the clip the mean covers
+  // The floor's normal in the world turned to +Y by `axis` (motion/floor_plane.h: the plane
+  // through the lower toe of the sampled frames, drawn towards the mean up where the toes do not
+  // spread); meaningful only when `problem` is empty.
+  Vec3 floor_up = Vec3::UnitY();
   std::string problem;  // why no axis could be read (no frames, a body lying down, ...)
 };
 
 // Reads the up axis from the body: the mean, over up to `max_frames` frames spread over the clip,
-// of the unit direction from the ankles' midpoint to the head joint, snapped to the nearest signed
-// axis. A dancer who stands most of the time reads within a few degrees of it; when the mean is
-// further than 35 degrees from every axis, or its length (how consistently the body pointed one
+// of the unit direction from the middle of the feet to the head joint, snapped to the nearest
+// signed axis. A dancer who stands most of the time reads within a few degrees of it; when the mean
+// is further than 35 degrees from every axis, or its length (how consistently the body pointed one
 // way) is under 0.5, nothing is read and `problem` says so.
 UpAxisDetection detect_up_axis(const Clip& clip, const JointRoles& roles, int max_frames = 240);
+
+// A world whose floor is not level: a depth camera pitched down, a pose estimator's camera
+// frame, a studio's ground plane set askew. Every bone direction is then off by the tilt, and the
+// follower, whose features are directions in the body's heading frame, loses the dance: 3 degrees
+// cost nothing, 5 degrees up to 1.5 points, 10 degrees 30 points (clean salsa take, noise, an
+// improvisation; docs/skeleton-maps.md "Up axis"). The tilt is read from the floor the toes touch
+// (UpAxisDetection::floor_up): within 1.3 degrees of the level over every salsa take, where the
+// body's mean feet-to-head direction leans with the dancer (up to 3.4 degrees over a take, 7 over
+// the first seconds of a Bandai dance) and with a suit's calibration error in the trunk. Over at
+// least kLevelLeastSpanS of motion, a floor further than kLevelFromDeg from level is levelled.
+inline constexpr double kLevelFromDeg = 3.0;
+inline constexpr double kLevelLeastSpanS = 5.0;
+// The turn that levels a world whose up is `mean_up` (already near +Y): the shortest arc from
+// `mean_up` to +Y, about a horizontal axis, so headings are kept. Identity when `mean_up` is
+// within `from_deg` of +Y, or is not a finite non-zero vector.
+Quat levelling_rotation(const Vec3& mean_up, double from_deg = kLevelFromDeg);
+// The levelling of the world after `detection`'s axis is turned to +Y (from its floor_up):
+// identity when the axis could not be read or the detection covers less than kLevelLeastSpanS.
+Quat levelling_rotation(const UpAxisDetection& detection);
+// Degrees between `mean_up` and +Y (0 for a zero or non-finite vector).
+double tilt_from_vertical_deg(const Vec3& mean_up);
 
 // Turns the whole world of `clip` by `rotation`: the root joint's rotation and position at every
 // frame. The skeleton (rest offsets) is unchanged, so a clip turned by R and then by R^-1 is the
 // clip it was.
 void turn_world(Clip& clip, const Quat& rotation);
-// Turns a Y-up clip into the world of a file whose up axis is `up`: the inverse of the turn
-// load_motion applies (nothing for +Y). For outputs written back into a file's own world.
-void turn_to_file_world(Clip& clip, UpAxis up);
+// Turns a Y-up clip into the world of a file that load_motion turned by `file_to_y_up`
+// (LoadedMotion::file_to_y_up(): the up axis's turn and any levelling): the inverse turn, nothing
+// for the identity. For outputs written back into a file's own world.
+void turn_to_file_world(Clip& clip, const Quat& file_to_y_up);
 
 }  // namespace duet
