@@ -87,7 +87,7 @@ int run_inspect(const InspectArgs& args) {
                     {"warning", motion.units_warning}};
     doc["up_axis"] = {{"axis", std::string(up_axis_name(motion.up_axis))},
                       {"source", motion.up_source},
-                      {"levelled_by_deg", motion.tilt_deg},
+                      {"levelled_by_deg", motion.tilt_deg()},
                       {"warning", motion.up_warning}};
     if (body.valid()) {
       doc["body_m"] = {{"standing_height", body.standing_height_m},

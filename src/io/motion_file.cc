@@ -11,7 +11,6 @@
 #include "duet/io/asf_amc.h"
 #include "duet/io/bvh.h"
 #include "duet/io/points_csv.h"
-#include "duet/math/rotation.h"
 #include "duet/motion/head_hands.h"
 
 namespace duet {
@@ -154,8 +153,6 @@ Result<LoadedMotion> load_points_csv(const std::string& path, const MotionLoadOp
   return loaded;
 }
 
-double turn_angle_deg(const Quat& turn) { return rad_to_deg(log_map(turn).norm()); }
-
 // The file's up axis: given, else read from the body, and a tilted world levelled; the clip is
 // turned to Y-up.
 void decide_up_axis(const MotionLoadOptions& options, bool have_roles, LoadedMotion& loaded) {
@@ -168,9 +165,9 @@ void decide_up_axis(const MotionLoadOptions& options, bool have_roles, LoadedMot
       loaded.up_axis = detection.axis;
       loaded.up_source = "read from the body";
       loaded.level = levelling_rotation(detection);
-      if (turn_angle_deg(loaded.level) > 0.0) {
-        loaded.up_source += fmt::format("; a tilted floor, levelled by {:.1f} degrees",
-                                        turn_angle_deg(loaded.level));
+      if (loaded.tilt_deg() > 0.0) {
+        loaded.up_source +=
+            fmt::format("; a tilted floor, levelled by {:.1f} degrees", loaded.tilt_deg());
       }
     } else {
       loaded.up_source = "assumed (+Y)";
@@ -180,7 +177,6 @@ void decide_up_axis(const MotionLoadOptions& options, bool have_roles, LoadedMot
     loaded.up_source = "assumed (+Y)";
   }
   if (options.level) loaded.level = options.level->normalized();
-  loaded.tilt_deg = turn_angle_deg(loaded.level);
   const Quat turn = loaded.file_to_y_up();
   if (turn.vec().squaredNorm() > 0.0) turn_world(loaded.clip, turn);
 }

@@ -186,7 +186,7 @@ TEST(CliFollowRigs, ATiltedFloorIsLevelledAndThePartnerAnswersOnIt) {
   ASSERT_TRUE(input) << input.error().message;
   EXPECT_EQ(input.value().up_axis, UpAxis::kPosZ);
   // The tilt read from the body: 12 degrees, give or take the dancer's own mean lean (1.5).
-  EXPECT_NEAR(input.value().tilt_deg, 12.0, 3.0);
+  EXPECT_NEAR(input.value().tilt_deg(), 12.0, 3.0);
   EXPECT_NE(input.value().up_source.find("levelled by"), std::string::npos)
       << input.value().up_source;
 

@@ -183,9 +183,9 @@ Performance with_room_placement(Performance performance, double yaw_rad, const V
 Performance with_world_tilt(Performance performance, double tilt_deg);
 // What loading a file does to a full-body performance's world (load_motion: motion/up_axis.h):
 // a floor tilted more than kLevelFromDeg over at least kLevelLeastSpanS, read from the body, is
-// levelled; the recorded real
-// wrists turn with it. Returns the levelling turn (the identity when nothing was levelled, and
-// for a performance with no feet and head, as a three-point CSV has none).
+// levelled; the recorded real wrists turn with it. Returns the levelling turn (the identity when
+// nothing was levelled, and for a performance with no feet and head, as a three-point CSV has
+// none).
 Quat level_as_loaded(Performance& performance);
 
 // The same performance danced on another rig (a user's suit, avatar or another studio's skeleton):

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "duet/base/result.h"
+#include "duet/math/rotation.h"
 #include "duet/motion/body_space.h"
 #include "duet/motion/clip.h"
 #include "duet/motion/role_detection.h"
@@ -51,10 +52,11 @@ struct LoadedMotion {
   // rotation_to_y_up(up_axis) on loading, and what is written back into its world (the user's
   // own output, the partner in the user's world) is turned back.
   UpAxis up_axis = UpAxis::kPosY;
-  // A tilted world levelled after the up axis's turn (motion/up_axis.h, levelling_rotation):
-  // the turn, and the tilt it removed in degrees (0 and the identity for a level world).
+  // A tilted world levelled after the up axis's turn (motion/up_axis.h, levelling_rotation); the
+  // identity for a level world.
   Quat level = Quat::Identity();
-  double tilt_deg = 0.0;
+  // The tilt the levelling removed, degrees (0 for a level world).
+  double tilt_deg() const { return rad_to_deg(log_map(level).norm()); }
   // The whole turn applied on loading; turn_to_file_world(clip, file_to_y_up()) undoes it.
   Quat file_to_y_up() const { return (level * rotation_to_y_up(up_axis)).normalized(); }
   // How the up axis was decided: "read from the body", kUpAxisGiven, or "assumed (+Y)" when the
