@@ -155,6 +155,21 @@ void BM_SynthesisSalsa(benchmark::State& state) {
 }
 BENCHMARK(BM_SynthesisSalsa);
 
+// The same without the reach through a jump's blend (stage 5b, docs/partner.md "Reach"): what
+// the reach costs, with a jump every 100 frames.
+void BM_SynthesisSalsaNoReach(benchmark::State& state) {
+  const Scene* scene = salsa_scene();
+  if (scene == nullptr) {
+    state.SkipWithError("no salsa data in DUET_DATA_DIR");
+    return;
+  }
+  PartnerParams params;
+  params.reach_s = 0.0;
+  state.SetLabel("all but the reach, 60_01/61_01");
+  run_synthesis(state, *scene, params);
+}
+BENCHMARK(BM_SynthesisSalsaNoReach);
+
 // The same with the foot hold on (docs/partner.md, "Feet through a jump"): a jump every 100
 // frames, so feet are held or stepping in part of the frames.
 void BM_SynthesisSalsaFootHold(benchmark::State& state) {

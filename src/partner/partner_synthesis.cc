@@ -275,6 +275,7 @@ std::string PartnerParams::validate() const {
       {"ik_target_max_blend_speed_mps", ik_target_max_blend_speed_mps},
       {"ik_fade_s", ik_fade_s},
       {"ik_target_jump_speed_mps", ik_target_jump_speed_mps},
+      {"reach_s", reach_s},
       {"foot.height_margin_m", foot.height_margin_m},
       {"foot.speed_threshold_mps", foot.speed_threshold_mps},
       {"foot.max_offset_m", foot.max_offset_m},
@@ -287,6 +288,13 @@ std::string PartnerParams::validate() const {
   if (!(ik_correction_max_speed_rad_s > 0.0)) {
     return "ik_correction_max_speed_rad_s must be > 0 (infinity for no limit; got " +
            std::to_string(ik_correction_max_speed_rad_s) + ")";
+  }
+  const std::pair<const char*, double> positive[] = {
+      {"reach_fade_m", reach_fade_m}, {"reach_max_speed_rad_s", reach_max_speed_rad_s}};
+  for (const auto& [name, value] : positive) {
+    if (!(value > 0.0)) {
+      return std::string(name) + " must be > 0 (got " + std::to_string(value) + ")";
+    }
   }
   if (const std::string_view problem = user_filter.validate(); !problem.empty()) {
     return "user_filter: " + std::string(problem);
@@ -486,6 +494,8 @@ void PartnerContext::reset() noexcept {
   ik_target_offset_ = {Vec3::Zero(), Vec3::Zero()};
   ik_target_offset_velocity_ = {Vec3::Zero(), Vec3::Zero()};
   ik_target_half_life_ = {0.0, 0.0};
+  reach_ramp_ = {1.0, 1.0};
+  for (auto& arm : reach_correction_) arm.fill(Vec3::Zero());
   blend_half_life_ = 0.0;
 }
 
@@ -734,6 +744,7 @@ bool PartnerSynthesisJob::run() const noexcept {
       }
       out_r[chain.start] = ik_start;
       out_r[chain.mid] = ik_mid;
+      ctx.ik_reached_ws_[r] = reached_at;
       diagnostics.ik_weight[r] = weight;
       diagnostics.ik_target_ws[r] = target;
       diagnostics.ik_error_m[r] = (reached_at - target).norm();
@@ -785,6 +796,68 @@ bool PartnerSynthesisJob::run() const noexcept {
     const Transform root = heading * Transform{out_r[0], out_t[0]};
     out_t[0] = root.translation;
     out_r[0] = root.rotation.normalized();
+  }
+
+  // 5b. Reach (issue 11): through a jump's blend, an arm whose hand holds the user's reaches for
+  //     it rather than waiting for the blend, which carries every joint at most
+  //     blend_max_speed_rad_s and kept held hands apart for up to 0.7 s after jumps that barely
+  //     moved the partner. A second IK on the blended pose, its weight rising from 0 at the jump
+  //     over reach_s (so the arm does not snap) and falling with the distance the blend still
+  //     holds the wrist from where the contact stage put it (so it fades out with the blend).
+  //     What it adds to each arm joint changes at most reach_max_speed_rad_s, also when it ends.
+  if (p.contact && p.blend && p.reach_s > 0.0) {
+    const double rise = dt / p.reach_s;
+    const bool blending = diagnostics.blend_offset_rad > kBlendingRad ||
+                          ctx.inertializer_.max_translation_offset() > kBlendingM;
+    bool posed = false;
+    for (std::size_t r = 0; r < 2; ++r) {
+      std::array<Vec3, 2>& shown = ctx.reach_correction_[r];
+      // A jump restarts the reach; the blend's transition (from the pose shown, reach included)
+      // takes what it had added.
+      if (jumped) shown.fill(Vec3::Zero());
+      ctx.reach_ramp_[r] = jumped ? 0.0 : std::min(1.0, ctx.reach_ramp_[r] + rise);
+      const bool reaching = blending && diagnostics.ik_weight[r] > 0.0 && ctx.reach_ramp_[r] > 0.0;
+      if (!reaching && shown[0].isZero(0.0) && shown[1].isZero(0.0)) continue;
+      if (!posed) {
+        forward_kinematics(skeleton, out_t, out_r, ctx.positions_ws_, ctx.rotations_ws_);
+        posed = true;
+      }
+      const ArmRoles& arm = kArms[r];
+      const TwoBoneChain chain =
+          chain_of(roles, arm.shoulder, arm.elbow, arm.wrist, ctx.positions_ws_, ctx.rotations_ws_);
+      const std::array<std::size_t, 2> joints = {chain.start, chain.mid};
+      std::array<Quat, 2> solved = {out_r[chain.start], out_r[chain.mid]};
+      if (reaching) {
+        const Vec3& target = ctx.ik_shown_target_[r];
+        const double gap = (chain.end_ws.translation - ctx.ik_reached_ws_[r]).norm();
+        const double reach = (chain.mid_ws.translation - chain.start_ws.translation).norm() +
+                             (chain.end_ws.translation - chain.mid_ws.translation).norm();
+        const double weight =
+            smoothstep(ctx.reach_ramp_[r]) * smoothstep(std::min(1.0, gap / p.reach_fade_m));
+        // A target out of the arm's reach (the partner still crossing to its place) would only
+        // stretch the arm straight.
+        if (weight > 0.0 && (target - chain.start_ws.translation).norm() < reach) {
+          IkTwoBoneJob ik = chain_job(chain, solved[0], solved[1], target);
+          ik.weight = weight;
+          ik.start_rotation_ls_out = &solved[0];
+          ik.mid_rotation_ls_out = &solved[1];
+          if (!ik.run()) solved = {out_r[chain.start], out_r[chain.mid]};
+        }
+      }
+      for (std::size_t k = 0; k < 2; ++k) {
+        Vec3 c = log_map(out_r[joints[k]].conjugate() * solved[k]);
+        const double most = p.reach_max_speed_rad_s * dt;
+        if ((c - shown[k]).norm() > most) {
+          c = shown[k] + (c - shown[k]) * (most / (c - shown[k]).norm());
+        }
+        shown[k] = c;
+        out_r[joints[k]] = (out_r[joints[k]] * exp_map(c)).normalized();
+        ctx.blend_rotations_[joints[k]] = out_r[joints[k]];  // the pose shown
+      }
+    }
+  } else {
+    ctx.reach_ramp_ = {1.0, 1.0};
+    for (auto& arm : ctx.reach_correction_) arm.fill(Vec3::Zero());
   }
 
   // 6. Foot hold (issue 11): through a jump's blend, planted feet stay where they stand and the

@@ -606,6 +606,79 @@ TEST(PartnerSynthesis, AJumpOutOfAContactDropsTheIkAndTheBlendTakesIt) {
   }
 }
 
+TEST(PartnerSynthesis, AHeldHandReachesForTheUsersThroughAJumpsBlend) {
+  // Hands held throughout. After frame 100 the captured follower holds the same grip with another
+  // arm pose: the right shoulder turned 2.4 rad, the root moved so the wrist stays on the grip.
+  // A jump from frame 50 to 150 blends the arm and the root across; the hand leaves the grip in
+  // between unless the reach (stage 5b) keeps it there.
+  const Vec3 grip(0.0, 0.0, 0.04);
+  Duet duet(220, 0, 220, grip);
+  const std::size_t shoulder = static_cast<std::size_t>(duet.roles[Role::kRightShoulder]);
+  const std::size_t elbow = static_cast<std::size_t>(duet.roles[Role::kRightElbow]);
+  const std::size_t wrist = duet.wrist(Role::kRightWrist);
+  const Vec3 held = test::world_pose(duet.follower, 100).positions[wrist];
+  for (int f = 100; f < 220; ++f) {
+    Quat& q = duet.follower.rotations_ls(f)[shoulder];
+    q = (quat_from_axis_angle(Vec3::UnitX(), 2.4) * q).normalized();
+    duet.follower.translations_ls(f)[0] +=
+        held - test::world_pose(duet.follower, f).positions[wrist];
+  }
+  duet.rebuild();
+  const int left_right = hand_pair(Side::kLeft, Side::kRight);
+  ASSERT_TRUE(duet.model.contacts().in_contact(50, left_right));
+  ASSERT_TRUE(duet.model.contacts().in_contact(150, left_right));
+
+  struct Seen {
+    double widest_m = 0.0;       // the wrist's largest distance from the IK target after the jump
+    double mean_m = 0.0;         // and its mean over the 0.5 s after it
+    double rejoined_s = -1.0;    // from then on within 2 cm of it
+    double fastest_rad_s = 0.0;  // the shoulder's and elbow's largest angular speed
+  };
+  const auto run_with = [&](double reach_s) {
+    PartnerParams params = only(true, true, false, false, true);
+    params.reach_s = reach_s;
+    Runner run(duet.model, params);
+    Seen seen;
+    std::array<Quat, 2> previous;
+    for (int i = 0; i < 110; ++i) {
+      const int frame = i < 50 ? i : 100 + i;
+      run.step(duet.follower, frame, user_from(duet.leader, i, duet.roles), i == 50);
+      const std::array<Quat, 2> now = {run.r[shoulder], run.r[elbow]};
+      if (i > 50) {
+        for (std::size_t k = 0; k < 2; ++k) {
+          seen.fastest_rad_s =
+              std::max(seen.fastest_rad_s, now[k].angularDistance(previous[k]) / kDt);
+        }
+      }
+      previous = now;
+      if (i < 50) continue;
+      const double gap = (run.world().positions[wrist] - run.info.ik_target_ws[1]).norm();
+      seen.widest_m = std::max(seen.widest_m, gap);
+      if (i < 80) seen.mean_m += gap / 30.0;
+      if (gap > 0.02)
+        seen.rejoined_s = -1.0;
+      else if (seen.rejoined_s < 0.0)
+        seen.rejoined_s = (i - 50) * kDt;
+    }
+    EXPECT_LT(run.info.ik_error_m[1], 1e-6);  // both end on the grip
+    EXPECT_LT(run.info.blend_offset_rad, 1e-4);
+    return seen;
+  };
+  const Seen blend_only = run_with(0.0);
+  const Seen reaching = run_with(PartnerParams{}.reach_s);
+  EXPECT_GT(blend_only.widest_m, 0.1);
+  EXPECT_GT(blend_only.rejoined_s, 0.2);
+  // The reach rises over reach_s: the hand leaves the grip less (measured: 0.20 -> 0.11 m on
+  // average, 0.41 -> 0.29 m at most) and is back on it sooner.
+  EXPECT_LT(reaching.mean_m, 0.6 * blend_only.mean_m);
+  EXPECT_LT(reaching.widest_m, 0.8 * blend_only.widest_m);
+  EXPECT_LT(reaching.rejoined_s, blend_only.rejoined_s);
+  // And it adds at most its own speed limit to the arm's.
+  const PartnerParams defaults;
+  EXPECT_LE(reaching.fastest_rad_s,
+            blend_only.fastest_rad_s + defaults.reach_max_speed_rad_s + 1e-6);
+}
+
 TEST(PartnerSynthesis, ContactTargetStaysContinuousWhenTheUsersWristTeleports) {
   const Vec3 grip(0.0, 0.0, 0.04);
   Duet duet(200, 0, 200, grip);
@@ -865,6 +938,9 @@ TEST(PartnerParams, ValidateAndParse) {
   EXPECT_EQ(p.validate(), "");
   p.blend_half_life_s = -1.0;
   EXPECT_NE(p.validate().find("blend_half_life_s"), std::string::npos);
+  p = PartnerParams();
+  p.reach_fade_m = 0.0;
+  EXPECT_NE(p.validate().find("reach_fade_m"), std::string::npos);
   p = PartnerParams();
   p.foot.max_offset_m = NAN;
   EXPECT_NE(p.validate().find("foot.max_offset_m"), std::string::npos);

@@ -8,6 +8,8 @@
 //   -> contact   two-bone IK of each arm whose hand holds the user's (5.2)
 //   -> blend     inertialization of the finished pose when the follower jumped (5.3); last, so
 //                a jump's change made by any stage is blended (the IK would snap the arms)
+//   -> reach     through that blend, a held hand reaches for the user's (contact and blend)
+//   -> foothold  through that blend, planted feet held by leg IK (off by default)
 //   -> partner pose, root in the user's world frame
 //
 // Offline: PartnerModel (per duet take; may allocate and fail with a message).
@@ -205,6 +207,19 @@ struct PartnerParams {
   // tail: a 0.7 m change took 0.6 s to come within 5 cm. Measured in docs/evaluation.md
   // ("Partner steadiness").
   bool blend_speed_limited = true;
+  // blend with contact: through a jump's blend an arm whose hand holds the user's reaches for it
+  // (stage 5b) instead of waiting for the blend, which kept held hands apart for up to 0.7 s
+  // after jumps that barely moved the partner (issue 11: hands rejoined within 0.3 s). A second
+  // IK on the blended pose, its weight rising over reach_s after the jump (smoothstep) and
+  // falling as the blend's hold on the wrist (its distance from where the contact IK put it)
+  // drops below reach_fade_m; what it adds to an arm joint changes at most
+  // reach_max_speed_rad_s. reach_s = 0: off. Measured with `duet eval` (docs/evaluation.md,
+  // "Hands first after a jump"): jumps rejoined within 0.3 s 108 -> 132 of 228 over the
+  // improvised and noise-sweep cases, for a p99 largest joint speed at most 0.02x the captured
+  // partner's higher; 6 rad/s or 0.2 s rejoined no more and cost up to 0.12x.
+  double reach_s = 0.3;
+  double reach_fade_m = 0.1;
+  double reach_max_speed_rad_s = 4.0;
 
   // contact: IK target and the time the IK weight takes to go from 0 to 1 (and back) when a
   // contact starts (ends). The weight follows a smoothstep of that linear ramp.
@@ -325,6 +340,11 @@ class PartnerContext {
   std::array<Vec3, 2> ik_target_offset_velocity_{Vec3::Zero(), Vec3::Zero()};
   std::array<double, 2> ik_target_half_life_{0.0, 0.0};
   double blend_half_life_ = 0.0;  // of the current transition
+  std::array<Vec3, 2> ik_reached_ws_{Vec3::Zero(), Vec3::Zero()};  // wrist after the contact IK
+  std::array<double, 2> reach_ramp_{1.0, 1.0};  // per response hand, since the last jump
+  std::array<std::array<Vec3, 2>, 2> reach_correction_{
+      {{Vec3::Zero(), Vec3::Zero()},
+       {Vec3::Zero(), Vec3::Zero()}}};  // per hand, shoulder and elbow
 };
 
 // Per-frame diagnostics (optional output).
