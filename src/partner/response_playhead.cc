@@ -22,6 +22,7 @@ const char* PlayheadParams::validate() const noexcept {
     return "jitter_time_constant_s must be finite and > 0";
   }
   if (!(coast_after_lost_s >= 0.0)) return "coast_after_lost_s must be >= 0";
+  if (!(blend_beyond_frames >= 0.0)) return "blend_beyond_frames must be >= 0";
   return "";
 }
 

@@ -81,7 +81,13 @@ TEST(PartnerPlace, AFarMoveTheFollowerDoesNotCallAJumpRestartsThePartner) {
   PartnerPlace place;
   EXPECT_FALSE(place.next(estimate(0, 100), kDt, models, params).jumped);  // the first frame
   EXPECT_FALSE(place.next(estimate(0, 102), kDt, models, params).jumped);  // within the band
-  EXPECT_FALSE(place.next(estimate(0, 96), kDt, models, params).jumped);   // jitter back
+  EXPECT_FALSE(place.next(estimate(0, 99), kDt, models, params).jumped);   // jitter back
+  // A catch-up the follower does not call a jump (up to 2n + 6 frames) is blended, not played
+  // at 6x the tempo; at 30 Hz (two template steps a frame) the same move is 4 frames ahead: kept.
+  EXPECT_TRUE(place.next(estimate(0, 105), kDt, models, params).jumped);
+  FollowResult thirty_hz = estimate(0, 111);
+  thirty_hz.steps = 2;
+  EXPECT_FALSE(place.next(thirty_hz, 2 * kDt, models, params).jumped);
   EXPECT_TRUE(place.next(estimate(0, 300), kDt, models, params).jumped);   // far: a look-alike
   EXPECT_TRUE(place.next(estimate(1, 301), kDt, models, params).jumped);   // another take
   // No estimate: the partner stays where it was.

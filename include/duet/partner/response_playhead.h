@@ -37,6 +37,13 @@ struct PlayheadParams {
   // Shorter spells, such as the landing of a jump, are followed as they come. 0: from the first
   // lost frame; inf: never.
   double coast_after_lost_s = 0.1;
+  // A move of the estimate further than this (template frames) from where the dancer's tempo
+  // takes it, which the follower does not call a jump (a catch-up of up to 2n + 6 frames, a
+  // correction while lost or settling), restarts the playhead there with a blend (PartnerPlace)
+  // instead of being played at several times the tempo. Measured in docs/evaluation.md
+  // ("Catch-ups are blended"): 3 / 4 / 6 / 8 frames; inf: only another take and the follower's
+  // own jumps.
+  double blend_beyond_frames = 4.0;
   // Empty when valid, else which value is wrong.
   const char* validate() const noexcept;
 };
