@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "duet/math/rotation.h"
 #include "duet/motion/body_space.h"
@@ -142,6 +143,19 @@ bool legs_are_chains(const Skeleton& skeleton, const JointRoles& roles) {
 bool finite_time(double t) { return t >= 0.0 && std::isfinite(t); }
 
 double smoothstep(double x) { return x * x * (3.0 - 2.0 * x); }
+
+double horizontal_radius(const Vec3& v) { return std::hypot(v.x(), v.z()); }
+
+// A blended place passes the user no nearer than this (pelvis centres, metres) unless an end does.
+constexpr double kKeepOutM = 0.4;
+
+// The point of the segment a-b (horizontal: x and z; y of a) nearest the origin.
+Vec3 nearest_on_segment_2d(const Vec3& a, const Vec3& b) {
+  const double dx = b.x() - a.x(), dz = b.z() - a.z();
+  const double length2 = dx * dx + dz * dz;
+  const double t = length2 > 0.0 ? std::clamp(-(a.x() * dx + a.z() * dz) / length2, 0.0, 1.0) : 0.0;
+  return Vec3(a.x() + t * dx, a.y(), a.z() + t * dz);
+}
 
 // The half-life at which a critically damped offset of size x0 (decaying from rest) peaks at
 // max_speed: the peak speed is x0 * y / e with y = 2 ln 2 / half-life. At least `minimum`.
@@ -494,6 +508,8 @@ void PartnerContext::reset() noexcept {
   ik_target_offset_ = {Vec3::Zero(), Vec3::Zero()};
   ik_target_offset_velocity_ = {Vec3::Zero(), Vec3::Zero()};
   ik_target_half_life_ = {0.0, 0.0};
+  detour_hs_ = Vec3::Zero();
+  detour_offset_m_ = 0.0;
   reach_ramp_ = {1.0, 1.0};
   for (auto& arm : reach_correction_) arm.fill(Vec3::Zero());
   blend_half_life_ = 0.0;
@@ -770,7 +786,26 @@ bool PartnerSynthesisJob::run() const noexcept {
   }
   if (p.blend) {
     if (jumped && ctx.primed_) {
+      // A straight line from the place shown to the new one that passes through the user's body
+      // (pelvis centres 0.14 m apart where the captured dancers were 0.60 m apart at the
+      // closest) gets a detour: pushed sideways, away from the user, by what it lacks of
+      // kKeepOutM, most at mid-way (sin of the blend's progress), none at both ends.
+      ctx.detour_hs_ = Vec3::Zero();
+      if (p.align) {
+        const Vec3& from = ctx.blend_translations_[0];
+        const Vec3& to = out_t[0];
+        const Vec3 nearest = nearest_on_segment_2d(from, to);
+        const double lack =
+            std::min(kKeepOutM, std::min(horizontal_radius(from), horizontal_radius(to))) -
+            horizontal_radius(nearest);
+        if (lack > 0.0) {
+          Vec3 side(nearest.x(), 0.0, nearest.z());
+          if (side.norm() < 1e-3) side = Vec3(to.z() - from.z(), 0.0, from.x() - to.x());
+          if (side.norm() > 1e-9) ctx.detour_hs_ = side.normalized() * lack;
+        }
+      }
       ctx.inertializer_.transition(ctx.blend_translations_, ctx.blend_rotations_, out_t, out_r);
+      ctx.detour_offset_m_ = ctx.inertializer_.root_translation_offset();
       ctx.blend_half_life_ =
           p.blend_speed_limited
               ? p.blend_half_life_s
@@ -787,6 +822,12 @@ bool PartnerSynthesisJob::run() const noexcept {
                              p.blend_speed_limited ? p.blend_max_speed_rad_s : kNoLimit,
                              p.blend_speed_limited ? p.blend_max_root_speed_mps : kNoLimit);
     diagnostics.blend_offset_rad = ctx.inertializer_.max_rotation_offset();
+    if (!ctx.detour_hs_.isZero(0.0) && ctx.detour_offset_m_ > 0.0) {
+      const double progress = std::clamp(
+          1.0 - ctx.inertializer_.root_translation_offset() / ctx.detour_offset_m_, 0.0, 1.0);
+      out_t[0] += ctx.detour_hs_ * std::sin(std::numbers::pi * progress);
+      if (progress >= 1.0) ctx.detour_hs_ = Vec3::Zero();
+    }
   } else {
     ctx.inertializer_.reset();
   }

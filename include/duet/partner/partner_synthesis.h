@@ -340,6 +340,10 @@ class PartnerContext {
   std::array<Vec3, 2> ik_target_offset_velocity_{Vec3::Zero(), Vec3::Zero()};
   std::array<double, 2> ik_target_half_life_{0.0, 0.0};
   double blend_half_life_ = 0.0;  // of the current transition
+  // The current transition's detour round the user (heading frame; zero: none) and the root's
+  // translation offset when it started (the detour's progress is measured against it).
+  Vec3 detour_hs_ = Vec3::Zero();
+  double detour_offset_m_ = 0.0;
   std::array<Vec3, 2> ik_reached_ws_{Vec3::Zero(), Vec3::Zero()};  // wrist after the contact IK
   std::array<double, 2> reach_ramp_{1.0, 1.0};  // per response hand, since the last jump
   std::array<std::array<Vec3, 2>, 2> reach_correction_{

@@ -92,6 +92,10 @@ class PoseInertializer {
   double max_rotation_offset() const noexcept;
   // Largest remaining translation offset over all joints, metres.
   double max_translation_offset() const noexcept;
+  // The root's (joint 0) remaining translation offset, metres (0 with no joints).
+  double root_translation_offset() const noexcept {
+    return translation_x_.empty() ? 0.0 : translation_x_[0].norm();
+  }
 
  private:
   std::vector<Vec3> rotation_x_;  // offset rotation vectors (log map)
