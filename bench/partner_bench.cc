@@ -144,44 +144,37 @@ const Scene* salsa_scene() {
   return &scene;
 }
 
-void BM_SynthesisSalsa(benchmark::State& state) {
+// The live synthesis on the salsa scene with `params`; skipped without the salsa data.
+void run_salsa_synthesis(benchmark::State& state, const PartnerParams& params, const char* label) {
   const Scene* scene = salsa_scene();
   if (scene == nullptr) {
     state.SkipWithError("no salsa data in DUET_DATA_DIR");
     return;
   }
-  state.SetLabel("all, 60_01/61_01");
-  run_synthesis(state, *scene, PartnerParams{});
+  state.SetLabel(label);
+  run_synthesis(state, *scene, params);
+}
+
+void BM_SynthesisSalsa(benchmark::State& state) {
+  run_salsa_synthesis(state, PartnerParams{}, "all, 60_01/61_01");
 }
 BENCHMARK(BM_SynthesisSalsa);
 
 // The same without the reach through a jump's blend (stage 5b, docs/partner.md "Reach"): what
 // the reach costs, with a jump every 100 frames.
 void BM_SynthesisSalsaNoReach(benchmark::State& state) {
-  const Scene* scene = salsa_scene();
-  if (scene == nullptr) {
-    state.SkipWithError("no salsa data in DUET_DATA_DIR");
-    return;
-  }
   PartnerParams params;
   params.reach_s = 0.0;
-  state.SetLabel("all but the reach, 60_01/61_01");
-  run_synthesis(state, *scene, params);
+  run_salsa_synthesis(state, params, "all but the reach, 60_01/61_01");
 }
 BENCHMARK(BM_SynthesisSalsaNoReach);
 
 // The same with the foot hold on (docs/partner.md, "Feet through a jump"): a jump every 100
 // frames, so feet are held or stepping in part of the frames.
 void BM_SynthesisSalsaFootHold(benchmark::State& state) {
-  const Scene* scene = salsa_scene();
-  if (scene == nullptr) {
-    state.SkipWithError("no salsa data in DUET_DATA_DIR");
-    return;
-  }
   PartnerParams params;
   params.foot_hold.enabled = true;
-  state.SetLabel("all + foot hold, 60_01/61_01");
-  run_synthesis(state, *scene, params);
+  run_salsa_synthesis(state, params, "all + foot hold, 60_01/61_01");
 }
 BENCHMARK(BM_SynthesisSalsaFootHold);
 

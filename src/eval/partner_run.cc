@@ -58,10 +58,6 @@ void load_frame(const Performance& performance, int f, SourceFrame& frame) {
   std::ranges::copy(performance.motion.rotations_ls(f), frame.rotations_ls.begin());
 }
 
-double horizontal_distance_m(const Vec3& a, const Vec3& b) {
-  return std::hypot(a.x() - b.x(), a.z() - b.z());
-}
-
 }  // namespace
 
 std::vector<PartnerConfig> standard_partner_configs(const PartnerParams& base) {
@@ -183,9 +179,9 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
               ? body_heading_frame(out.user_positions_ws, performance.roles)
               : performance.true_headings_ws[fs];
       sampler.compute(truth.template_frame, user_heading);
-      r.spacing_error_m = std::abs(
-          horizontal_distance_m(out.partner_positions_ws[0], user_heading.translation) -
-          horizontal_distance_m(sampler.placed_positions_ws()[0], user_heading.translation));
+      r.spacing_error_m =
+          std::abs(horizontal_distance(out.partner_positions_ws[0], user_heading.translation) -
+                   horizontal_distance(sampler.placed_positions_ws()[0], user_heading.translation));
       r.joint_error_m =
           mean_joint_distance_m(out.partner_positions_ws, sampler.placed_positions_ws());
 

@@ -25,10 +25,6 @@ double smoothstep01(double x) {
   return x * x * (3.0 - 2.0 * x);
 }
 
-double horizontal_distance(const Vec3& a, const Vec3& b) {
-  return std::hypot(a.x() - b.x(), a.z() - b.z());
-}
-
 // The angle of the turn about the world vertical contained in q (its twist about Y), in
 // (-pi, pi].
 double heading_angle(const Quat& q) {

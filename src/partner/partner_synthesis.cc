@@ -144,7 +144,11 @@ bool finite_time(double t) { return t >= 0.0 && std::isfinite(t); }
 
 double smoothstep(double x) { return x * x * (3.0 - 2.0 * x); }
 
-double horizontal_radius(const Vec3& v) { return std::hypot(v.x(), v.z()); }
+// `to`, or the point `most` from `from` towards it when it is further: a step under a speed limit.
+Vec3 step_towards(const Vec3& from, const Vec3& to, double most) {
+  const double distance = (to - from).norm();
+  return distance > most ? Vec3(from + (to - from) * (most / distance)) : to;
+}
 
 // A blended place passes the user no nearer than this (pelvis centres, metres) unless an end does.
 constexpr double kKeepOutM = 0.4;
@@ -246,8 +250,8 @@ Result<PartnerModel> PartnerModel::build(const Clip& template_clip,
       const Vec3& there = positions[static_cast<std::size_t>(other) * joints + toe];
       CapturedFoot& foot = model.captured_feet_[static_cast<std::size_t>(f) * 2 + side];
       foot.height_above_ground_m = static_cast<float>(here.y() - model.ground_heights_[side]);
-      foot.speed_mps = static_cast<float>(std::hypot(here.x() - there.x(), here.z() - there.z()) *
-                                          response_clip.frame_rate());
+      foot.speed_mps =
+          static_cast<float>(horizontal_distance(here, there) * response_clip.frame_rate());
     }
   }
   return model;
@@ -745,9 +749,7 @@ bool PartnerSynthesisJob::run() const noexcept {
           Vec3 c =
               filters[k].filter(log_map(captured.conjugate() * solved), dt, p.ik_correction_filter);
           const double most = p.ik_correction_max_speed_rad_s * dt;
-          if (primed && (c - shown[k]).norm() > most) {
-            c = shown[k] + (c - shown[k]) * (most / (c - shown[k]).norm());
-          }
+          if (primed) c = step_towards(shown[k], c, most);
           shown[k] = c;
           return c;
         };
@@ -795,9 +797,9 @@ bool PartnerSynthesisJob::run() const noexcept {
         const Vec3& from = ctx.blend_translations_[0];
         const Vec3& to = out_t[0];
         const Vec3 nearest = nearest_on_segment_2d(from, to);
-        const double lack =
-            std::min(kKeepOutM, std::min(horizontal_radius(from), horizontal_radius(to))) -
-            horizontal_radius(nearest);
+        const double lack = std::min(kKeepOutM, std::min(horizontal_distance(from, Vec3::Zero()),
+                                                         horizontal_distance(to, Vec3::Zero()))) -
+                            horizontal_distance(nearest, Vec3::Zero());
         if (lack > 0.0) {
           Vec3 side(nearest.x(), 0.0, nearest.z());
           if (side.norm() < 1e-3) side = Vec3(to.z() - from.z(), 0.0, from.x() - to.x());
@@ -886,13 +888,9 @@ bool PartnerSynthesisJob::run() const noexcept {
         }
       }
       for (std::size_t k = 0; k < 2; ++k) {
-        Vec3 c = log_map(out_r[joints[k]].conjugate() * solved[k]);
-        const double most = p.reach_max_speed_rad_s * dt;
-        if ((c - shown[k]).norm() > most) {
-          c = shown[k] + (c - shown[k]) * (most / (c - shown[k]).norm());
-        }
-        shown[k] = c;
-        out_r[joints[k]] = (out_r[joints[k]] * exp_map(c)).normalized();
+        shown[k] = step_towards(shown[k], log_map(out_r[joints[k]].conjugate() * solved[k]),
+                                p.reach_max_speed_rad_s * dt);
+        out_r[joints[k]] = (out_r[joints[k]] * exp_map(shown[k])).normalized();
         ctx.blend_rotations_[joints[k]] = out_r[joints[k]];  // the pose shown
       }
     }

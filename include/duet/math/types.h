@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cmath>
 
 namespace duet {
 
@@ -24,5 +25,10 @@ struct Transform {
     return {inv, inv * -translation};
   }
 };
+
+// Distance on the floor (x and z; Y is up).
+inline double horizontal_distance(const Vec3& a, const Vec3& b) {
+  return std::hypot(a.x() - b.x(), a.z() - b.z());
+}
 
 }  // namespace duet
