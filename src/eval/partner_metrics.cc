@@ -226,9 +226,20 @@ void PartnerMetricsAccumulator::add(const Performance& performance,
                                     std::span<const PartnerFrameRecord> records) {
   assert(records.size() == performance.truth.size());
   const std::size_t n = std::min(records.size(), performance.truth.size());
+  // Frames where the captured partner keeps clear of the user, and the partner does not. A true
+  // jump's own frame is left out: the true response is cut there, the partner cannot be.
+  const auto uncrowded_truth = [&](std::size_t f) {
+    return !performance.truth[f].jump &&
+           records[f].true_user_distance_m >= options_.crowd_distance_m + options_.crowd_margin_m;
+  };
+  const auto crowded = [&](std::size_t f) {
+    return records[f].user_distance_m < options_.crowd_distance_m && uncrowded_truth(f);
+  };
   for (std::size_t f = 0; f < n; ++f) {
     const PartnerFrameRecord& r = records[f];
     ++frames_;
+    if (uncrowded_truth(f)) closest_m_ = std::min(closest_m_, r.user_distance_m);
+    crowded_frames_ += crowded(f) ? 1 : 0;
     joint_error_sum_m_ += r.joint_error_m;
     step_us_sum_ += r.step_us;
     for (int pair = 0; pair < kHandPairCount; ++pair) {
@@ -284,6 +295,7 @@ void PartnerMetricsAccumulator::add(const Performance& performance,
     const double t0 = performance.times_s[j];
     double rejoin = std::numeric_limits<double>::infinity();
     double spacing = -1.0, slide = 0.0;
+    bool crowd = false;
     for (std::size_t f = j; f < n && performance.times_s[f] < t0 + options_.rejoin_search_s; ++f) {
       const double t = performance.times_s[f] - t0;
       if (!std::isfinite(rejoin) && rejoined_from(f)) rejoin = t;
@@ -293,11 +305,13 @@ void PartnerMetricsAccumulator::add(const Performance& performance,
       if (f > j && t < options_.post_jump_window_s) {
         slide = std::max(slide, records[f].planted_slide_mps);
       }
+      if (t < options_.post_jump_window_s) crowd = crowd || crowded(f);
     }
     jump_rejoin_s_.push_back(rejoin);
     // A performance that ends first: the last frame's spacing.
     jump_spacing_m_.push_back(spacing >= 0.0 ? spacing : records[n - 1].spacing_error_m);
     jump_slide_mps_.push_back(slide);
+    jumps_crowded_ += crowd ? 1 : 0;
   }
 }
 
@@ -350,6 +364,9 @@ void PartnerMetricsAccumulator::merge(const PartnerMetricsAccumulator& other) {
                          other.jump_slide_mps_.end());
   max_slide_mps_ = std::max(max_slide_mps_, other.max_slide_mps_);
   sliding_frames_ += other.sliding_frames_;
+  crowded_frames_ += other.crowded_frames_;
+  jumps_crowded_ += other.jumps_crowded_;
+  closest_m_ = std::min(closest_m_, other.closest_m_);
   add_reference(other.reference_);
 }
 
@@ -434,6 +451,9 @@ PartnerMetrics PartnerMetricsAccumulator::summary() const {
   }
   m.max_slide_mps = max_slide_mps_;
   m.sliding_frames = sliding_frames_;
+  m.crowded_frames = crowded_frames_;
+  m.jumps_crowded = jumps_crowded_;
+  m.closest_cm = std::isfinite(closest_m_) ? 100.0 * closest_m_ : -1.0;
   return m;
 }
 

@@ -179,9 +179,11 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
               ? body_heading_frame(out.user_positions_ws, performance.roles)
               : performance.true_headings_ws[fs];
       sampler.compute(truth.template_frame, user_heading);
-      r.spacing_error_m =
-          std::abs(horizontal_distance(out.partner_positions_ws[0], user_heading.translation) -
-                   horizontal_distance(sampler.placed_positions_ws()[0], user_heading.translation));
+      r.user_distance_m =
+          horizontal_distance(out.partner_positions_ws[0], user_heading.translation);
+      r.true_user_distance_m =
+          horizontal_distance(sampler.placed_positions_ws()[0], user_heading.translation);
+      r.spacing_error_m = std::abs(r.user_distance_m - r.true_user_distance_m);
       r.joint_error_m =
           mean_joint_distance_m(out.partner_positions_ws, sampler.placed_positions_ws());
 

@@ -103,14 +103,15 @@ void append_steadiness_table(std::string& out, const EvalReport& report) {
   out += "\npartner steadiness and transitions after jumps (issue 11; docs/evaluation.md):\n";
   constexpr const char* kHeader =
       "{:<18} {:<12} {:>8} {:>8} {:>6} {:>6} {:>8} {:>8} {:>7} {:>8} {:>8} {:>7} {:>8} {:>8} "
-      "{:>8} {:>6} {:>8} {:>7}\n";
+      "{:>8} {:>6} {:>8} {:>7} {:>7} {:>7} {:>7}\n";
   fmt::format_to(std::back_inserter(out), kHeader, "case", "corrections", "speed", "captured",
                  "ratio", "x true", "hand med", "sensed", ">win99", "rejoin", "rejoin", "in time",
-                 "spacing", "spacing", "slide", ">limit", "slide", ">limit");
+                 "spacing", "spacing", "slide", ">limit", "slide", ">limit", "crowded", "closest",
+                 "crowded");
   fmt::format_to(std::back_inserter(out), kHeader, "", "",
                  fmt::format("p{:g}", 100.0 * o.reference_percentile), "deg/s", "", "", "cm", "cm",
                  "jumps", "med s", "max s", "jumps", "med cm", "max cm", "jump m/s", "jumps",
-                 "all m/s", "frames");
+                 "all m/s", "frames", "jumps", "cm", "frames");
   for (const PartnerRow& row : report.partner_rows) {
     const PartnerMetrics& m = row.metrics;
     const bool hands = row.aligned && m.hand_samples > 0;
@@ -133,7 +134,10 @@ void append_steadiness_table(std::string& out, const EvalReport& report) {
         partner_cell(placed, m.max_spacing_error_cm, 1),
         partner_cell(jumps, m.max_jump_slide_mps, 2),
         jumps ? fmt::format("{}/{}", m.jumps_sliding, m.jumps) : "-",
-        fmt::format("{:.2f}", m.max_slide_mps), m.sliding_frames);
+        fmt::format("{:.2f}", m.max_slide_mps), m.sliding_frames,
+        placed ? fmt::format("{}/{}", m.jumps_crowded, m.jumps) : "-",
+        partner_cell(row.aligned && m.closest_cm >= 0.0, m.closest_cm, 0),
+        row.aligned ? fmt::format("{}", m.crowded_frames) : "-");
   }
   out += "\ncolumns:\n";
   const auto line = [&out](std::string_view name, const std::string& text) {
@@ -164,6 +168,14 @@ void append_steadiness_table(std::string& out, const EvalReport& report) {
                    "after a jump (largest over jumps; >limit: jumps above {:g} m/s), and over "
                    "every frame (>limit: frames above it)",
                    o.post_jump_window_s, o.slide_limit_mps));
+  line("crowded, closest",
+       fmt::format(
+           "frames where the partner's pelvis is within {:g} cm of the user's (horizontally) "
+           "while the true response's is at least {:g} cm away: jumps with such a frame "
+           "in their {:g} s window, and all such frames; closest: the partner's smallest "
+           "distance to the user where the true response keeps that {:g} cm",
+           100.0 * o.crowd_distance_m, 100.0 * (o.crowd_distance_m + o.crowd_margin_m),
+           o.post_jump_window_s, 100.0 * (o.crowd_distance_m + o.crowd_margin_m)));
 }
 
 // The partner section of the table: one line per case x configuration, then per case the captured
@@ -236,7 +248,7 @@ void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::
                  "{},{},{},{},{},{},{:.4f},{},{:.4f},{:.4f},{:.5f},{:.5f},{:.3f},{:.3f},{},{:.2f},"
                  "{:.2f},{},"
                  "{:.2f},{},{:.2f},{:.5f},{:.3f},{:.2f},{:.2f},{},{},{:.2f},{:.2f},{:.2f},{:.2f},"
-                 "{:.3f},{:.3f},{},{:.2f},{:.2f},{:.3f},{},{:.3f},{},{:.4f},{:.2f}\n",
+                 "{:.3f},{:.3f},{},{:.2f},{:.2f},{:.3f},{},{:.3f},{},{:.4f},{:.2f},{},{},{:.1f}\n",
                  row.case_name, row.config, take, take_name, row.aligned ? 1 : 0, m.frames,
                  m.mean_joint_error_cm, m.hand_samples, m.median_hand_error_cm,
                  m.mean_hand_error_cm, m.slip_rate, m.captured_slip_rate, m.ground_speed_cm_s,
@@ -249,7 +261,8 @@ void append_partner_csv_row(std::string& out, const PartnerRow& row, const std::
                  m.captured_frame_speed_deg_s, m.median_rejoin_s, m.max_rejoin_s,
                  m.jumps_rejoined_in_time, m.median_spacing_error_cm, m.max_spacing_error_cm,
                  m.max_jump_slide_mps, m.jumps_sliding, m.max_slide_mps, m.sliding_frames,
-                 m.median_sensed_hand_error_cm, m.true_frame_speed_deg_s);
+                 m.median_sensed_hand_error_cm, m.true_frame_speed_deg_s, m.jumps_crowded,
+                 m.crowded_frames, m.closest_cm);
 }
 
 // reliability.dat and its plot: per case, the 10 confidence bins of the first tracker (hmm when
@@ -314,7 +327,7 @@ std::string format_partner_csv(const EvalReport& report) {
       "true_mean_jerk_mps3,frame_speed_deg_s,captured_frame_speed_deg_s,median_rejoin_s,"
       "max_rejoin_s,jumps_rejoined_in_time,median_spacing_error_cm,max_spacing_error_cm,"
       "max_jump_slide_mps,jumps_sliding,max_slide_mps,sliding_frames,median_sensed_hand_error_cm,"
-      "true_frame_speed_deg_s\n";
+      "true_frame_speed_deg_s,jumps_crowded,crowded_frames,closest_cm\n";
   for (const PartnerRow& row : report.partner_rows) {
     for (const auto& [take, metrics] : row.per_take) {
       append_partner_csv_row(out, row, std::to_string(take), take_name(report, take), metrics);

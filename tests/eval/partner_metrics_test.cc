@@ -315,6 +315,46 @@ TEST(PartnerMetricsAccumulator, SteadinessAndTheTransitionAfterAJump) {
   EXPECT_NEAR(m2.median_rejoin_s, 0.35, 1e-9);
 }
 
+TEST(PartnerMetricsAccumulator, CrowdingCountsOnlyWhereTheCaptureKeptClear) {
+  // 20 frames at 10 Hz, a true jump at frame 5 (window: frames 5-9). The captured partner keeps
+  // 0.6 m from the user, except at frames 15-16 where it comes to 0.2 m itself.
+  Performance performance;
+  for (int f = 0; f < 20; ++f) {
+    performance.times_s.push_back(0.1 * f);
+    performance.truth.push_back({0, static_cast<double>(f), false, f == 5});
+  }
+  std::vector<PartnerFrameRecord> records(20);
+  for (int f = 0; f < 20; ++f) {
+    PartnerFrameRecord& r = records[static_cast<std::size_t>(f)];
+    r.true_user_distance_m = f == 15 || f == 16 ? 0.2 : 0.6;
+    r.user_distance_m = r.true_user_distance_m;
+  }
+  records[5].user_distance_m = 0.10;   // the jump's own frame: the old place, not counted
+  records[7].user_distance_m = 0.12;   // the blend carries the partner through the user
+  records[12].user_distance_m = 0.25;  // too close, outside the jump's window
+  records[13].user_distance_m = 0.35;  // closer than captured, but not within 0.3 m
+  records[15].user_distance_m = 0.05;  // where the capture itself is close: not counted
+  PartnerMetricsAccumulator accumulator;
+  accumulator.add(performance, records);
+  const PartnerMetrics m = accumulator.summary();
+  EXPECT_EQ(m.crowded_frames, 2);  // frames 7 and 12
+  EXPECT_EQ(m.jumps_crowded, 1);
+  EXPECT_NEAR(m.closest_cm, 12.0, 1e-9);
+
+  // No frame too close: nothing counted, the closest is the nearest clear frame.
+  records[7].user_distance_m = 0.6;
+  records[12].user_distance_m = 0.6;
+  PartnerMetricsAccumulator clear;
+  clear.add(performance, records);
+  EXPECT_EQ(clear.summary().crowded_frames, 0);
+  EXPECT_EQ(clear.summary().jumps_crowded, 0);
+  EXPECT_NEAR(clear.summary().closest_cm, 35.0, 1e-9);
+  // Merging keeps the smaller closest and adds the counts.
+  clear.merge(accumulator);
+  EXPECT_EQ(clear.summary().crowded_frames, 2);
+  EXPECT_NEAR(clear.summary().closest_cm, 12.0, 1e-9);
+}
+
 // The whole run on a real take: the user dances 60_10 exactly, so the true response is the
 // captured follower placed relative to the user and the raw pose (align only) matches it.
 // The duet of take 60_10 alone, with the given input points.

@@ -21,13 +21,17 @@
 //                 reach the partner's joints);
 //   after a jump  the time until the hands are rejoined and the spacing is the captured one
 //                 again, the spacing error a fixed time after the jump, and the speed of planted
-//                 feet in the window after the jump.
+//                 feet in the window after the jump;
+//   crowding      frames where the partner's pelvis comes within crowd_distance_m of the user's
+//                 while the captured partner's keeps crowd_distance_m + crowd_margin_m away (the
+//                 partner walks into the user), and the closest it comes there.
 //
 // Offline code: allocates freely (it is not on the live path; the synthesis it measures is).
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -63,6 +67,12 @@ struct PartnerMetricsOptions {
   // is near the ground; it slides when the partner's toe moves faster than slide_limit_mps.
   double planted_speed_mps = 0.3;
   double slide_limit_mps = 0.3;
+  // Too close: the partner's pelvis within crowd_distance_m of the user's (horizontally) at a
+  // frame where the true response's is at least crowd_distance_m + crowd_margin_m from it. Salsa
+  // partners come that close only where the capture does (a blend that carried the partner
+  // through the user came within 0.12 m: docs/evaluation.md, "Round the user").
+  double crowd_distance_m = 0.3;
+  double crowd_margin_m = 0.1;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -181,6 +191,9 @@ struct PartnerFrameRecord {
   // Largest horizontal speed of a partner toe on a planted foot since the previous frame (see
   // PartnerMetricsOptions), m/s; -1 when no foot is planted.
   double planted_slide_mps = -1.0;
+  // Horizontal pelvis-to-user-root distance of the partner and of the true response, metres.
+  double user_distance_m = 0.0;
+  double true_user_distance_m = 0.0;
 };
 
 // The captured response of the takes a performance was made from, at the take's own rate: the
@@ -265,6 +278,12 @@ struct PartnerMetrics {
   long long jumps_sliding = 0;
   double max_slide_mps = 0.0;
   long long sliding_frames = 0;  // frames with a planted foot above slide_limit_mps
+  // Crowding (PartnerMetricsOptions::crowd_distance_m): frames too close, the jumps with such a
+  // frame in their window, and the partner's smallest distance to the user (cm) over the frames
+  // where the true response keeps crowd_distance_m + crowd_margin_m away (-1: no such frame).
+  long long crowded_frames = 0;
+  long long jumps_crowded = 0;
+  double closest_cm = -1.0;
 };
 
 // Pools the records of performances (frames and jumps weigh equally across performances) and
@@ -298,6 +317,8 @@ class PartnerMetricsAccumulator {
   std::vector<double> jump_slide_mps_;        // per jump, largest planted slide in the window
   double max_slide_mps_ = 0.0;
   long long sliding_frames_ = 0;
+  long long crowded_frames_ = 0, jumps_crowded_ = 0;
+  double closest_m_ = std::numeric_limits<double>::infinity();  // see PartnerMetrics::closest_cm
   CapturedReference reference_;
 };
 
