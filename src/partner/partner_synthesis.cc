@@ -152,13 +152,22 @@ Vec3 step_towards(const Vec3& from, const Vec3& to, double most) {
 
 // A blended place passes the user no nearer than this (pelvis centres, metres) unless an end does.
 constexpr double kKeepOutM = 0.4;
+// The detour is fullest where the line passes nearest, but within this part of the blend, so that
+// it never swings out within a few frames of either end.
+constexpr double kDetourPeakRange[2] = {0.2, 0.8};
 
-// The point of the segment a-b (horizontal: x and z; y of a) nearest the origin.
-Vec3 nearest_on_segment_2d(const Vec3& a, const Vec3& b) {
+// Where on the segment a-b (horizontal: x and z) the point nearest the origin lies: 0 at a, 1 at b.
+double nearest_along_segment_2d(const Vec3& a, const Vec3& b) {
   const double dx = b.x() - a.x(), dz = b.z() - a.z();
   const double length2 = dx * dx + dz * dz;
-  const double t = length2 > 0.0 ? std::clamp(-(a.x() * dx + a.z() * dz) / length2, 0.0, 1.0) : 0.0;
-  return Vec3(a.x() + t * dx, a.y(), a.z() + t * dz);
+  return length2 > 0.0 ? std::clamp(-(a.x() * dx + a.z() * dz) / length2, 0.0, 1.0) : 0.0;
+}
+
+// The detour's share at a blend's progress p (0 at the start, 1 at the end): 1 at `peak`, where
+// the straight line passes nearest the user, 0 at both ends, a quarter sine on either side.
+double detour_share(double p, double peak) {
+  constexpr double kQuarter = std::numbers::pi / 2.0;
+  return p <= peak ? std::sin(kQuarter * p / peak) : std::sin(kQuarter * (1.0 - p) / (1.0 - peak));
 }
 
 // The half-life at which a critically damped offset of size x0 (decaying from rest) peaks at
@@ -514,6 +523,7 @@ void PartnerContext::reset() noexcept {
   ik_target_half_life_ = {0.0, 0.0};
   detour_hs_ = Vec3::Zero();
   detour_offset_m_ = 0.0;
+  detour_peak_ = 0.5;
   reach_ramp_ = {1.0, 1.0};
   for (auto& arm : reach_correction_) arm.fill(Vec3::Zero());
   blend_half_life_ = 0.0;
@@ -791,12 +801,13 @@ bool PartnerSynthesisJob::run() const noexcept {
       // A straight line from the place shown to the new one that passes through the user's body
       // (pelvis centres 0.14 m apart where the captured dancers were 0.60 m apart at the
       // closest) gets a detour: pushed sideways, away from the user, by what it lacks of
-      // kKeepOutM, most at mid-way (sin of the blend's progress), none at both ends.
+      // kKeepOutM, fullest where the line passes nearest (detour_share), none at both ends.
       ctx.detour_hs_ = Vec3::Zero();
       if (p.align) {
         const Vec3& from = ctx.blend_translations_[0];
         const Vec3& to = out_t[0];
-        const Vec3 nearest = nearest_on_segment_2d(from, to);
+        const double along = nearest_along_segment_2d(from, to);
+        const Vec3 nearest = from + along * (to - from);
         const double lack = std::min(kKeepOutM, std::min(horizontal_distance(from, Vec3::Zero()),
                                                          horizontal_distance(to, Vec3::Zero()))) -
                             horizontal_distance(nearest, Vec3::Zero());
@@ -804,6 +815,7 @@ bool PartnerSynthesisJob::run() const noexcept {
           Vec3 side(nearest.x(), 0.0, nearest.z());
           if (side.norm() < 1e-3) side = Vec3(to.z() - from.z(), 0.0, from.x() - to.x());
           if (side.norm() > 1e-9) ctx.detour_hs_ = side.normalized() * lack;
+          ctx.detour_peak_ = std::clamp(along, kDetourPeakRange[0], kDetourPeakRange[1]);
         }
       }
       ctx.inertializer_.transition(ctx.blend_translations_, ctx.blend_rotations_, out_t, out_r);
@@ -827,7 +839,7 @@ bool PartnerSynthesisJob::run() const noexcept {
     if (!ctx.detour_hs_.isZero(0.0) && ctx.detour_offset_m_ > 0.0) {
       const double progress = std::clamp(
           1.0 - ctx.inertializer_.root_translation_offset() / ctx.detour_offset_m_, 0.0, 1.0);
-      out_t[0] += ctx.detour_hs_ * std::sin(std::numbers::pi * progress);
+      out_t[0] += ctx.detour_hs_ * detour_share(progress, ctx.detour_peak_);
       if (progress >= 1.0) ctx.detour_hs_ = Vec3::Zero();
     }
   } else {

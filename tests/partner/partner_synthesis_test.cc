@@ -517,40 +517,47 @@ TEST(PartnerSynthesis, BlendHidesAJump) {
 }
 
 TEST(PartnerSynthesis, ABlendedPlaceDoesNotPassThroughTheUser) {
-  // The follower stands 2 m to the leader's left until frame 100 and as far to his right after:
-  // a jump from frame 50 to 150 changes its place across the user. A straight line in the user's
-  // heading frame would pass through the user's body; the blend takes a detour.
-  Duet duet(300, 0, 0);
-  const UserPose user = user_from(duet.leader, 0, duet.roles);
-  ASSERT_TRUE(user.body_heading_valid);
-  const Vec3 centre = user.body_heading.translation;
-  for (int f = 100; f < 300; ++f) {
-    Vec3& root = duet.follower.translations_ls(f)[0];
-    root.x() = 2.0 * centre.x() - root.x();
-  }
-  duet.rebuild();
-  const auto distance = [&](const Vec3& p) {
-    return std::hypot(p.x() - centre.x(), p.z() - centre.z());
-  };
-  Runner run(duet.model, only(true, false, false, false, true));
-  double closest = std::numeric_limits<double>::infinity(), fastest = 0.0;
-  Vec3 before = Vec3::Zero(), after = Vec3::Zero();
-  for (int i = 0; i < 190; ++i) {
-    const int frame = i < 50 ? i : 100 + i;
-    run.step(duet.follower, frame, user, i == 50);
-    if (i == 49) before = run.t[0];
-    if (i >= 50) {
-      closest = std::min(closest, distance(run.t[0]));
-      fastest = std::max(fastest, (run.t[0] - after).norm() / kDt);
+  // The follower stands 2 m to the leader's left until frame 100 and to his right after (2 m, or
+  // 0.6 m: the straight line then passes through the user three quarters of the way): a jump from
+  // frame 50 to 150 changes its place across the user. A straight line in the user's heading
+  // frame would pass through the user's body; the blend takes a detour.
+  for (const double right_m : {2.0, 0.6}) {
+    SCOPED_TRACE(right_m);
+    Duet duet(300, 0, 0);
+    const UserPose user = user_from(duet.leader, 0, duet.roles);
+    ASSERT_TRUE(user.body_heading_valid);
+    const Vec3 centre = user.body_heading.translation;
+    for (int f = 100; f < 300; ++f) {
+      Vec3& root = duet.follower.translations_ls(f)[0];
+      root.x() = centre.x() - (right_m / 2.0) * (root.x() - centre.x());
     }
-    after = run.t[0];
+    duet.rebuild();
+    const auto distance = [&](const Vec3& p) {
+      return std::hypot(p.x() - centre.x(), p.z() - centre.z());
+    };
+    Runner run(duet.model, only(true, false, false, false, true));
+    double closest = std::numeric_limits<double>::infinity(), fastest = 0.0;
+    Vec3 before = Vec3::Zero(), after = Vec3::Zero();
+    for (int i = 0; i < 190; ++i) {
+      const int frame = i < 50 ? i : 100 + i;
+      run.step(duet.follower, frame, user, i == 50);
+      if (i == 49) before = run.t[0];
+      if (i >= 50) {
+        closest = std::min(closest, distance(run.t[0]));
+        fastest = std::max(fastest, (run.t[0] - after).norm() / kDt);
+      }
+      after = run.t[0];
+    }
+    ASSERT_GT(distance(before), 1.5);
+    ASSERT_GT(distance(after), 0.9 * right_m);
+    // Where the straight line passes the user: in the user's body.
+    const double along = distance(before) / (distance(before) + distance(after));
+    EXPECT_LT(distance(before + along * (after - before)), 0.3);
+    EXPECT_GT(closest, 0.38);  // the detour keeps 0.4 m, also off mid-way
+    // The detour adds to the root's speed cap, but not by much.
+    EXPECT_LE(fastest, 1.5 * PartnerParams{}.blend_max_root_speed_mps);
+    EXPECT_LT((after - duet.follower.translations_ls(289)[0]).norm(), 0.01);  // and it arrives
   }
-  ASSERT_GT(std::min(distance(before), distance(after)), 1.5);
-  EXPECT_LT(distance(0.5 * (before + after)), 0.3);  // the straight line's midpoint: in the user
-  EXPECT_GT(closest, 0.38);                          // the detour keeps 0.4 m
-  // The detour adds to the root's speed cap, but not by much.
-  EXPECT_LE(fastest, 1.5 * PartnerParams{}.blend_max_root_speed_mps);
-  EXPECT_LT((after - duet.follower.translations_ls(289)[0]).norm(), 0.01);  // and it arrives
 }
 
 TEST(PartnerSynthesis, BlendTurnsNoJointFasterThanItsCap) {

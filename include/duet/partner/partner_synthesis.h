@@ -344,6 +344,7 @@ class PartnerContext {
   // translation offset when it started (the detour's progress is measured against it).
   Vec3 detour_hs_ = Vec3::Zero();
   double detour_offset_m_ = 0.0;
+  double detour_peak_ = 0.5;  // the blend's progress at which the detour is fullest
   std::array<Vec3, 2> ik_reached_ws_{Vec3::Zero(), Vec3::Zero()};  // wrist after the contact IK
   std::array<double, 2> reach_ramp_{1.0, 1.0};  // per response hand, since the last jump
   std::array<std::array<Vec3, 2>, 2> reach_correction_{
