@@ -94,6 +94,7 @@ void run_synthesis(benchmark::State& state, const Scene& scene, const PartnerPar
     job.model = &model.value();
     job.params = &params;
     job.frame = frame;
+    job.frame_position = frame;  // the playhead's real frame, as LiveLoop passes it
     job.jumped = i % 100 == 0;
     job.dt_s = 1.0 / 60;
     job.translations_ls = scene.follower.translations_ls(frame);
@@ -168,6 +169,15 @@ void BM_SynthesisSalsaNoReach(benchmark::State& state) {
   run_salsa_synthesis(state, params, "all but the reach, 60_01/61_01");
 }
 BENCHMARK(BM_SynthesisSalsaNoReach);
+
+// The same with the facing filtered as it is, not relative to the template's
+// (PartnerParams::smooth_facing_offset): what filtering it relative to the template costs.
+void BM_SynthesisSalsaPlainFacing(benchmark::State& state) {
+  PartnerParams params;
+  params.smooth_facing_offset = false;
+  run_salsa_synthesis(state, params, "all, the facing filtered as it is, 60_01/61_01");
+}
+BENCHMARK(BM_SynthesisSalsaPlainFacing);
 
 // The same with the foot hold on (docs/partner.md, "Feet through a jump"): a jump every 100
 // frames, so feet are held or stepping in part of the frames.

@@ -37,7 +37,8 @@ namespace {
 // way that frame is taken (`template_frame(f)`).
 template <typename TemplateFrame>
 Result<std::vector<RootPlacement>> placements(const Clip& template_clip, const Clip& response_clip,
-                                              TemplateFrame template_frame) {
+                                              TemplateFrame template_frame,
+                                              std::vector<Transform>& template_headings) {
   if (template_clip.frame_count() != response_clip.frame_count()) {
     return Error{"spatial alignment: the template has " +
                  std::to_string(template_clip.frame_count()) + " frames, the response " +
@@ -48,8 +49,10 @@ Result<std::vector<RootPlacement>> placements(const Clip& template_clip, const C
     return Error{"spatial alignment: the duet has no frames or no joints"};
   }
   std::vector<RootPlacement> out(static_cast<std::size_t>(template_clip.frame_count()));
+  template_headings.assign(out.size(), Transform{});
   for (int f = 0; f < template_clip.frame_count(); ++f) {
     const Transform tmpl = template_frame(f);
+    template_headings[static_cast<std::size_t>(f)] = tmpl;
     const Transform resp{response_clip.rotations_ls(f)[0], response_clip.translations_ls(f)[0]};
     const Transform rel = tmpl.inverse() * resp;
     if (!rel.translation.allFinite() || !rel.rotation.coeffs().allFinite()) {
@@ -65,12 +68,14 @@ Result<std::vector<RootPlacement>> placements(const Clip& template_clip, const C
 
 Result<SpatialAlignment> SpatialAlignment::build(const Clip& template_clip,
                                                  const Clip& response_clip) {
-  Result<std::vector<RootPlacement>> made =
-      placements(template_clip, response_clip, [&](int f) {
-        return heading_frame(template_clip.translations_ls(f)[0], template_clip.rotations_ls(f)[0]);
-      });
-  if (!made) return made.error();
   SpatialAlignment alignment;
+  Result<std::vector<RootPlacement>> made = placements(
+      template_clip, response_clip,
+      [&](int f) {
+        return heading_frame(template_clip.translations_ls(f)[0], template_clip.rotations_ls(f)[0]);
+      },
+      alignment.template_headings_);
+  if (!made) return made.error();
   alignment.placements_ = std::move(made).value();
   return alignment;
 }
@@ -86,14 +91,16 @@ Result<SpatialAlignment> SpatialAlignment::build(const Clip& template_clip,
   }
   const std::vector<Vec3> positions = world_positions(template_clip);
   const auto n = static_cast<std::size_t>(template_clip.joint_count());
-  Result<std::vector<RootPlacement>> made =
-      placements(template_clip, response_clip, [&](int f) {
+  SpatialAlignment alignment;
+  Result<std::vector<RootPlacement>> made = placements(
+      template_clip, response_clip,
+      [&](int f) {
         return body_heading_frame(
             std::span<const Vec3>(positions.data() + static_cast<std::size_t>(f) * n, n),
             template_roles);
-      });
+      },
+      alignment.template_headings_);
   if (!made) return made.error();
-  SpatialAlignment alignment;
   alignment.placements_ = std::move(made).value();
   return alignment;
 }
@@ -111,6 +118,14 @@ RootPlacement SpatialAlignment::placement_at(double frame) const noexcept {
   placement.position_hs = (1.0 - w) * p0.position_hs + w * p1.position_hs;
   placement.rotation_hs = p0.rotation_hs.slerp(w, p1.rotation_hs).normalized();
   return placement;
+}
+
+Transform SpatialAlignment::template_heading_at(double frame) const noexcept {
+  const auto [f0, f1, w] = bracket_frame(frame, static_cast<int>(template_headings_.size()));
+  const Transform& h0 = template_headings_[static_cast<std::size_t>(f0)];
+  const Transform& h1 = template_headings_[static_cast<std::size_t>(f1)];
+  return {h0.rotation.slerp(w, h1.rotation).normalized(),
+          (1.0 - w) * h0.translation + w * h1.translation};
 }
 
 }  // namespace duet

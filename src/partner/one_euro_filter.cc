@@ -39,4 +39,9 @@ Vec3 OneEuroFilter3::filter(const Vec3& sample, double dt_s, const OneEuroParams
   return value_;
 }
 
+void OneEuroFilter3::rebase(const Quat& rotation, const Vec3& translation) noexcept {
+  value_ = rotation * value_ + translation;
+  speed_ = rotation * speed_;
+}
+
 }  // namespace duet

@@ -524,6 +524,7 @@ void PartnerContext::reset() noexcept {
   detour_hs_ = Vec3::Zero();
   detour_offset_m_ = 0.0;
   detour_peak_ = 0.5;
+  facing_is_offset_ = false;
   reach_ramp_ = {1.0, 1.0};
   for (auto& arm : reach_correction_) arm.fill(Vec3::Zero());
   blend_half_life_ = 0.0;
@@ -573,7 +574,11 @@ bool PartnerSynthesisJob::run() const noexcept {
     std::copy(rotations_ls.begin(), rotations_ls.end(), out_r.begin());
   }
 
-  // 0. The user's heading frame, through the 1-euro filter when smoothing.
+  // 0. The user's heading frame, through the 1-euro filter when smoothing. With
+  //    smooth_facing_offset the facing filtered is the user's facing relative to the template's
+  //    at the partner's frame (still while the user dances the template, turns and all), turned
+  //    back by the template's afterwards: the filter's lag then falls on the noise and on the
+  //    user's departures from the template, not on the dance's own turns.
   const bool user_root_finite = user != nullptr && user->root_position_ws.allFinite() &&
                                 user->root_rotation_ws.coeffs().allFinite() &&
                                 user->root_rotation_ws.norm() > 0.0;
@@ -583,7 +588,24 @@ bool PartnerSynthesisJob::run() const noexcept {
                        ? user->body_heading
                        : heading_frame(user->root_position_ws, user->root_rotation_ws.normalized());
     if (p.smooth) {
-      const Vec3 facing = user_heading.rotation * Vec3::UnitZ();
+      const bool by_offset = p.smooth_facing_offset && p.align && has_position;
+      Quat template_rotation = Quat::Identity();
+      if (by_offset) {
+        template_rotation = model->alignment().template_heading_at(frame_position).rotation;
+        if (!ctx.facing_is_offset_) {
+          ctx.user_facing_filter_.reset();
+        } else if (jumped) {
+          // The offset jumps with the template's heading; the facing shown must not: the filter
+          // continues from the facing it showed (offset * old = offset * d * new).
+          ctx.user_facing_filter_.rebase(ctx.template_rotation_ * template_rotation.conjugate(),
+                                         Vec3::Zero());
+        }
+        ctx.template_rotation_ = template_rotation;
+      } else if (ctx.facing_is_offset_) {
+        ctx.user_facing_filter_.reset();
+      }
+      ctx.facing_is_offset_ = by_offset;
+      const Vec3 facing = user_heading.rotation * template_rotation.conjugate() * Vec3::UnitZ();
       OneEuroParams facing_filter = p.user_filter;
       if (p.user_facing_jitter_reference_rad > 0.0) {
         const double jitter = ctx.facing_jitter(facing, dt);
@@ -594,14 +616,16 @@ bool PartnerSynthesisJob::run() const noexcept {
       const Vec3 smooth_position =
           ctx.user_root_filter_.filter(user_heading.translation, dt, p.user_filter);
       if (smooth_facing.norm() > 1e-6) {
-        user_heading = {yaw_rotation(std::atan2(smooth_facing.x(), smooth_facing.z())),
-                        smooth_position};
+        user_heading = {
+            yaw_rotation(std::atan2(smooth_facing.x(), smooth_facing.z())) * template_rotation,
+            smooth_position};
       }
     }
   }
   if (!p.smooth) {
     ctx.user_root_filter_.reset();
     ctx.user_facing_filter_.reset();
+    ctx.facing_is_offset_ = false;
   }
 
   // 1. Align (5.1): the root relative to the user's heading frame.

@@ -49,6 +49,17 @@ TEST(SpatialAlignment, StoresTheResponseRootInTheTemplateHeadingFrame) {
   EXPECT_NEAR(alignment.value().placement_at(-3.0).position_hs.y(), 0.97, 1e-12);
   EXPECT_NEAR(alignment.value().placement_at(9.0).position_hs.y(), 0.99, 1e-12);
   EXPECT_NEAR(alignment.value().placement_at(std::nan("")).position_hs.y(), 0.97, 1e-12);
+  // The template's own heading frame, what the placements are relative to: at frames, between
+  // them (yaw -0.3 -> 0.4: 0.05 at 1.5), and clamped outside.
+  for (int f = 0; f < 3; ++f) {
+    const Transform h = alignment.value().template_heading_at(f);
+    EXPECT_TRUE(h.translation.isApprox(Vec3(2.0 * f, 0.0, -1.0 * f))) << f;
+    EXPECT_NEAR(heading_yaw(h.rotation), 0.7 * f - 1.0, 1e-9) << f;
+  }
+  const Transform between = alignment.value().template_heading_at(1.5);
+  EXPECT_TRUE(between.translation.isApprox(Vec3(3.0, 0.0, -1.5)));
+  EXPECT_NEAR(heading_yaw(between.rotation), 0.05, 1e-9);
+  EXPECT_NEAR(heading_yaw(alignment.value().template_heading_at(-3.0).rotation), -1.0, 1e-9);
 }
 
 TEST(SpatialAlignment, PartnerKeepsItsRelativePlaceWhenTheUserMovesAndTurns) {

@@ -8,6 +8,8 @@
 #include <limits>
 #include <random>
 
+#include "duet/math/rotation.h"
+
 namespace duet {
 namespace {
 
@@ -56,6 +58,30 @@ TEST(OneEuroFilter, StartsAndRestartsFromTheSampleAndIgnoresNonFiniteInput) {
   EXPECT_EQ(filter.filter(Vec3(4, 5, 6), 0.0, params), Vec3(4, 5, 6));
   filter.reset();
   EXPECT_EQ(filter.filter(Vec3(7, 8, 9), kDt, params), Vec3(7, 8, 9));
+}
+
+TEST(OneEuroFilter, RebaseMovesTheStateWithTheFrame) {
+  // A signal moving along +x at 1 m/s, expressed in a frame that then turns by 90 degrees about
+  // +y and shifts by (0, 0, 2): after the rebase the filter continues as if it had always seen the
+  // signal in the new frame, with no jump and no catch-up.
+  const OneEuroParams params;
+  OneEuroFilter3 moved, fresh;
+  const Quat turn = yaw_rotation(kPi / 2.0);
+  const Vec3 shift(0.0, 0.0, 2.0);
+  Vec3 out = Vec3::Zero();
+  for (int t = 0; t <= 60; ++t) {
+    const Vec3 sample(1.0 * t * kDt, 0.0, 0.0);
+    out = moved.filter(sample, kDt, params);
+    fresh.filter(turn * sample + shift, kDt, params);
+  }
+  moved.rebase(turn, shift);
+  EXPECT_TRUE(moved.value().isApprox(turn * out + shift, 1e-12));
+  EXPECT_TRUE(moved.value().isApprox(fresh.value(), 1e-9));
+  for (int t = 61; t <= 90; ++t) {
+    const Vec3 sample = turn * Vec3(1.0 * t * kDt, 0.0, 0.0) + shift;
+    EXPECT_TRUE(moved.filter(sample, kDt, params).isApprox(fresh.filter(sample, kDt, params), 1e-9))
+        << t;
+  }
 }
 
 TEST(OneEuroFilter, ValidatesItsParameters) {

@@ -67,9 +67,14 @@ class SpatialAlignment {
   // At a real frame (clamped to the clip): lerp / slerp between the two nearest frames, as the
   // clips themselves are sampled (Clip::sample).
   RootPlacement placement_at(double frame) const noexcept;
+  // The template's heading frame (the one the placements are relative to) in the capture's world,
+  // at a real frame (clamped; translation lerped, rotation slerped). The partner's smoothing
+  // filters the user's facing relative to it (PartnerParams::smooth_facing_offset).
+  Transform template_heading_at(double frame) const noexcept;
 
  private:
   std::vector<RootPlacement> placements_;
+  std::vector<Transform> template_headings_;  // one per frame
 };
 
 }  // namespace duet

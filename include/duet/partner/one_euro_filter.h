@@ -26,6 +26,11 @@ class OneEuroFilter3 {
   // output is returned.
   Vec3 filter(const Vec3& sample, double dt_s, const OneEuroParams& params) noexcept;
   bool primed() const noexcept { return primed_; }
+  // The last output.
+  const Vec3& value() const noexcept { return value_; }
+  // Moves the state by a rigid motion (value -> rotation * value + translation, its speed
+  // rotated), so that a signal expressed in a frame that just moved continues from where it was.
+  void rebase(const Quat& rotation, const Vec3& translation) noexcept;
 
  private:
   bool primed_ = false;

@@ -151,6 +151,15 @@ struct PartnerParams {
   // noise by about 0.04 rad and is smoothed hard (beta 2). 0: no adaptation. Measured in
   // docs/evaluation.md ("Partner steadiness").
   double user_facing_jitter_reference_rad = 0.02;
+  // smooth: the facing the 1-euro filter smooths is the user's facing relative to the template's
+  // at the partner's frame, which holds still while the user dances the template (its turns
+  // included), rather than the facing itself, whose filtering lags every turn of the dance
+  // (issue 11: "filter the correction, not the target"). At a jump the filter carries on from the
+  // facing it showed. The position is filtered as it is: relative to the template's, the playhead's
+  // jitter under a noisy sensor (1-5 cm of the template's pelvis) went into the partner's place.
+  // Measured in docs/evaluation.md ("The facing relative to the template"). false: the facing
+  // itself.
+  bool smooth_facing_offset = true;
   // smooth: the correction the contact IK adds to the captured arm (per arm joint, the rotation
   // from the captured local rotation to the IK's, as a rotation vector) goes through a 1-euro
   // filter: 1 Hz still, +1 Hz per rad/s the correction changes at. The IK otherwise carries every
@@ -309,6 +318,10 @@ class PartnerContext {
   // facing direction (a unit horizontal vector, so the yaw never wraps).
   OneEuroFilter3 user_root_filter_;
   OneEuroFilter3 user_facing_filter_;
+  // The facing filter holds the user's facing relative to the template's (smooth_facing_offset),
+  // and the template's heading rotation it was taken against last frame.
+  bool facing_is_offset_ = false;
+  Quat template_rotation_ = Quat::Identity();
   // The jitter (radians) of the user's raw facing yaw, after adding this frame's facing.
   double facing_jitter(const Vec3& facing, double dt) noexcept;
   JitterMeter user_facing_jitter_;  // of the raw facing's yaw, radians
