@@ -170,14 +170,14 @@ void BM_SynthesisSalsaNoReach(benchmark::State& state) {
 }
 BENCHMARK(BM_SynthesisSalsaNoReach);
 
-// The same with the facing filtered as it is, not relative to the template's
-// (PartnerParams::smooth_facing_offset): what filtering it relative to the template costs.
-void BM_SynthesisSalsaPlainFacing(benchmark::State& state) {
+// The same with the user's heading filtered as it is, not relative to the template's
+// (PartnerParams::smooth_relative_to_template): what filtering it relative to the template costs.
+void BM_SynthesisSalsaPlainHeading(benchmark::State& state) {
   PartnerParams params;
-  params.smooth_facing_offset = false;
-  run_salsa_synthesis(state, params, "all, the facing filtered as it is, 60_01/61_01");
+  params.smooth_relative_to_template = false;
+  run_salsa_synthesis(state, params, "all, the heading filtered as it is, 60_01/61_01");
 }
-BENCHMARK(BM_SynthesisSalsaPlainFacing);
+BENCHMARK(BM_SynthesisSalsaPlainHeading);
 
 // The same with the foot hold on (docs/partner.md, "Feet through a jump"): a jump every 100
 // frames, so feet are held or stepping in part of the frames.

@@ -524,7 +524,8 @@ void PartnerContext::reset() noexcept {
   detour_hs_ = Vec3::Zero();
   detour_offset_m_ = 0.0;
   detour_peak_ = 0.5;
-  facing_is_offset_ = false;
+  heading_is_relative_ = false;
+  user_position_shown_ = Vec3::Zero();
   reach_ramp_ = {1.0, 1.0};
   for (auto& arm : reach_correction_) arm.fill(Vec3::Zero());
   blend_half_life_ = 0.0;
@@ -575,10 +576,11 @@ bool PartnerSynthesisJob::run() const noexcept {
   }
 
   // 0. The user's heading frame, through the 1-euro filter when smoothing. With
-  //    smooth_facing_offset the facing filtered is the user's facing relative to the template's
-  //    at the partner's frame (still while the user dances the template, turns and all), turned
-  //    back by the template's afterwards: the filter's lag then falls on the noise and on the
-  //    user's departures from the template, not on the dance's own turns.
+  //    smooth_relative_to_template what is filtered is the user's heading relative to the
+  //    template's at the partner's frame: the facing as a turn from the template's, the position
+  //    as a shift from the template's pelvis (turned by that filtered turn). Both hold still while
+  //    the user dances the template, turns and steps included, so the filter's lag falls on the
+  //    noise and on the user's departures from the template, not on the dance itself.
   const bool user_root_finite = user != nullptr && user->root_position_ws.allFinite() &&
                                 user->root_rotation_ws.coeffs().allFinite() &&
                                 user->root_rotation_ws.norm() > 0.0;
@@ -588,24 +590,29 @@ bool PartnerSynthesisJob::run() const noexcept {
                        ? user->body_heading
                        : heading_frame(user->root_position_ws, user->root_rotation_ws.normalized());
     if (p.smooth) {
-      const bool by_offset = p.smooth_facing_offset && p.align && has_position;
-      Quat template_rotation = Quat::Identity();
-      if (by_offset) {
-        template_rotation = model->alignment().template_heading_at(frame_position).rotation;
-        if (!ctx.facing_is_offset_) {
+      const bool relative = p.smooth_relative_to_template && p.align && has_position;
+      Transform template_heading;  // the identity when not relative
+      if (relative) {
+        template_heading = model->alignment().template_heading_at(frame_position);
+        // A taller user's steps are longer: the template's path scaled like the spacing.
+        template_heading.translation *= model->spacing_scale(user->height_m);
+        if (!ctx.heading_is_relative_) {
           ctx.user_facing_filter_.reset();
+          ctx.user_root_filter_.reset();
         } else if (jumped) {
-          // The offset jumps with the template's heading; the facing shown must not: the filter
-          // continues from the facing it showed (offset * old = offset * d * new).
-          ctx.user_facing_filter_.rebase(ctx.template_rotation_ * template_rotation.conjugate(),
-                                         Vec3::Zero());
+          // The template's heading changes at once at a jump; the heading shown must not: the
+          // facing filter's turn becomes turn * d, d = old template heading * new one^-1 (turn *
+          // d * new = turn * old), and the position filter is moved below.
+          ctx.user_facing_filter_.rebase(
+              ctx.template_rotation_ * template_heading.rotation.conjugate(), Vec3::Zero());
         }
-        ctx.template_rotation_ = template_rotation;
-      } else if (ctx.facing_is_offset_) {
+        ctx.template_rotation_ = template_heading.rotation;
+      } else if (ctx.heading_is_relative_) {
         ctx.user_facing_filter_.reset();
+        ctx.user_root_filter_.reset();
       }
-      ctx.facing_is_offset_ = by_offset;
-      const Vec3 facing = user_heading.rotation * template_rotation.conjugate() * Vec3::UnitZ();
+      const Vec3 facing =
+          user_heading.rotation * template_heading.rotation.conjugate() * Vec3::UnitZ();
       OneEuroParams facing_filter = p.user_filter;
       if (p.user_facing_jitter_reference_rad > 0.0) {
         const double jitter = ctx.facing_jitter(facing, dt);
@@ -613,19 +620,27 @@ bool PartnerSynthesisJob::run() const noexcept {
         facing_filter.beta /= 1.0 + ratio * ratio;
       }
       const Vec3 smooth_facing = ctx.user_facing_filter_.filter(facing, dt, facing_filter);
-      const Vec3 smooth_position =
-          ctx.user_root_filter_.filter(user_heading.translation, dt, p.user_filter);
-      if (smooth_facing.norm() > 1e-6) {
-        user_heading = {
-            yaw_rotation(std::atan2(smooth_facing.x(), smooth_facing.z())) * template_rotation,
-            smooth_position};
+      const Quat turn = smooth_facing.norm() > 1e-6
+                            ? yaw_rotation(std::atan2(smooth_facing.x(), smooth_facing.z()))
+                            : yaw_rotation(std::atan2(facing.x(), facing.z()));
+      const Vec3 template_position = turn * template_heading.translation;
+      if (relative && ctx.heading_is_relative_ && jumped && ctx.user_root_filter_.primed()) {
+        ctx.user_root_filter_.rebase(
+            Quat::Identity(),
+            ctx.user_position_shown_ - template_position - ctx.user_root_filter_.value());
       }
+      ctx.heading_is_relative_ = relative;
+      const Vec3 position = ctx.user_root_filter_.filter(
+                                user_heading.translation - template_position, dt, p.user_filter) +
+                            template_position;
+      ctx.user_position_shown_ = position;
+      user_heading = {turn * template_heading.rotation, position};
     }
   }
   if (!p.smooth) {
     ctx.user_root_filter_.reset();
     ctx.user_facing_filter_.reset();
-    ctx.facing_is_offset_ = false;
+    ctx.heading_is_relative_ = false;
   }
 
   // 1. Align (5.1): the root relative to the user's heading frame.

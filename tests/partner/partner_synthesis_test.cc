@@ -438,7 +438,8 @@ TEST(PartnerSynthesis, TheFacingFilterDoesNotLagTheDancesOwnTurn) {
   // The template spins at 3 rad/s and the captured partner turns round it, 2 m away. The user
   // dances exactly that, through a sensor that adds +-0.06 rad of heading jitter. Filtered as it
   // is, the jittering facing is smoothed hard and lags the spin; filtered relative to the
-  // template's facing at the partner's frame (smooth_facing_offset), only the jitter is smoothed.
+  // template's facing at the partner's frame (smooth_relative_to_template), only the jitter is
+  // smoothed.
   Duet duet(240, 0, 0);
   const Vec3 leader_at = duet.leader.translations_ls(0)[0];
   const Vec3 follower_from_leader = duet.follower.translations_ls(0)[0] - leader_at;
@@ -453,7 +454,7 @@ TEST(PartnerSynthesis, TheFacingFilterDoesNotLagTheDancesOwnTurn) {
   duet.rebuild();
   const auto mean_yaw_error = [&](bool relative, bool jitter) {
     PartnerParams params = only(true, false, true, false, false);
-    params.smooth_facing_offset = relative;
+    params.smooth_relative_to_template = relative;
     Runner run(duet.model, params);
     unsigned state = 5u;
     double sum = 0.0;

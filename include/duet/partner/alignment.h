@@ -69,7 +69,7 @@ class SpatialAlignment {
   RootPlacement placement_at(double frame) const noexcept;
   // The template's heading frame (the one the placements are relative to) in the capture's world,
   // at a real frame (clamped; translation lerped, rotation slerped). The partner's smoothing
-  // filters the user's facing relative to it (PartnerParams::smooth_facing_offset).
+  // filters the user's heading relative to it (PartnerParams::smooth_relative_to_template).
   Transform template_heading_at(double frame) const noexcept;
 
  private:

@@ -151,15 +151,14 @@ struct PartnerParams {
   // noise by about 0.04 rad and is smoothed hard (beta 2). 0: no adaptation. Measured in
   // docs/evaluation.md ("Partner steadiness").
   double user_facing_jitter_reference_rad = 0.02;
-  // smooth: the facing the 1-euro filter smooths is the user's facing relative to the template's
-  // at the partner's frame, which holds still while the user dances the template (its turns
-  // included), rather than the facing itself, whose filtering lags every turn of the dance
-  // (issue 11: "filter the correction, not the target"). At a jump the filter carries on from the
-  // facing it showed. The position is filtered as it is: filtered relative to the template's pelvis
-  // it made the partner skate more at 4 degrees of noise (58 -> 63 cm/s on noise-sweep-4).
-  // Measured in docs/evaluation.md ("The facing relative to the template"). false: the facing
-  // itself.
-  bool smooth_facing_offset = true;
+  // smooth: what the 1-euro filter smooths is the user's heading relative to the template's at
+  // the partner's frame (the facing as a turn from the template's, the position as a shift from the
+  // template's pelvis), which holds still while the user dances the template, turns and steps
+  // included, rather than the heading itself, whose filtering lags every turn and step of the
+  // dance (issue 11: "filter the correction, not the target"). At a jump the filters carry on
+  // from the heading they showed. Measured in docs/evaluation.md ("The heading relative to the
+  // template"). false: the heading itself.
+  bool smooth_relative_to_template = true;
   // smooth: the correction the contact IK adds to the captured arm (per arm joint, the rotation
   // from the captured local rotation to the IK's, as a rotation vector) goes through a 1-euro
   // filter: 1 Hz still, +1 Hz per rad/s the correction changes at. The IK otherwise carries every
@@ -318,10 +317,11 @@ class PartnerContext {
   // facing direction (a unit horizontal vector, so the yaw never wraps).
   OneEuroFilter3 user_root_filter_;
   OneEuroFilter3 user_facing_filter_;
-  // The facing filter holds the user's facing relative to the template's (smooth_facing_offset),
-  // and the template's heading rotation it was taken against last frame.
-  bool facing_is_offset_ = false;
+  // The filters hold the user's heading relative to the template's (smooth_relative_to_template),
+  // the template's heading rotation it was taken against last frame, and the position shown.
+  bool heading_is_relative_ = false;
   Quat template_rotation_ = Quat::Identity();
+  Vec3 user_position_shown_ = Vec3::Zero();
   // The jitter (radians) of the user's raw facing yaw, after adding this frame's facing.
   double facing_jitter(const Vec3& facing, double dt) noexcept;
   JitterMeter user_facing_jitter_;  // of the raw facing's yaw, radians
