@@ -525,7 +525,6 @@ void PartnerContext::reset() noexcept {
   detour_offset_m_ = 0.0;
   detour_peak_ = 0.5;
   heading_is_relative_ = false;
-  user_position_shown_ = Vec3::Zero();
   reach_ramp_ = {1.0, 1.0};
   for (auto& arm : reach_correction_) arm.fill(Vec3::Zero());
   blend_half_life_ = 0.0;
@@ -625,15 +624,15 @@ bool PartnerSynthesisJob::run() const noexcept {
                             : yaw_rotation(std::atan2(facing.x(), facing.z()));
       const Vec3 template_position = turn * template_heading.translation;
       if (relative && ctx.heading_is_relative_ && jumped && ctx.user_root_filter_.primed()) {
+        // ctx.user_heading_: the heading shown last frame (relative implies align).
         ctx.user_root_filter_.rebase(
             Quat::Identity(),
-            ctx.user_position_shown_ - template_position - ctx.user_root_filter_.value());
+            ctx.user_heading_.translation - template_position - ctx.user_root_filter_.value());
       }
       ctx.heading_is_relative_ = relative;
       const Vec3 position = ctx.user_root_filter_.filter(
                                 user_heading.translation - template_position, dt, p.user_filter) +
                             template_position;
-      ctx.user_position_shown_ = position;
       user_heading = {turn * template_heading.rotation, position};
     }
   }

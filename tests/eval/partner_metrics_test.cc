@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <map>
 
 #include "duet/eval/partner_run.h"
@@ -178,13 +180,20 @@ TEST(CapturedReference, CountsSlipsAndKeepsSpeeds) {
   EXPECT_EQ(lifted.slip_frames, 0);
 }
 
+// `frames` frames at 10 Hz of take 0, template frame f at frame f, true jumps at `jumps`.
+Performance at_10_hz(int frames, std::initializer_list<int> jumps) {
+  Performance performance;
+  for (int f = 0; f < frames; ++f) {
+    performance.times_s.push_back(0.1 * f);
+    performance.truth.push_back({0, static_cast<double>(f), false,
+                                 std::find(jumps.begin(), jumps.end(), f) != jumps.end()});
+  }
+  return performance;
+}
+
 TEST(PartnerMetricsAccumulator, PoolsFramesHandsSlipsAndJumpWindows) {
   // 10 frames at 10 Hz with a true jump at frame 4 (window: frames 4..8, t in [0.4, 0.9)).
-  Performance performance;
-  for (int f = 0; f < 10; ++f) {
-    performance.times_s.push_back(0.1 * f);
-    performance.truth.push_back({0, static_cast<double>(f), false, f == 4});
-  }
+  const Performance performance = at_10_hz(10, {4});
   std::vector<PartnerFrameRecord> records(10);
   for (int f = 0; f < 10; ++f) {
     PartnerFrameRecord& r = records[static_cast<std::size_t>(f)];
@@ -264,11 +273,7 @@ TEST(PartnerMetricsAccumulator, PoolsFramesHandsSlipsAndJumpWindows) {
 TEST(PartnerMetricsAccumulator, SteadinessAndTheTransitionAfterAJump) {
   // 30 frames at 10 Hz, true jumps at frames 5 and 20. After the first, the hands rejoin at
   // frame 8 (0.3 s) and the spacing at frame 7; after the second, the hands never rejoin.
-  Performance performance;
-  for (int f = 0; f < 30; ++f) {
-    performance.times_s.push_back(0.1 * f);
-    performance.truth.push_back({0, static_cast<double>(f), false, f == 5 || f == 20});
-  }
+  const Performance performance = at_10_hz(30, {5, 20});
   std::vector<PartnerFrameRecord> records(30);
   for (int f = 0; f < 30; ++f) {
     PartnerFrameRecord& r = records[static_cast<std::size_t>(f)];
@@ -318,11 +323,7 @@ TEST(PartnerMetricsAccumulator, SteadinessAndTheTransitionAfterAJump) {
 TEST(PartnerMetricsAccumulator, CrowdingCountsOnlyWhereTheCaptureKeptClear) {
   // 20 frames at 10 Hz, a true jump at frame 5 (window: frames 5-9). The captured partner keeps
   // 0.6 m from the user, except at frames 15-16 where it comes to 0.2 m itself.
-  Performance performance;
-  for (int f = 0; f < 20; ++f) {
-    performance.times_s.push_back(0.1 * f);
-    performance.truth.push_back({0, static_cast<double>(f), false, f == 5});
-  }
+  const Performance performance = at_10_hz(20, {5});
   std::vector<PartnerFrameRecord> records(20);
   for (int f = 0; f < 20; ++f) {
     PartnerFrameRecord& r = records[static_cast<std::size_t>(f)];

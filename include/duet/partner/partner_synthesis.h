@@ -318,10 +318,9 @@ class PartnerContext {
   OneEuroFilter3 user_root_filter_;
   OneEuroFilter3 user_facing_filter_;
   // The filters hold the user's heading relative to the template's (smooth_relative_to_template),
-  // the template's heading rotation it was taken against last frame, and the position shown.
+  // and the template's heading rotation it was taken against last frame.
   bool heading_is_relative_ = false;
   Quat template_rotation_ = Quat::Identity();
-  Vec3 user_position_shown_ = Vec3::Zero();
   // The jitter (radians) of the user's raw facing yaw, after adding this frame's facing.
   double facing_jitter(const Vec3& facing, double dt) noexcept;
   JitterMeter user_facing_jitter_;  // of the raw facing's yaw, radians
