@@ -138,6 +138,8 @@ Result<HandContacts> HandContacts::detect(const Clip& template_clip,
   contacts.raw_mask_.assign(static_cast<std::size_t>(frames), 0);
   contacts.box_gap_.assign(static_cast<std::size_t>(frames) * kHandPairCount, 0.0f);
   contacts.offset_ls_.assign(static_cast<std::size_t>(frames) * kHandPairCount, Vec3::Zero());
+  contacts.template_wrist_rotations_ws_.assign(static_cast<std::size_t>(frames) * kSideCount,
+                                               Quat::Identity());
 
   const Clip* clips[2] = {&template_clip, &response_clip};
   const JointRoles* roles[2] = {&template_roles, &response_roles};
@@ -160,6 +162,11 @@ Result<HandContacts> HandContacts::detect(const Clip& template_clip,
     for (int c = 0; c < 2; ++c) {
       forward_kinematics(clips[c]->skeleton(), clips[c]->translations_ls(f),
                          clips[c]->rotations_ls(f), positions[c], rotations[c]);
+    }
+    for (const Side side : {Side::kLeft, Side::kRight}) {
+      const auto s = static_cast<std::size_t>(side);
+      contacts.template_wrist_rotations_ws_[static_cast<std::size_t>(f) * kSideCount + s] =
+          rotations[0][static_cast<std::size_t>(hands[0][s][0])];
     }
     std::uint8_t raw = 0;
     for (int p = 0; p < kHandPairCount; ++p) {
@@ -235,6 +242,14 @@ const Vec3& HandContacts::offset_ls(int frame, int pair) const noexcept {
 Vec3 HandContacts::offset_ls_at(double frame, int pair) const noexcept {
   const auto [f0, f1, w] = bracket_frame(frame, frame_count());
   return (1.0 - w) * offset_ls(f0, pair) + w * offset_ls(f1, pair);
+}
+
+Quat HandContacts::template_wrist_rotation_at(double frame, Side side) const noexcept {
+  const auto [f0, f1, w] = bracket_frame(frame, frame_count());
+  const auto s = static_cast<std::size_t>(side);
+  const Quat& q0 = template_wrist_rotations_ws_[static_cast<std::size_t>(f0) * kSideCount + s];
+  const Quat& q1 = template_wrist_rotations_ws_[static_cast<std::size_t>(f1) * kSideCount + s];
+  return q0.slerp(w, q1).normalized();
 }
 
 std::span<const ContactInterval> HandContacts::intervals(int pair) const noexcept {

@@ -199,6 +199,10 @@ bool finite_pose(const UserPose& user, Side side) {
   return user.wrist_positions_ws[s].allFinite() && user.wrist_rotations_ws[s].coeffs().allFinite();
 }
 
+SteadyDifferenceParams steady_difference_params(const PartnerParams& p) {
+  return {p.ik_difference_time_constant_s, p.ik_difference_power_time_constant_s};
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -329,7 +333,8 @@ std::string PartnerParams::validate() const {
   const std::pair<const char*, double> references[] = {
       {"user_facing_jitter_reference_rad", user_facing_jitter_reference_rad},
       {"ik_target_jitter_reference_m", ik_target_jitter_reference_m},
-      {"ik_difference_time_constant_s", ik_difference_time_constant_s}};
+      {"ik_difference_time_constant_s", ik_difference_time_constant_s},
+      {"ik_difference_power_time_constant_s", ik_difference_power_time_constant_s}};
   for (const auto& [name, value] : references) {
     if (!(value >= 0.0) || !std::isfinite(value)) {
       return std::string(name) + " must be finite and >= 0 (0: none; got " + std::to_string(value) +
@@ -473,26 +478,40 @@ Vec3 PartnerContext::steady_ik_target(std::size_t hand, const Vec3& target,
                                       const PartnerParams& p, double dt, bool restart) noexcept {
   const double jitter = ik_target_jitter(hand, target, dt, restart);
   const auto pair = static_cast<std::size_t>(ik_pair_[hand]);
-  if (!target.allFinite() || !captured_wrist.allFinite() || pair >= ik_difference_hs_.size()) {
+  if (!target.allFinite() || !captured_wrist.allFinite() || pair >= ik_difference_.size()) {
     return target;
   }
   const Quat to_body = body_rotation.normalized().conjugate();
   const Vec3 difference_hs = to_body * (target - captured_wrist);
-  // The averaging time: none on a clean sensor, up to ik_difference_time_constant_s under noise.
-  const double ratio = jitter / p.ik_target_jitter_reference_m;
-  const double noisy = ratio * ratio * ratio * ratio;
-  const double tau = p.ik_difference_time_constant_s * noisy / (1.0 + noisy);
-  double& seen = ik_difference_seen_s_[pair];
-  seen += dt > 0.0 && std::isfinite(dt) ? dt : 0.0;
-  // A running mean until the average has seen tau (its first sample may be all noise).
-  const double alpha = tau > 0.0 && dt > 0.0 && std::isfinite(dt)
-                           ? std::max(1.0 - std::exp(-dt / tau), std::min(1.0, dt / seen))
-                           : 1.0;
-  Vec3& average = ik_difference_hs_[pair];
-  average = ik_difference_valid_[pair] ? Vec3(average + alpha * (difference_hs - average))
-                                       : difference_hs;
-  ik_difference_valid_[pair] = true;
-  return captured_wrist + body_rotation.normalized() * average;
+  return captured_wrist +
+         body_rotation.normalized() * ik_difference_[pair].update(difference_hs, jitter,
+                                                                  p.ik_target_jitter_reference_m,
+                                                                  dt, steady_difference_params(p));
+}
+
+Quat PartnerContext::steady_hand_turn(std::size_t hand, const Quat& sensed, const Quat& captured,
+                                      double offset_m, const PartnerParams& p, double dt,
+                                      bool restart) noexcept {
+  const auto pair = static_cast<std::size_t>(ik_pair_[hand]);
+  const Quat from = captured.normalized();
+  const Vec3 turn = log_map(from.conjugate() * sensed.normalized());
+  if (!turn.allFinite() || pair >= ik_turn_difference_.size()) return sensed;
+  // A second difference over 1.5 rad (86 degrees in a frame) is a move, not jitter: white noise
+  // of 10 degrees per axis (4 per joint above the hand) gives second differences of 0.4 rad RMS.
+  constexpr double kJitterTimeConstantS = 1.0, kMoveRad = 1.5;
+  double variance = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    JitterMeter& meter = ik_turn_jitter_[hand][static_cast<std::size_t>(axis)];
+    if (restart) meter.restart();
+    meter.add(turn[axis], dt, kJitterTimeConstantS, kMoveRad);
+    variance += meter.rms() * meter.rms();
+  }
+  // The turn moves the target by about offset_m times its angle: the target's jitter reference
+  // in radians. At least 1 cm of lever, so a zero offset does not divide by zero.
+  const double reference_rad = p.ik_target_jitter_reference_m / std::max(offset_m, 0.01);
+  return (from * exp_map(ik_turn_difference_[pair].update(turn, std::sqrt(variance), reference_rad,
+                                                          dt, steady_difference_params(p))))
+      .normalized();
 }
 
 void PartnerContext::reset() noexcept {
@@ -509,9 +528,11 @@ void PartnerContext::reset() noexcept {
   for (auto& hand : ik_target_jitter_) {
     for (JitterMeter& meter : hand) meter.reset();
   }
-  ik_difference_hs_.fill(Vec3::Zero());
-  ik_difference_valid_.fill(false);
-  ik_difference_seen_s_.fill(0.0);
+  for (auto& hand : ik_turn_jitter_) {
+    for (JitterMeter& meter : hand) meter.reset();
+  }
+  for (SteadyDifference& difference : ik_difference_) difference.reset();
+  for (SteadyDifference& difference : ik_turn_difference_) difference.reset();
   for (auto& arm : ik_correction_filter_) {
     for (OneEuroFilter3& filter : arm) filter.reset();
   }
@@ -733,16 +754,30 @@ bool PartnerSynthesisJob::run() const noexcept {
       }
       const auto t = static_cast<std::size_t>(ts);
       Vec3 raw_target = user->wrist_positions_ws[t];
+      const bool steady = p.smooth && p.ik_target_jitter_reference_m > 0.0;
+      const bool target_restarts = jumped || ctx.ik_pair_[r] != previous_pair;
       if (p.ik_target == IkTarget::kCapturedOffset) {
-        raw_target += user->wrist_rotations_ws[t].normalized() *
-                      (has_position ? contacts.offset_ls_at(frame_position, ctx.ik_pair_[r])
-                                    : contacts.offset_ls(frame, ctx.ik_pair_[r]));
+        const double at = has_position ? frame_position : static_cast<double>(frame);
+        const Vec3 offset = has_position ? contacts.offset_ls_at(frame_position, ctx.ik_pair_[r])
+                                         : contacts.offset_ls(frame, ctx.ik_pair_[r]);
+        Quat carried_by = user->wrist_rotations_ws[t].normalized();
+        if (steady && p.align && p.steady_hand_turn) {
+          // The offset is carried by the user's hand turned as the template's is, in the user's
+          // heading, plus the steady difference of the sensed turn from it: under noise the
+          // sensed hand's turn (the sum of every joint's noise above it) swung a 10-30 cm offset
+          // by centimetres.
+          const Quat template_hand =
+              heading.rotation * model->alignment().template_heading_at(at).rotation.conjugate() *
+              contacts.template_wrist_rotation_at(at, ts);
+          carried_by = ctx.steady_hand_turn(r, carried_by, template_hand, offset.norm(), p, dt,
+                                            target_restarts);
+        }
+        raw_target += carried_by * offset;
       }
-      if (p.smooth && p.ik_target_jitter_reference_m > 0.0) {
+      if (steady) {
         raw_target = ctx.steady_ik_target(
             r, raw_target, ctx.positions_ws_[static_cast<std::size_t>(roles[kArms[r].wrist])],
-            p.align ? heading.rotation : Quat::Identity(), p, dt,
-            jumped || ctx.ik_pair_[r] != previous_pair);
+            p.align ? heading.rotation : Quat::Identity(), p, dt, target_restarts);
       }
       // Keep the target continuous across jumps (5.3): the step of the raw target is absorbed
       // by an offset that decays like the blend. The speed test uses at least one model frame

@@ -409,6 +409,71 @@ TEST(PartnerSynthesis, UnderHeavyJitterTheHandStillLearnsABodyDifference) {
   EXPECT_LT((shifted_noisy - shifted_clean).norm(), 0.015);  // and under noise too, on average
 }
 
+// The user's hand turns `turn` (a rotation vector in the hand's frame) off the template's, plus
+// white noise of `noise_rad` per axis, with a 20 cm grip, and is 8 cm off the template's (another
+// body); the partner's hand and the IK's target every frame, and the hand's mean over the last
+// 2 s. steady_turn: PartnerParams::steady_hand_turn.
+struct TurnRun {
+  Vec3 mean = Vec3::Zero();
+  std::vector<Vec3> hands;
+  std::vector<Vec3> targets;  // the contact IK's
+};
+TurnRun run_turned_hand(const Vec3& turn, double noise_rad, bool steady_turn) {
+  const Vec3 grip(0.0, 0.0, 0.2);
+  Duet duet(240, 0, 240, grip);
+  const std::size_t wrist = duet.wrist(Role::kRightWrist);
+  const double dt = 1.0 / 30.0;
+  PartnerParams params = only(true, true, true, false, false);
+  params.steady_hand_turn = steady_turn;
+  Runner run(duet.model, params);
+  std::mt19937 rng(9);
+  std::normal_distribution<double> jitter(0.0, noise_rad);
+  TurnRun out;
+  for (int f = 0; f < 120; ++f) {
+    UserPose user = user_from(duet.leader, 2 * f, duet.roles);
+    user.wrist_positions_ws[0] += Vec3(0.08, 0.0, 0.0);
+    user.wrist_rotations_ws[0] =
+        (user.wrist_rotations_ws[0] * exp_map(turn + Vec3(jitter(rng), jitter(rng), jitter(rng))))
+            .normalized();
+    run.step(2 * f, duet.follower.translations_ls(2 * f), duet.follower.rotations_ls(2 * f), user,
+             false, dt);
+    out.hands.push_back(run.world().positions[wrist]);
+    out.targets.push_back(run.info.ik_target_ws[static_cast<std::size_t>(Side::kRight)]);
+    if (f >= 60) out.mean += run.world().positions[wrist] / 60.0;
+  }
+  return out;
+}
+
+TEST(PartnerSynthesis, AJitteringHandTurnDoesNotSwingTheGrip) {
+  // 10 degrees of noise per axis on the user's hand rotation (the sum of every joint's above it
+  // at 4 degrees per joint) swing a 20 cm grip by about 6 cm. With a real difference in where
+  // the hand is, the averaged target is trusted and keeps what is left of that noise; the steady
+  // turn keeps the partner's hand nearer where a clean sensor has it than the sensed turn does.
+  const TurnRun clean = run_turned_hand(Vec3::Zero(), 0.0, true);
+  const TurnRun steady = run_turned_hand(Vec3::Zero(), 0.17, true);
+  const TurnRun sensed = run_turned_hand(Vec3::Zero(), 0.17, false);
+  double steady_target = 0.0, sensed_target = 0.0, steady_hand = 0.0, sensed_hand = 0.0;
+  for (std::size_t f = 30; f < clean.hands.size(); ++f) {  // after the jitter has been measured
+    steady_target += (steady.targets[f] - clean.targets[f]).norm() / 90.0;
+    sensed_target += (sensed.targets[f] - clean.targets[f]).norm() / 90.0;
+    steady_hand += (steady.hands[f] - clean.hands[f]).norm() / 90.0;
+    sensed_hand += (sensed.hands[f] - clean.hands[f]).norm() / 90.0;
+  }
+  EXPECT_LT(steady_target, 0.7 * sensed_target);  // measured 0.86 against 1.57 cm
+  EXPECT_LT(steady_hand, 0.7 * sensed_hand);      // 0.57 against 1.06 cm
+}
+
+TEST(PartnerSynthesis, AHandTurnedOffTheTemplatesStillTurnsTheGrip) {
+  // A user who holds the hand turned 30 degrees from the template's (another grip, another rig):
+  // the steady turn keeps that difference, on a clean sensor and on average under noise.
+  const Vec3 turn(0.0, 0.52, 0.0);
+  const TurnRun captured = run_turned_hand(Vec3::Zero(), 0.0, true);
+  const TurnRun turned_clean = run_turned_hand(turn, 0.0, true);
+  const TurnRun turned_noisy = run_turned_hand(turn, 0.17, true);
+  EXPECT_GT((turned_clean.mean - captured.mean).norm(), 0.06);  // 20 cm x 0.52 rad
+  EXPECT_LT((turned_noisy.mean - turned_clean.mean).norm(), 0.02);
+}
+
 TEST(PartnerSynthesis, SmoothDampsJitter) {
   Duet duet(120, 0, 0);
   const std::size_t elbow = static_cast<std::size_t>(duet.roles[Role::kLeftElbow]);

@@ -85,6 +85,9 @@ class HandContacts {
   const Vec3& offset_ls(int frame, int pair) const noexcept;
   // The same at a real frame (clamped to the clip): lerp between the two nearest frames.
   Vec3 offset_ls_at(double frame, int pair) const noexcept;
+  // The template's hand joint rotation in the capture's world at a real frame (clamped; slerp):
+  // what the user's sensed hand rotation is compared with (steady_difference.h).
+  Quat template_wrist_rotation_at(double frame, Side side) const noexcept;
 
   std::span<const ContactInterval> intervals(int pair) const noexcept;
   // Fraction of frames in which pair is in contact (after debouncing), in [0, 1].
@@ -102,6 +105,7 @@ class HandContacts {
   std::vector<std::uint8_t> raw_mask_;  // per frame
   std::vector<float> box_gap_;          // frame * kHandPairCount + pair
   std::vector<Vec3> offset_ls_;         // frame * kHandPairCount + pair
+  std::vector<Quat> template_wrist_rotations_ws_;  // frame * kSideCount + side
   std::array<std::vector<ContactInterval>, kHandPairCount> intervals_;
 };
 

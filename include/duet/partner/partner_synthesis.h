@@ -36,6 +36,7 @@
 #include "duet/partner/one_euro_filter.h"
 #include "duet/partner/response_playhead.h"
 #include "duet/partner/smoothing.h"
+#include "duet/partner/steady_difference.h"
 
 namespace duet {
 
@@ -188,6 +189,16 @@ struct PartnerParams {
   // steadiness").
   double ik_target_jitter_reference_m = 0.02;
   double ik_difference_time_constant_s = 0.1;
+  // smooth: the average is trusted by the share of its power that is not the sensor's noise,
+  // the power measured over this long (steady_difference.h: near 1 on a clean sensor, towards
+  // the captured arm where the noise is as large as the difference); 0: trusted whole.
+  double ik_difference_power_time_constant_s = 1.0;
+  // smooth and align: the captured offset from the user's hand to the partner's (10-30 cm) is
+  // carried by the template's hand turned into the user's heading plus the steady difference
+  // (as above) of the user's sensed hand turn from it, not by the sensed turn itself, whose
+  // noise (every joint's above the hand) swung the offset by centimetres. false: by the sensed
+  // turn. Measured in docs/evaluation.md ("What the hand's difference is trusted for").
+  bool steady_hand_turn = true;
   // smooth: the response is shown at a real frame that advances at the dancer's tempo
   // (response_playhead.h; used by LiveLoop, which samples the pose there and passes it as
   // PartnerSynthesisJob::frame_position).
@@ -334,9 +345,14 @@ class PartnerContext {
   Vec3 steady_ik_target(std::size_t hand, const Vec3& target, const Vec3& captured_wrist,
                         const Quat& body_rotation, const PartnerParams& p, double dt,
                         bool restart) noexcept;
-  std::array<Vec3, kHandPairCount> ik_difference_hs_{};  // per hand pair, kept across contacts
-  std::array<bool, kHandPairCount> ik_difference_valid_{};
-  std::array<double, kHandPairCount> ik_difference_seen_s_{};
+  std::array<SteadyDifference, kHandPairCount> ik_difference_;  // per hand pair, across contacts
+  // The rotation that carries the captured offset: the template's hand turned into the user's
+  // heading, plus the steady difference of the user's sensed hand turn from it (a rotation
+  // vector in the template hand's frame, per hand pair).
+  Quat steady_hand_turn(std::size_t hand, const Quat& sensed, const Quat& captured, double offset_m,
+                        const PartnerParams& p, double dt, bool restart) noexcept;
+  std::array<SteadyDifference, kHandPairCount> ik_turn_difference_;
+  std::array<std::array<JitterMeter, 3>, 2> ik_turn_jitter_;  // per hand, per axis, radians
   // The jitter (metres, RMS over the axes) of each response hand's raw IK target, after adding
   // this frame's target; restart: the target moved on (a jump, another hand held).
   double ik_target_jitter(std::size_t hand, const Vec3& target, double dt, bool restart) noexcept;
