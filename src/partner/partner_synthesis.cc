@@ -443,7 +443,9 @@ void PartnerContext::resize(int joint_count) {
   reset();
 }
 
-// The jitter (radians) of the user's raw facing yaw, unwrapped so a turn through +-pi is no step.
+// The jitter (radians) of the yaw of the facing the filter smooths (the user's raw facing, or with
+// smooth_relative_to_template its turn from the template's), unwrapped so a turn through +-pi is
+// no step.
 double PartnerContext::facing_jitter(const Vec3& facing, double dt) noexcept {
   const double yaw = std::atan2(facing.x(), facing.z());
   if (!std::isfinite(yaw)) return user_facing_jitter_.rms();

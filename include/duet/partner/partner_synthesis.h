@@ -334,8 +334,8 @@ class PartnerContext {
   Quat template_rotation_ = Quat::Identity();
   // The jitter (radians) of the user's raw facing yaw, after adding this frame's facing.
   double facing_jitter(const Vec3& facing, double dt) noexcept;
-  JitterMeter user_facing_jitter_;  // of the raw facing's yaw, radians
-  double user_facing_yaw_ = 0.0;    // the raw facing's yaw, unwrapped
+  JitterMeter user_facing_jitter_;  // of the yaw of the facing filtered (relative or raw), rad
+  double user_facing_yaw_ = 0.0;    // that facing's yaw, unwrapped
   bool user_facing_yaw_valid_ = false;
   // Per response hand, per arm joint (shoulder, elbow): the IK's correction (smooth).
   std::array<std::array<OneEuroFilter3, 2>, 2> ik_correction_filter_;
