@@ -334,7 +334,8 @@ std::string PartnerParams::validate() const {
       {"user_facing_jitter_reference_rad", user_facing_jitter_reference_rad},
       {"ik_target_jitter_reference_m", ik_target_jitter_reference_m},
       {"ik_difference_time_constant_s", ik_difference_time_constant_s},
-      {"ik_difference_power_time_constant_s", ik_difference_power_time_constant_s}};
+      {"ik_difference_power_time_constant_s", ik_difference_power_time_constant_s},
+      {"ik_correction_clean_cutoff_hz", ik_correction_clean_cutoff_hz}};
   for (const auto& [name, value] : references) {
     if (!(value >= 0.0) || !std::isfinite(value)) {
       return std::string(name) + " must be finite and >= 0 (0: none; got " + std::to_string(value) +
@@ -479,6 +480,7 @@ Vec3 PartnerContext::steady_ik_target(std::size_t hand, const Vec3& target,
                                       const Vec3& captured_wrist, const Quat& body_rotation,
                                       const PartnerParams& p, double dt, bool restart) noexcept {
   const double jitter = ik_target_jitter(hand, target, dt, restart);
+  ik_target_jitter_m_[hand] = jitter;
   const auto pair = static_cast<std::size_t>(ik_pair_[hand]);
   if (!target.allFinite() || !captured_wrist.allFinite() || pair >= ik_difference_.size()) {
     return target;
@@ -533,6 +535,7 @@ void PartnerContext::reset() noexcept {
   for (auto& hand : ik_turn_jitter_) {
     for (JitterMeter& meter : hand) meter.reset();
   }
+  ik_target_jitter_m_.fill(0.0);
   for (SteadyDifference& difference : ik_difference_) difference.reset();
   for (SteadyDifference& difference : ik_turn_difference_) difference.reset();
   for (auto& arm : ik_correction_filter_) {
@@ -828,11 +831,25 @@ bool PartnerSynthesisJob::run() const noexcept {
         // The correction (captured -> IK, in the joint's own frame) through the 1-euro filter,
         // then put back on the captured rotation; the wrist lands where that arm reaches.
         // At most ik_correction_max_speed_rad_s: the IK adds at most that to a joint's speed.
+        // The filter's cutoff falls as the target's measured jitter grows (a steady-state Kalman
+        // filter's gain goes as 1 / noise): ik_correction_clean_cutoff_hz on a clean sensor,
+        // where the 1 Hz filter only lagged the correction (a 1.15x body's hands 1 cm apart),
+        // the filter's own min_cutoff_hz from ik_target_jitter_reference_m up.
         std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
+        OneEuroParams correction_filter = p.ik_correction_filter;
+        if (steady && p.ik_correction_clean_cutoff_hz > correction_filter.min_cutoff_hz) {
+          const double jitter = ctx.ik_target_jitter_m_[r];
+          correction_filter.min_cutoff_hz =
+              jitter * p.ik_correction_clean_cutoff_hz >
+                      correction_filter.min_cutoff_hz * p.ik_target_jitter_reference_m
+                  ? std::max(
+                        correction_filter.min_cutoff_hz,
+                        correction_filter.min_cutoff_hz * p.ik_target_jitter_reference_m / jitter)
+                  : p.ik_correction_clean_cutoff_hz;
+        }
         const auto correct = [&](std::size_t k, const Quat& captured, const Quat& solved) {
           const bool primed = filters[k].primed();
-          Vec3 c =
-              filters[k].filter(log_map(captured.conjugate() * solved), dt, p.ik_correction_filter);
+          Vec3 c = filters[k].filter(log_map(captured.conjugate() * solved), dt, correction_filter);
           const double most = p.ik_correction_max_speed_rad_s * dt;
           if (primed) c = step_towards(shown[k], c, most);
           shown[k] = c;

@@ -271,6 +271,33 @@ TEST(PartnerSynthesis, ContactMovesThePartnersWristToTheUsersHand) {
   }
 }
 
+TEST(PartnerSynthesis, OnACleanSensorTheCorrectionFollowsAMovingHand) {
+  // Hands held; the user's hand 10 cm off the template's and circling 5 cm at 1 Hz (another
+  // body dancing its own way), sensed cleanly. The correction filter, whose cutoff rises to
+  // ik_correction_clean_cutoff_hz on a clean sensor, keeps the partner's hand on the target; at
+  // its noisy-sensor cutoff (1 Hz) it lagged behind.
+  const Vec3 grip(0.0, 0.0, 0.04);
+  Duet duet(240, 0, 240, grip);
+  const auto mean_miss = [&](double clean_cutoff_hz) {
+    PartnerParams params = only(true, true, true, false, false);
+    params.ik_correction_clean_cutoff_hz = clean_cutoff_hz;
+    Runner run(duet.model, params);
+    double miss = 0.0;
+    for (int f = 0; f < 240; ++f) {
+      const double angle = 2.0 * kPi * f / kFps;
+      UserPose user = user_from(duet.leader, f, duet.roles);
+      user.wrist_positions_ws[0] += Vec3(0.1 + 0.05 * std::cos(angle), 0.05 * std::sin(angle), 0);
+      run.step(duet.follower, f, user);
+      if (f >= 60) miss += run.info.ik_error_m[1] / 180.0;
+    }
+    return miss;
+  };
+  const double clean_cutoff = mean_miss(PartnerParams{}.ik_correction_clean_cutoff_hz);
+  const double noisy_cutoff = mean_miss(0.0);
+  EXPECT_LT(clean_cutoff, 0.5 * noisy_cutoff);
+  EXPECT_LT(clean_cutoff, 0.01);
+}
+
 TEST(PartnerSynthesis, SmoothFiltersTheContactTargetsJitter) {
   // Hands held throughout; the sensor jitters the user's left wrist by 1 cm per axis per frame.
   // With smooth on, the IK's correction goes through the 1-euro filter and its speed limit: the

@@ -176,6 +176,12 @@ struct PartnerParams {
   // speed is about what it is with the IK off; 2 rad/s was as steady but slowed a persistent
   // correction (`body-size`: median hand error 1.25 cm, 0.99 at 4 rad/s).
   double ik_correction_max_speed_rad_s = 4.0;
+  // smooth: the correction filter's cutoff falls as the IK target's measured jitter grows:
+  // this on a clean sensor, ik_correction_filter.min_cutoff_hz * ik_target_jitter_reference_m /
+  // jitter between, ik_correction_filter's own from the reference up. 0 (or at most
+  // min_cutoff_hz): the filter as given. Measured in docs/evaluation.md ("The IK's correction
+  // filtered by the noise").
+  double ik_correction_clean_cutoff_hz = 10.0;
   // smooth: under a noisy sensor the user's wrist, and with it the IK target, jitters (at 4
   // degrees per joint and axis by 6-9 cm a frame), and the IK passed it into the partner's arm
   // (issue 11: the hand 6.7 cm from the user's real hand at 60 Hz, 1.4 cm with the IK off). What
@@ -357,6 +363,7 @@ class PartnerContext {
   // this frame's target; restart: the target moved on (a jump, another hand held).
   double ik_target_jitter(std::size_t hand, const Vec3& target, double dt, bool restart) noexcept;
   std::array<std::array<JitterMeter, 3>, 2> ik_target_jitter_;  // per hand, per axis
+  std::array<double, 2> ik_target_jitter_m_{};                  // per hand, this frame's reading
   std::array<double, 2> ik_ramp_{0.0, 0.0};  // per response hand, linear fade state in [0, 1]
   std::array<int, 2> ik_pair_{-1, -1};       // pair that last drove that hand
   // IK target continuity, per response hand: last frame's raw and shown targets (valid when the
