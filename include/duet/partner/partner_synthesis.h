@@ -338,7 +338,7 @@ class PartnerContext {
   // and the template's heading rotation it was taken against last frame.
   bool heading_is_relative_ = false;
   Quat template_rotation_ = Quat::Identity();
-  // The jitter (radians) of the user's raw facing yaw, after adding this frame's facing.
+  // The jitter (radians) of the filtered facing's yaw, after adding this frame's facing.
   double facing_jitter(const Vec3& facing, double dt) noexcept;
   JitterMeter user_facing_jitter_;  // of the yaw of the facing filtered (relative or raw), rad
   double user_facing_yaw_ = 0.0;    // that facing's yaw, unwrapped
@@ -347,7 +347,7 @@ class PartnerContext {
   std::array<std::array<OneEuroFilter3, 2>, 2> ik_correction_filter_;
   std::array<std::array<Vec3, 2>, 2> ik_correction_{};  // their outputs last frame
   // The IK target under a noisy sensor: the captured wrist plus the average, in the user's body
-  // frame, of what the sensed target adds to it (PartnerParams::ik_difference_time_constant_s).
+  // frame, of what the sensed target adds to it, trusted by its real share (steady_difference.h).
   Vec3 steady_ik_target(std::size_t hand, const Vec3& target, const Vec3& captured_wrist,
                         const Quat& body_rotation, const PartnerParams& p, double dt,
                         bool restart) noexcept;
