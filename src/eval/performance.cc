@@ -651,7 +651,9 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     options.seed = derive_seed(seed, 11);
     performance = play(sources[0], options);
   }
-  if (recipe.body_scale != 1.0)
+  // On another rig the body is scaled after retargeting: retargeting onto the rig gives the rig's
+  // own bone lengths, and a scale before it was lost (body-size@asf was clean@asf).
+  if (recipe.body_scale != 1.0 && !recipe.rig)
     performance = with_body_scale(std::move(performance), recipe.body_scale);
   if (recipe.room_yaw_rad != 0.0 || !recipe.room_offset_m.isZero()) {
     performance =
@@ -664,6 +666,8 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     Result<Performance> moved = with_rig(std::move(performance), recipe.rig, recipe.rig_roles);
     if (!moved) return moved.error();
     performance = std::move(moved).value();
+    if (recipe.body_scale != 1.0)
+      performance = with_body_scale(std::move(performance), recipe.body_scale);
   }
   if (recipe.noise.active() || recipe.head_hands) record_true_wrists(performance);
   if (recipe.head_hands) record_true_headings(performance);

@@ -594,6 +594,27 @@ TEST(MakePerformance, ComposesImprovisationNoiseAndALowRate) {
   EXPECT_EQ(again.value().times_s, p.value().times_s);
 }
 
+TEST(MakePerformance, ABodySizeOnAnotherRigIsThatRigsBodyScaled) {
+  // Retargeting onto a rig gives the rig's bone lengths: the body's scale is applied after it,
+  // or body-size@rig would be the rig's own body (it was).
+  const Fixture f = make_fixture(120);
+  const SourceTake source = f.source();
+  const auto head_to_foot_m = [&](double body_scale) {
+    PerformanceRecipe recipe;
+    recipe.rig = f.clip.skeleton_ptr();
+    recipe.rig_roles = f.roles;
+    recipe.body_scale = body_scale;
+    Result<Performance> p = make_performance(std::span(&source, 1), recipe, 3);
+    EXPECT_TRUE(p) << p.error().message;
+    if (!p) return 0.0;
+    const std::vector<Vec3> world = world_positions(p.value().motion);
+    return (world[static_cast<std::size_t>(f.roles[Role::kHead])] -
+            world[static_cast<std::size_t>(f.roles[Role::kLeftAnkle])])
+        .norm();
+  };
+  EXPECT_NEAR(head_to_foot_m(1.15) / head_to_foot_m(1.0), 1.15, 1e-6);
+}
+
 TEST(MakePerformance, RecordsTheRealWristsBeforeTheNoise) {
   // The partner metrics score the partner's hands against the user's real hands: the wrists as
   // they were before the sensor's noise, kept in step with dropped and repeated frames.
