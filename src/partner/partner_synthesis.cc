@@ -199,6 +199,26 @@ bool finite_pose(const UserPose& user, Side side) {
   return user.wrist_positions_ws[s].allFinite() && user.wrist_rotations_ws[s].coeffs().allFinite();
 }
 
+// The RMS over the axes of a vector's jitter, per-axis meters.
+double jitter_rms(const std::array<JitterMeter, 3>& meters) {
+  double variance = 0.0;
+  for (const JitterMeter& meter : meters) variance += meter.rms() * meter.rms();
+  return std::sqrt(variance);
+}
+
+// Adds one sample of a vector to its per-axis meters (time constant 1 s; a second difference
+// over max_step is a move, not jitter) and returns its jitter's RMS over the axes.
+double add_vector_jitter(std::array<JitterMeter, 3>& meters, const Vec3& value, double dt,
+                         double max_step, bool restart) {
+  constexpr double kJitterTimeConstantS = 1.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    JitterMeter& meter = meters[static_cast<std::size_t>(axis)];
+    if (restart) meter.restart();
+    meter.add(value[axis], dt, kJitterTimeConstantS, max_step);
+  }
+  return jitter_rms(meters);
+}
+
 SteadyDifferenceParams steady_difference_params(const PartnerParams& p) {
   return {p.ik_difference_time_constant_s, p.ik_difference_power_time_constant_s};
 }
@@ -465,22 +485,14 @@ double PartnerContext::facing_jitter(const Vec3& facing, double dt) noexcept {
 double PartnerContext::ik_target_jitter(std::size_t hand, const Vec3& target, double dt,
                                         bool restart) noexcept {
   // A second difference over 0.3 m in a frame is the target moving on, not jitter.
-  constexpr double kJitterTimeConstantS = 1.0, kMoveM = 0.3;
-  double variance = 0.0;
-  for (int axis = 0; axis < 3; ++axis) {
-    JitterMeter& meter = ik_target_jitter_[hand][static_cast<std::size_t>(axis)];
-    if (restart) meter.restart();
-    meter.add(target[axis], dt, kJitterTimeConstantS, kMoveM);
-    variance += meter.rms() * meter.rms();
-  }
-  return std::sqrt(variance);
+  constexpr double kMoveM = 0.3;
+  return add_vector_jitter(ik_target_jitter_[hand], target, dt, kMoveM, restart);
 }
 
 Vec3 PartnerContext::steady_ik_target(std::size_t hand, const Vec3& target,
                                       const Vec3& captured_wrist, const Quat& body_rotation,
                                       const PartnerParams& p, double dt, bool restart) noexcept {
   const double jitter = ik_target_jitter(hand, target, dt, restart);
-  ik_target_jitter_m_[hand] = jitter;
   const auto pair = static_cast<std::size_t>(ik_pair_[hand]);
   if (!target.allFinite() || !captured_wrist.allFinite() || pair >= ik_difference_.size()) {
     return target;
@@ -502,18 +514,12 @@ Quat PartnerContext::steady_hand_turn(std::size_t hand, const Quat& sensed, cons
   if (!turn.allFinite() || pair >= ik_turn_difference_.size()) return sensed;
   // A second difference over 1.5 rad (86 degrees in a frame) is a move, not jitter: white noise
   // of 10 degrees per axis (4 per joint above the hand) gives second differences of 0.4 rad RMS.
-  constexpr double kJitterTimeConstantS = 1.0, kMoveRad = 1.5;
-  double variance = 0.0;
-  for (int axis = 0; axis < 3; ++axis) {
-    JitterMeter& meter = ik_turn_jitter_[hand][static_cast<std::size_t>(axis)];
-    if (restart) meter.restart();
-    meter.add(turn[axis], dt, kJitterTimeConstantS, kMoveRad);
-    variance += meter.rms() * meter.rms();
-  }
+  constexpr double kMoveRad = 1.5;
+  const double jitter = add_vector_jitter(ik_turn_jitter_[hand], turn, dt, kMoveRad, restart);
   // The turn moves the target by about offset_m times its angle: the target's jitter reference
   // in radians. At least 1 cm of lever, so a zero offset does not divide by zero.
   const double reference_rad = p.ik_target_jitter_reference_m / std::max(offset_m, 0.01);
-  return (from * exp_map(ik_turn_difference_[pair].update(turn, std::sqrt(variance), reference_rad,
+  return (from * exp_map(ik_turn_difference_[pair].update(turn, jitter, reference_rad,
                                                           dt, steady_difference_params(p))))
       .normalized();
 }
@@ -535,7 +541,6 @@ void PartnerContext::reset() noexcept {
   for (auto& hand : ik_turn_jitter_) {
     for (JitterMeter& meter : hand) meter.reset();
   }
-  ik_target_jitter_m_.fill(0.0);
   for (SteadyDifference& difference : ik_difference_) difference.reset();
   for (SteadyDifference& difference : ik_turn_difference_) difference.reset();
   for (auto& arm : ik_correction_filter_) {
@@ -838,7 +843,7 @@ bool PartnerSynthesisJob::run() const noexcept {
         std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
         OneEuroParams correction_filter = p.ik_correction_filter;
         if (steady && p.ik_correction_clean_cutoff_hz > correction_filter.min_cutoff_hz) {
-          const double jitter = ctx.ik_target_jitter_m_[r];
+          const double jitter = jitter_rms(ctx.ik_target_jitter_[r]);
           correction_filter.min_cutoff_hz =
               jitter * p.ik_correction_clean_cutoff_hz >
                       correction_filter.min_cutoff_hz * p.ik_target_jitter_reference_m

@@ -363,7 +363,6 @@ class PartnerContext {
   // this frame's target; restart: the target moved on (a jump, another hand held).
   double ik_target_jitter(std::size_t hand, const Vec3& target, double dt, bool restart) noexcept;
   std::array<std::array<JitterMeter, 3>, 2> ik_target_jitter_;  // per hand, per axis
-  std::array<double, 2> ik_target_jitter_m_{};                  // per hand, this frame's reading
   std::array<double, 2> ik_ramp_{0.0, 0.0};  // per response hand, linear fade state in [0, 1]
   std::array<int, 2> ik_pair_{-1, -1};       // pair that last drove that hand
   // IK target continuity, per response hand: last frame's raw and shown targets (valid when the
