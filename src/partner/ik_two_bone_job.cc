@@ -33,6 +33,15 @@ Quat shortest_arc(const Vec3& from, const Vec3& to, const Vec3& axis_hint) {
   return Quat(1.0 + c, axis.x(), axis.y(), axis.z()).normalized();
 }
 
+// The distance the chain reaches for a target at distance d (soft_reach above): d itself up to
+// (1 - soft) of the length, then an exponential approach to the full length.
+double soft_distance(double d, double length, double soft) {
+  const double soft_length = std::clamp(soft, 0.0, 1.0) * length;
+  const double hard = length - soft_length;
+  if (soft_length <= 0.0 || d <= hard) return d;
+  return hard + soft_length * (1.0 - std::exp(-(d - hard) / soft_length));
+}
+
 }  // namespace
 
 std::string_view IkTwoBoneJob::validate() const noexcept {
@@ -46,6 +55,7 @@ std::string_view IkTwoBoneJob::validate() const noexcept {
   if (!finite(target_ws)) return "target_ws is not finite (not set?)";
   if (!std::isfinite(weight)) return "weight is not finite";
   if (!std::isfinite(swivel_offset_rad)) return "swivel_offset_rad is not finite";
+  if (!(soft_reach >= 0.0 && soft_reach <= 1.0)) return "soft_reach is not within [0, 1]";
   if (!finite(start_joint_ws->translation) || !unit(start_joint_ws->rotation)) {
     return "start_joint_ws is not a finite rigid transform with a unit rotation";
   }
@@ -90,7 +100,7 @@ bool IkTwoBoneJob::run() const noexcept {
     }
     // Law of cosines for the interior angle at the elbow, with the distance clamped to what the
     // chain can reach.
-    const double dc = std::clamp(d, std::abs(l1 - l2), l1 + l2);
+    const double dc = std::clamp(soft_distance(d, l1 + l2, soft_reach), std::abs(l1 - l2), l1 + l2);
     const double cos_wanted =
         std::clamp((l1 * l1 + l2 * l2 - dc * dc) / (2.0 * l1 * l2), -1.0, 1.0);
     const double cos_current = std::clamp(-a.dot(b) / (l1 * l2), -1.0, 1.0);

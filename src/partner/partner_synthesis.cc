@@ -362,6 +362,10 @@ std::string PartnerParams::validate() const {
              ")";
     }
   }
+  if (!(ik_soft_reach >= 0.0 && ik_soft_reach < 1.0)) {
+    return "ik_soft_reach must be within [0, 1) (0: none; got " + std::to_string(ik_soft_reach) +
+           ")";
+  }
   if (const std::string_view problem = ik_correction_filter.validate(); !problem.empty()) {
     return "ik_correction_filter: " + std::string(problem);
   }
@@ -824,6 +828,7 @@ bool PartnerSynthesisJob::run() const noexcept {
       Vec3 reached_at = Vec3::Zero();
       IkTwoBoneJob ik = chain_job(chain, captured_start, captured_mid, target);
       ik.weight = weight;
+      ik.soft_reach = p.ik_soft_reach;
       ik.start_rotation_ls_out = &ik_start;
       ik.mid_rotation_ls_out = &ik_mid;
       ik.end_position_ws = &reached_at;
@@ -991,6 +996,7 @@ bool PartnerSynthesisJob::run() const noexcept {
         if (weight > 0.0 && (target - chain.start_ws.translation).norm() < reach) {
           IkTwoBoneJob ik = chain_job(chain, solved[0], solved[1], target);
           ik.weight = weight;
+          ik.soft_reach = p.ik_soft_reach;
           ik.start_rotation_ls_out = &solved[0];
           ik.mid_rotation_ls_out = &solved[1];
           if (!ik.run()) solved = {out_r[chain.start], out_r[chain.mid]};

@@ -148,6 +148,11 @@ TEST(IkTwoBoneJob, ValidatesEveryInput) {
   job = full;
   job.swivel_offset_rad = INFINITY;
   expect_fails(job, "swivel");
+  for (const double soft : {-0.1, 1.5, static_cast<double>(NAN)}) {
+    job = full;
+    job.soft_reach = soft;
+    expect_fails(job, "soft_reach");
+  }
   // Not-unit rotations and non-finite transforms are bad input too.
   const Quat scaled(2.0, 0.0, 0.0, 0.0);
   job = full;
@@ -269,6 +274,69 @@ TEST(IkTwoBoneJob, ElbowDoesNotFlipAlongAContinuousPath) {
   const double fine = largest_elbow_step(16000);
   EXPECT_LT(fine, 0.5 * coarse);
   EXPECT_LT(fine, 0.01);  // metres, for a 0.55 m arm
+}
+
+// Solves from the template pose towards a target `distance` from the shoulder (along a fixed
+// direction) with the given soft reach; returns the elbow's interior angle and where the wrist
+// lands.
+struct SoftSolve {
+  double elbow_angle_rad = 0.0;
+  Vec3 wrist_ws = Vec3::Zero();
+  Vec3 shoulder_ws = Vec3::Zero();
+};
+SoftSolve solve_at_distance(double distance, double soft_reach) {
+  Chain c(Transform(), 1.0);
+  const Vec3 s = c.positions_ws[Chain::kShoulder];
+  const Vec3 direction = Vec3(0.6, -0.3, 0.5).normalized();
+  const Transform sw = c.ws(Chain::kShoulder), m = c.ws(Chain::kElbow), e = c.ws(Chain::kWrist);
+  IkTwoBoneJob job;
+  job.start_joint_ws = &sw;
+  job.mid_joint_ws = &m;
+  job.end_joint_ws = &e;
+  job.start_rotation_ls = &c.rotations_ls[Chain::kShoulder];
+  job.mid_rotation_ls = &c.rotations_ls[Chain::kElbow];
+  job.target_ws = s + distance * direction;
+  job.soft_reach = soft_reach;
+  job.start_rotation_ls_out = &c.rotations_ls[Chain::kShoulder];
+  job.mid_rotation_ls_out = &c.rotations_ls[Chain::kElbow];
+  EXPECT_TRUE(job.run());
+  c.fk();
+  const Vec3 upper = c.positions_ws[Chain::kShoulder] - c.positions_ws[Chain::kElbow];
+  const Vec3 lower = c.positions_ws[Chain::kWrist] - c.positions_ws[Chain::kElbow];
+  return {std::acos(std::clamp(upper.normalized().dot(lower.normalized()), -1.0, 1.0)),
+          c.positions_ws[Chain::kWrist], s};
+}
+
+TEST(IkTwoBoneJob, SoftReachEasesTheLastShareOfTheReach) {
+  const double length = 0.55, soft = 0.1;
+  const double soft_length = soft * length, hard = length - soft_length;
+  // Within the hard share the target is reached exactly.
+  const SoftSolve inside = solve_at_distance(0.8 * length, soft);
+  EXPECT_NEAR((inside.wrist_ws - inside.shoulder_ws).norm(), 0.8 * length, 1e-9);
+  // Beyond it the wrist lands short, on the eased distance, pointing at the target; and however
+  // far the target, the arm never quite straightens (up to the full length, the elbow stays bent
+  // by a few degrees).
+  for (const double distance : {0.95 * length, length, 2.0 * length}) {
+    const SoftSolve eased = solve_at_distance(distance, soft);
+    const double expected = hard + soft_length * (1.0 - std::exp(-(distance - hard) / soft_length));
+    EXPECT_NEAR((eased.wrist_ws - eased.shoulder_ws).norm(), expected, 1e-9) << distance;
+    EXPECT_LT((eased.wrist_ws - eased.shoulder_ws).norm(), std::min(distance, length));
+    if (distance <= length) {
+      EXPECT_LT(eased.elbow_angle_rad, kPi - 0.05) << distance;
+    }
+  }
+  // Why: over the last millimetre before full extension the hard reach turns the elbow by
+  // several degrees (a target jittering by a millimetre there flicks the forearm); the soft one
+  // by a small fraction of that.
+  const double hard_turn = std::abs(solve_at_distance(length, 0.0).elbow_angle_rad -
+                                    solve_at_distance(length - 0.001, 0.0).elbow_angle_rad);
+  const double soft_turn = std::abs(solve_at_distance(length, soft).elbow_angle_rad -
+                                    solve_at_distance(length - 0.001, soft).elbow_angle_rad);
+  EXPECT_GT(hard_turn, 0.08);  // radians: about 7 degrees for this 0.30 + 0.25 m arm
+  EXPECT_LT(soft_turn, 0.1 * hard_turn);
+  // Soft reach 0 is the hard reach: a reachable target is reached at full extension.
+  const SoftSolve straight = solve_at_distance(length, 0.0);
+  EXPECT_NEAR((straight.wrist_ws - straight.shoulder_ws).norm(), length, 1e-9);
 }
 
 TEST(IkTwoBoneJob, KeepsTheElbowOnTheTemplateSide) {

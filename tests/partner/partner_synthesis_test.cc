@@ -1136,6 +1136,11 @@ TEST(PartnerParams, ValidateAndParse) {
   p = PartnerParams();
   p.foot.max_offset_m = NAN;
   EXPECT_NE(p.validate().find("foot.max_offset_m"), std::string::npos);
+  for (const double soft : {-0.1, 1.0, static_cast<double>(NAN)}) {
+    p = PartnerParams();
+    p.ik_soft_reach = soft;
+    EXPECT_NE(p.validate().find("ik_soft_reach"), std::string::npos) << soft;
+  }
 
   p = PartnerParams();
   EXPECT_EQ(corrections_string(p), "align,contact,smooth,footlock,blend");

@@ -52,6 +52,14 @@ struct IkTwoBoneJob {
   // rule). 0 keeps the swivel of the current pose.
   double swivel_offset_rad = 0.0;
 
+  // Soft reach (Harris 2012): the share of the chain's full length (upper + lower bone) over
+  // which reaching out to full extension is eased. Near a straight chain the law of cosines turns
+  // the elbow ever faster per centimetre of target distance (infinitely fast at full extension),
+  // so a target jittering at the edge of the reach snaps the elbow. With a soft share s, a
+  // target beyond (1 - s) of the length is reached to (1 - s) L + s L (1 - exp(-excess / (s L))):
+  // the chain approaches straight smoothly and falls short by at most the excess. 0: off.
+  double soft_reach = 0.0;
+
   // ---- Outputs (owned by the caller; may alias start_rotation_ls / mid_rotation_ls) ----
 
   // Corrected local rotations of the start and mid joints.

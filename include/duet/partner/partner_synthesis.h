@@ -182,6 +182,12 @@ struct PartnerParams {
   // min_cutoff_hz): the filter as given. Measured in docs/evaluation.md ("The IK's correction
   // filtered by the noise").
   double ik_correction_clean_cutoff_hz = 10.0;
+  // contact: the arms' IK eases the last share of the arm's length (IkTwoBoneJob::soft_reach):
+  // near a straight arm the elbow turns ever faster per centimetre the target moves, so a target
+  // at the edge of the reach (a larger user, a hand further out than the capture's) snapped the
+  // elbow. Measured in docs/evaluation.md ("Soft reach"): `harsh@asf` p99 largest joint speed
+  // 1.11x -> 1.09x the captured partner's, `body-size@asf` hand 1.58 -> 1.35 cm. 0: hard reach.
+  double ik_soft_reach = 0.08;
   // smooth: under a noisy sensor the user's wrist, and with it the IK target, jitters (at 4
   // degrees per joint and axis by 6-9 cm a frame), and the IK passed it into the partner's arm
   // (issue 11: the hand 6.7 cm from the user's real hand at 60 Hz, 1.4 cm with the IK off). What
