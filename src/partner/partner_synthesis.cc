@@ -714,14 +714,15 @@ bool PartnerSynthesisJob::run() const noexcept {
   if (need_world) {
     forward_kinematics(skeleton, out_t, out_r, ctx.positions_ws_, ctx.rotations_ws_);
   }
+  Vec3 foot_lock_shift = Vec3::Zero();
   if (p.foot_lock) {
     const std::array<Vec3, 2> feet = {ctx.positions_ws_[static_cast<std::size_t>(roles[kToes[0]])],
                                       ctx.positions_ws_[static_cast<std::size_t>(roles[kToes[1]])]};
-    const Vec3 shift = ctx.foot_locker_.update(feet, planted, p.foot, dt);
-    out_t[0] += shift;
-    for (Vec3& position : ctx.positions_ws_) position += shift;
+    foot_lock_shift = ctx.foot_locker_.update(feet, planted, p.foot, dt);
+    out_t[0] += foot_lock_shift;
+    for (Vec3& position : ctx.positions_ws_) position += foot_lock_shift;
     diagnostics.foot_locked = {ctx.foot_locker_.locked(0), ctx.foot_locker_.locked(1)};
-    diagnostics.foot_lock_offset_ws = shift;
+    diagnostics.foot_lock_offset_ws = foot_lock_shift;
   } else {
     ctx.foot_locker_.reset();
   }
@@ -789,8 +790,12 @@ bool PartnerSynthesisJob::run() const noexcept {
         raw_target += carried_by * offset;
       }
       if (steady) {
+        // The difference is taken from the captured wrist before the foot lock's shift: the
+        // shift is the partner's own and known exactly, so the arm takes it whole; only the
+        // user's difference from the capture is averaged and trusted by its share.
         raw_target = ctx.steady_ik_target(
-            r, raw_target, ctx.positions_ws_[static_cast<std::size_t>(roles[kArms[r].wrist])],
+            r, raw_target,
+            ctx.positions_ws_[static_cast<std::size_t>(roles[kArms[r].wrist])] - foot_lock_shift,
             p.align ? heading.rotation : Quat::Identity(), p, dt, target_restarts);
       }
       // Keep the target continuous across jumps (5.3): the step of the raw target is absorbed
