@@ -19,8 +19,10 @@
 #include "duet/follow/hmm_follower.h"
 #include "duet/io/atomic_write.h"
 #include "eval_non_dance.h"
+#include "eval_recorded.h"
 #include "eval_rigs.h"
 #include "library_options.h"
+#include "motion_options.h"
 #include "number_checks.h"
 #include "progress.h"
 
@@ -43,6 +45,8 @@ struct EvalArgs {
   bool no_partner_metrics = false;
   bool beam = false;
   bool noise_sweep = false;
+  std::vector<std::string> recorded;  // TAKE=FILE
+  MotionFileOptions recorded_motion;
   std::string partner_csv_path;
   CaseSettings settings;
   double noise_cm = 1.0;
@@ -160,8 +164,8 @@ int run_eval(EvalArgs& args) {
   const std::vector<EvalCase> standard = standard_cases(args.settings);
   EvalOptions options;
   std::string error;
-  // --noise-sweep alone runs the sweep only; with --cases, after them.
-  if (args.cases.empty() && !args.noise_sweep) args.cases = {"all"};
+  // --noise-sweep or --recorded alone runs only those; with --cases, after them.
+  if (args.cases.empty() && !args.noise_sweep && args.recorded.empty()) args.cases = {"all"};
   if (!select_cases(args.cases, standard, options.cases, error)) return usage_error(error);
   if (args.noise_sweep) std::ranges::move(noise_sweep_cases(), std::back_inserter(options.cases));
   if (args.trackers.empty()) {
@@ -290,6 +294,16 @@ int run_eval(EvalArgs& args) {
   if (data_dir.empty() && std::getenv("DUET_DATA_DIR") != nullptr) {
     data_dir = std::getenv("DUET_DATA_DIR");
   }
+  // Recorded performances after the chosen cases, loaded before the long run.
+  MotionLoadOptions recorded_load;
+  if (!make_load_options(args.recorded_motion, recorded_load)) return kExitFailure;
+  Result<std::vector<EvalCase>> recorded =
+      load_recorded_cases(args.recorded, recorded_load, *library);
+  if (!recorded) {
+    fmt::print(stderr, "duet eval: {}\n", recorded.error().message);
+    return kExitFailure;
+  }
+  std::ranges::move(recorded.value(), std::back_inserter(options.cases));
   Result<std::vector<EvalRig>> rigs = load_eval_rigs(args.rigs, data_dir, *library);
   if (!rigs) {
     fmt::print(stderr, "duet eval: {}\n", rigs.error().message);
@@ -431,6 +445,15 @@ Command register_eval(CLI::App& app) {
                "Also run noise-sweep-0 ... noise-sweep-5: improv-pause with 0 to 5 degrees of "
                "rotation noise per axis (+1 cm root noise above 0); alone (without --cases) "
                "only these");
+  app.add_option("--recorded", args->recorded,
+                 "A recording of one of the library's takes danced again, scored like the cases "
+                 "(its frame i is the take's moment i / rate), as TAKE=FILE: TAKE a take's name "
+                 "or index, FILE a motion file (e.g. 01=60.asf+60_01.amc, the CMU original of take "
+                 "01). Reported as recorded-TAKE; repeatable or comma-separated; alone (without "
+                 "--cases) only these. --recorded-fps, --recorded-scale, --recorded-map and "
+                 "--recorded-up read the file as --input does for `duet follow`")
+      ->delimiter(',');
+  add_motion_file_options(app, args->recorded_motion, "recorded-");
   app.add_option("--trackers", args->trackers,
                  "Followers, comma-separated (default all): hmm, hmm-paper, left-to-right, "
                  "nearest, online-dtw, naive-hmm (O(M^2), run on the first take alone)")

@@ -626,10 +626,44 @@ Result<Performance> with_rig(Performance performance, std::shared_ptr<const Skel
   return performance;
 }
 
+Result<Performance> recorded_performance(Clip clip, const JointRoles& roles, int take,
+                                         int take_frames, double template_rate_hz) {
+  const double rate = clip.frame_rate();
+  if (!(rate > 0.0) || !std::isfinite(rate)) return Error{"the recording has no frame rate"};
+  if (!(template_rate_hz > 0.0) || !std::isfinite(template_rate_hz)) {
+    return Error{"the take has no frame rate"};
+  }
+  if (take_frames < 2) return Error{"the take has fewer than 2 frames"};
+  // The last frame whose moment is within the take.
+  const double last_moment = static_cast<double>(take_frames - 1) / template_rate_hz;
+  const int frames =
+      std::min(clip.frame_count(), static_cast<int>(std::floor(last_moment * rate + 1e-9)) + 1);
+  if (frames < 2) return Error{"the recording has fewer than 2 frames within the take"};
+  Performance performance;
+  performance.motion = Clip(clip.skeleton_ptr(), rate, frames);
+  for (int f = 0; f < frames; ++f) {
+    std::ranges::copy(clip.translations_ls(f), performance.motion.translations_ls(f).begin());
+    std::ranges::copy(clip.rotations_ls(f), performance.motion.rotations_ls(f).begin());
+  }
+  performance.roles = roles;
+  performance.template_rate_hz = template_rate_hz;
+  performance.times_s.resize(static_cast<std::size_t>(frames));
+  performance.truth.resize(static_cast<std::size_t>(frames));
+  for (int f = 0; f < frames; ++f) {
+    const auto i = static_cast<std::size_t>(f);
+    performance.times_s[i] = static_cast<double>(f) / rate;
+    performance.truth[i].take = take;
+    performance.truth[i].template_frame = static_cast<double>(f) * template_rate_hz / rate;
+  }
+  return performance;
+}
+
 Result<Performance> make_performance(std::span<const SourceTake> sources,
                                      const PerformanceRecipe& recipe, std::uint64_t seed) {
-  if (sources.empty() || sources[0].clip == nullptr) return Error{"no take to perform from"};
-  if (sources[0].clip->frame_count() >= 2) {
+  if (!recipe.recorded && (sources.empty() || sources[0].clip == nullptr)) {
+    return Error{"no take to perform from"};
+  }
+  if (!recipe.recorded && sources[0].clip->frame_count() >= 2) {
     const double frames = frames_bound(*sources[0].clip, recipe);
     if (!(frames <= static_cast<double>(kMaxClipFrames))) {
       return Error{fmt::format(
@@ -639,7 +673,9 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     }
   }
   Performance performance;
-  if (recipe.improvise) {
+  if (recipe.recorded) {
+    performance = *recipe.recorded;
+  } else if (recipe.improvise) {
     ImproviseOptions options = recipe.improvise_options;
     options.seed = derive_seed(seed, 10);
     Result<Performance> improvised = improvise(sources, options);

@@ -451,10 +451,17 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
   report.partner_options = options.partner;
   for (const DuetTake& t : library.takes()) report.take_names.push_back(t.name);
 
-  const long long total =
-      static_cast<long long>(options.cases.size() * options.takes.size() *
-                             (trackers.size() + (options.partner_metrics ? 1 : 0))) +
-      (naive ? 1 : 0);
+  // A recorded case is performed once, from its own take; every other case from each take.
+  const auto takes_of = [&](const EvalCase& eval_case) {
+    return eval_case.recipe.recorded && !eval_case.recipe.recorded->truth.empty()
+               ? std::vector<int>{eval_case.recipe.recorded->truth.front().take}
+               : options.takes;
+  };
+  long long total = naive ? 1 : 0;
+  for (const EvalCase& eval_case : options.cases) {
+    total += static_cast<long long>(takes_of(eval_case).size() *
+                                    (trackers.size() + (options.partner_metrics ? 1 : 0)));
+  }
   long long done = 0;
 
   for (const EvalCase& eval_case : options.cases) {
@@ -468,8 +475,13 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
     std::vector<std::vector<std::pair<int, PartnerMetrics>>> partner_per_take(configs);
     double loop_us_sum = 0.0;
     long long loop_frames = 0;
-    for (std::size_t ti = 0; ti < options.takes.size(); ++ti) {
-      const int take = options.takes[ti];
+    const std::vector<int> case_takes = takes_of(eval_case);
+    for (std::size_t ti = 0; ti < case_takes.size(); ++ti) {
+      const int take = case_takes[ti];
+      if (take < 0 || take >= static_cast<int>(lib.takes().size())) {
+        return Error{"case " + eval_case.name + ": take " + std::to_string(take) +
+                     " is not in the library"};
+      }
       const std::vector<SourceTake> sources = sources_for(lib, take, eval_case.across_takes);
       Result<Performance> made = make_performance(
           sources, eval_case.recipe,
@@ -545,7 +557,9 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
   if (naive) {
     // On naive_case if it performs in the user's role from one take, else on the first case that
     // does.
-    const auto eligible = [](const EvalCase& c) { return !c.partner_role && !c.across_takes; };
+    const auto eligible = [](const EvalCase& c) {
+      return !c.partner_role && !c.across_takes && !c.recipe.recorded;
+    };
     const EvalCase* chosen = nullptr;
     for (const EvalCase& c : options.cases) {
       if (c.name == options.naive_case && eligible(c)) chosen = &c;

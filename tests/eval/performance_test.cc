@@ -615,6 +615,42 @@ TEST(MakePerformance, ABodySizeOnAnotherRigIsThatRigsBodyScaled) {
   EXPECT_NEAR(head_to_foot_m(1.15) / head_to_foot_m(1.0), 1.15, 1e-6);
 }
 
+TEST(RecordedPerformance, FrameIIsTheTakesMomentIOverTheRecordingsRate) {
+  // A 120 Hz recording of a 60 Hz take, 50 frames longer than the take: frame i is template
+  // frame i / 2, and what runs past the take's end is cut off.
+  const Fixture take = make_fixture(300);
+  const Fixture recording{make_dance(make_role_skeleton(), 120.0, 650),
+                          daz_roles(*make_role_skeleton())};
+  Result<Performance> made =
+      recorded_performance(recording.clip, recording.roles, 5, take.clip.frame_count(), 60.0);
+  ASSERT_TRUE(made) << made.error().message;
+  const Performance& p = made.value();
+  ASSERT_EQ(p.frame_count(), 599);  // moments 0 .. 299 / 60 s at 120 Hz
+  ASSERT_EQ(p.truth.size(), 599u);
+  EXPECT_EQ(p.truth[0].take, 5);
+  EXPECT_DOUBLE_EQ(p.truth[301].template_frame, 150.5);
+  EXPECT_DOUBLE_EQ(p.truth.back().template_frame, 299.0);
+  EXPECT_DOUBLE_EQ(p.times_s[240], 2.0);
+  EXPECT_DOUBLE_EQ(p.template_rate_hz, 60.0);
+  EXPECT_EQ(p.motion.rotations_ls(100)[3].coeffs(), recording.clip.rotations_ls(100)[3].coeffs());
+  EXPECT_TRUE(p.true_wrists_ws.empty());  // a recording's wrists are the real ones
+
+  // Made into a case: the perturbations of the recipe still apply, and it needs no sources.
+  PerformanceRecipe recipe;
+  recipe.recorded = std::make_shared<const Performance>(p);
+  recipe.noise = {2.0, 0.0, 0};
+  Result<Performance> noisy = make_performance({}, recipe, 3);
+  ASSERT_TRUE(noisy) << noisy.error().message;
+  EXPECT_EQ(noisy.value().frame_count(), 599);
+  EXPECT_EQ(noisy.value().true_wrists_ws.size(), 599u);
+
+  // Bad input.
+  EXPECT_FALSE(recorded_performance(recording.clip, recording.roles, 5, 1, 60.0));
+  EXPECT_FALSE(recorded_performance(recording.clip, recording.roles, 5, 300, 0.0));
+  const Fixture one{make_dance(make_role_skeleton(), 120.0, 1), daz_roles(*make_role_skeleton())};
+  EXPECT_FALSE(recorded_performance(one.clip, one.roles, 5, 300, 60.0));
+}
+
 TEST(MakePerformance, RecordsTheRealWristsBeforeTheNoise) {
   // The partner metrics score the partner's hands against the user's real hands: the wrists as
   // they were before the sensor's noise, kept in step with dropped and repeated frames.

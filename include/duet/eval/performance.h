@@ -114,6 +114,14 @@ struct ImproviseOptions {
 // uses sources[0]'s skeleton and roles.
 Result<Performance> improvise(std::span<const SourceTake> sources, const ImproviseOptions& options);
 
+// A recording of one take danced again (a real capture of the same dance, e.g. take 01 on the
+// CMU ASF rig): frame i, at the recording's own rate, is moment i / rate of the take, so its truth
+// is template frame i * template_rate_hz / rate. `clip` must be in metres and Y up (as
+// load_motion gives it) and `roles` name its joints. Frames past the take's last frame are cut
+// off. Error when the clip has fewer than 2 frames, no positive frame rate, or `take_frames` < 2.
+Result<Performance> recorded_performance(Clip clip, const JointRoles& roles, int take,
+                                         int take_frames, double template_rate_hz);
+
 // Per-frame sensor noise: every joint's local rotation is multiplied by a random rotation whose
 // rotation vector has independent normal components (RMS angle rotation_deg), and the root's
 // position channels get independent normal noise (per-axis standard deviation position_m; other
@@ -211,6 +219,9 @@ Result<Performance> with_head_hands(Performance performance, const PointNoiseOpt
 // (full body only), head and hands, frame loss. Each stage's seed is
 // derived from `seed`.
 struct PerformanceRecipe {
+  // A recorded performance (recorded_performance) performed instead of playing or improvising
+  // from the sources; the perturbations below still apply. Its truth names its take.
+  std::shared_ptr<const Performance> recorded;
   bool improvise = false;
   PlayOptions play;                    // when !improvise (seed ignored)
   ImproviseOptions improvise_options;  // when improvise (seed ignored)
@@ -228,7 +239,8 @@ struct PerformanceRecipe {
   FrameLossOptions loss;  // seed ignored
 };
 
-// sources[0] is the performed take (play); improvise draws from all of them. A recipe that
+// sources[0] is the performed take (play); improvise draws from all of them; a recorded
+// performance needs no sources. A recipe that
 // would make more than kMaxClipFrames frames (a long duration at a high rate, a slow tempo) is
 // an error before anything is made.
 Result<Performance> make_performance(std::span<const SourceTake> sources,

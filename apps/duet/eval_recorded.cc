@@ -1,0 +1,71 @@
+#include "eval_recorded.h"
+
+#include <charconv>
+#include <memory>
+
+#include "duet/eval/performance.h"
+#include "duet/io/motion_argument.h"
+
+namespace duet::app {
+
+namespace {
+
+// The library index of `word`: a take's name, else a take index; -1 when neither.
+int find_take(const DuetLibrary& library, const std::string& word) {
+  const auto& takes = library.takes();
+  for (std::size_t k = 0; k < takes.size(); ++k) {
+    if (takes[k].name == word) return static_cast<int>(k);
+  }
+  int index = -1;
+  const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), index);
+  if (error == std::errc() && end == word.data() + word.size() && index >= 0 &&
+      index < static_cast<int>(takes.size())) {
+    return index;
+  }
+  return -1;
+}
+
+std::string take_names(const DuetLibrary& library) {
+  std::string names;
+  for (const DuetTake& take : library.takes()) names += (names.empty() ? "" : ", ") + take.name;
+  return names;
+}
+
+}  // namespace
+
+Result<std::vector<EvalCase>> load_recorded_cases(const std::vector<std::string>& entries,
+                                                  const MotionLoadOptions& load_options,
+                                                  const DuetLibrary& library) {
+  std::vector<EvalCase> cases;
+  for (const std::string& entry : entries) {
+    const std::string where = "--recorded " + entry;
+    const std::size_t equals = entry.find('=');
+    if (equals == std::string::npos || equals == 0 || equals + 1 == entry.size()) {
+      return Error{where + ": expected TAKE=FILE, e.g. 01=60.asf+60_01.amc"};
+    }
+    const std::string take_word = entry.substr(0, equals);
+    const int take = find_take(library, take_word);
+    if (take < 0) {
+      return Error{where + ": no take '" + take_word +
+                   "' in the library (its takes: " + take_names(library) + ")"};
+    }
+    Result<std::vector<std::string>> paths = split_motion_argument(entry.substr(equals + 1));
+    if (!paths) return Error{where + ": " + paths.error().message};
+    Result<LoadedMotion> loaded = load_motion(paths.value(), load_options);
+    if (!loaded) return Error{where + ": " + loaded.error().message};
+    const DuetTake& source = library.takes()[static_cast<std::size_t>(take)];
+    const Clip& template_clip = source.template_motion.clip;
+    Result<Performance> performance =
+        recorded_performance(std::move(loaded.value().clip), loaded.value().roles, take,
+                             template_clip.frame_count(), template_clip.frame_rate());
+    if (!performance) return Error{where + ": " + performance.error().message};
+    EvalCase recorded;
+    recorded.name = "recorded-" + source.name;
+    recorded.description = "take " + source.name + " recorded in " + loaded.value().description;
+    recorded.recipe.recorded = std::make_shared<const Performance>(std::move(performance).value());
+    cases.push_back(std::move(recorded));
+  }
+  return cases;
+}
+
+}  // namespace duet::app
