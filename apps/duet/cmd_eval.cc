@@ -71,8 +71,8 @@ struct EvalArgs {
   std::optional<float> outlier_pause_fraction;
   std::optional<int> dtw_back, dtw_ahead;
   // Feature weights (FeatureSpec); unset keeps the defaults.
-  std::optional<double> posture_weight, root_velocity_weight, effector_speed_weight,
-      velocity_window;
+  std::optional<double> posture_weight, head_hands_posture_weight, root_velocity_weight,
+      effector_speed_weight, velocity_window;
 };
 
 constexpr const char* kCommand = "eval";
@@ -243,6 +243,9 @@ int run_eval(EvalArgs& args) {
 
   FeatureSpec features;
   if (args.posture_weight) features.posture_weight = *args.posture_weight;
+  if (args.head_hands_posture_weight) {
+    features.head_hands_posture_weight = *args.head_hands_posture_weight;
+  }
   if (args.root_velocity_weight) features.root_velocity_weight = *args.root_velocity_weight;
   if (args.effector_speed_weight) features.effector_speed_weight = *args.effector_speed_weight;
   if (args.velocity_window) features.velocity_window_s = *args.velocity_window;
@@ -642,6 +645,10 @@ Command register_eval(CLI::App& app) {
   tuning->add_option("--dtw-ahead", args->dtw_ahead, "online DTW window ahead of the estimate")
       ->check(non_negative_check());
   tuning->add_option("--posture-weight", args->posture_weight, "FeatureSpec posture_weight")
+      ->check(non_negative_check());
+  tuning
+      ->add_option("--head-hands-posture-weight", args->head_hands_posture_weight,
+                   "FeatureSpec head_hands_posture_weight (the posture weight of three points)")
       ->check(non_negative_check());
   tuning
       ->add_option("--root-velocity-weight", args->root_velocity_weight,

@@ -252,7 +252,7 @@ FeatureNormalizer FeatureNormalizer::fit(const FeatureMatrix& raw, const Feature
   normalizer.mean_ = mean.cast<float>();
   for (int b = 0; b < kFeatureBlockCount; ++b) {
     const auto block = static_cast<FeatureBlock>(b);
-    const double weight = block == FeatureBlock::kPosture        ? spec.posture_weight
+    const double weight = block == FeatureBlock::kPosture        ? spec.posture_block_weight()
                           : block == FeatureBlock::kRootVelocity ? spec.root_velocity_weight
                                                                  : spec.effector_speed_weight;
     const int begin = spec.block_begin(block);

@@ -210,6 +210,16 @@ TEST(FeatureNormalizer, FloorsTinyDeviationsAndWeighsBlocks) {
   n.apply(rows);
   EXPECT_NEAR(rows.col(0).mean(), 0.0f, 1e-5f);
   EXPECT_TRUE(rows.allFinite());
+
+  // Three points weigh their posture block by head_hands_posture_weight, not posture_weight.
+  FeatureSpec points;
+  points.input_points = InputPoints::kHeadHands;
+  points.posture_weight = 9.0;  // not used for three points
+  FeatureMatrix raw_points = FeatureMatrix::Zero(100, points.dimension());
+  for (int f = 0; f < 100; ++f) raw_points(f, 0) = static_cast<float>(f % 2);  // std 0.5
+  const FeatureNormalizer p = FeatureNormalizer::fit(raw_points, points);
+  EXPECT_NEAR(p.scale()[0],
+              points.head_hands_posture_weight / (std::sqrt(points.posture_dims()) * 0.5), 1e-5);
 }
 
 }  // namespace

@@ -63,6 +63,18 @@ struct FeatureSpec {
   // 99.8% of frames within 100 ms in `duet eval` (docs/evaluation.md).
   double root_velocity_weight = 0.3;
   double effector_speed_weight = 0.3;
+  // Three points (kHeadHands) weigh their posture block (the hands relative to the head, the
+  // head's height) by this instead of posture_weight. Those positions are where a rig puts its
+  // head and wrist joints (or a headset its eyes and a controller its grip): on the original CMU
+  // ASF fit of take 01 the hands sit 10 cm wider and 9 cm lower below the head than on the
+  // library's BVH, 0.4-0.95 standard deviations per dimension, and at weight 1 that recording was
+  // followed on 36 % of frames, 94 % lost. 0.5: 92 % (docs/evaluation.md, "Three points on
+  // another rig"); below it the Bandai dance and wave stop being lost.
+  double head_hands_posture_weight = 0.5;
+  // The posture block's weight for these input points.
+  double posture_block_weight() const {
+    return input_points == InputPoints::kHeadHands ? head_hands_posture_weight : posture_weight;
+  }
 
   // Velocities are differences over at least this much real time (not one frame): a live sensor
   // jitters by millimetres per frame, which a 1/120 s difference would turn into large speeds.
