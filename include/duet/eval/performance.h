@@ -240,9 +240,8 @@ struct PerformanceRecipe {
 };
 
 // sources[0] is the performed take (play); improvise draws from all of them; a recorded
-// performance needs no sources. A recipe that
-// would make more than kMaxClipFrames frames (a long duration at a high rate, a slow tempo) is
-// an error before anything is made.
+// performance needs no sources. A recipe that would make more than kMaxClipFrames frames (a long
+// duration at a high rate, a slow tempo) is an error before anything is made.
 Result<Performance> make_performance(std::span<const SourceTake> sources,
                                      const PerformanceRecipe& recipe, std::uint64_t seed);
 
