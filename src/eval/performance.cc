@@ -640,11 +640,8 @@ Result<Performance> recorded_performance(Clip clip, const JointRoles& roles, int
       std::min(clip.frame_count(), static_cast<int>(std::floor(last_moment * rate + 1e-9)) + 1);
   if (frames < 2) return Error{"the recording has fewer than 2 frames within the take"};
   Performance performance;
-  performance.motion = Clip(clip.skeleton_ptr(), rate, frames);
-  for (int f = 0; f < frames; ++f) {
-    std::ranges::copy(clip.translations_ls(f), performance.motion.translations_ls(f).begin());
-    std::ranges::copy(clip.rotations_ls(f), performance.motion.rotations_ls(f).begin());
-  }
+  clip.keep_first_frames(frames);
+  performance.motion = std::move(clip);
   performance.roles = roles;
   performance.template_rate_hz = template_rate_hz;
   performance.times_s.resize(static_cast<std::size_t>(frames));

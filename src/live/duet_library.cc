@@ -53,14 +53,7 @@ Status check_duet(const std::string& what, LoadedMotion& leader, LoadedMotion& p
                    std::to_string(partner.clip.frame_count()) +
                    "); a duet is captured together (use --trim to cut to the shorter)"};
     }
-    for (LoadedMotion* m : {&leader, &partner}) {
-      Clip trimmed(m->clip.skeleton_ptr(), m->clip.frame_rate(), frames);
-      for (int f = 0; f < frames; ++f) {
-        std::ranges::copy(m->clip.translations_ls(f), trimmed.translations_ls(f).begin());
-        std::ranges::copy(m->clip.rotations_ls(f), trimmed.rotations_ls(f).begin());
-      }
-      m->clip = std::move(trimmed);
-    }
+    for (LoadedMotion* m : {&leader, &partner}) m->clip.keep_first_frames(frames);
   }
   if (frames < 3) return Error{what + ": a duet needs at least 3 frames"};
   return Ok{};

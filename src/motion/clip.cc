@@ -81,4 +81,12 @@ void Clip::scale_lengths(double factor) {
   for (Vec3& t : translations_ls_) t *= factor;
 }
 
+void Clip::keep_first_frames(int count) {
+  assert(count >= 0);
+  if (count >= frame_count_) return;
+  frame_count_ = count;
+  translations_ls_.resize(frame_begin(count, joint_count()));
+  rotations_ls_.resize(translations_ls_.size());
+}
+
 }  // namespace duet

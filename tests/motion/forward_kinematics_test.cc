@@ -56,6 +56,17 @@ TEST(Clip, ScaleLengthsScalesOffsetsAndTranslations) {
   EXPECT_LT((clip.translations_ls(0)[2] - Vec3(0.8, 0, 0)).norm(), 1e-12);
 }
 
+TEST(Clip, KeepFirstFramesDropsTheRest) {
+  Clip clip(make_arm(), 60.0, 5);
+  for (int f = 0; f < 5; ++f) clip.translations_ls(f)[0] = Vec3(f, 0, 0);
+  clip.keep_first_frames(9);  // more than it has: unchanged
+  EXPECT_EQ(clip.frame_count(), 5);
+  clip.keep_first_frames(3);
+  ASSERT_EQ(clip.frame_count(), 3);
+  EXPECT_EQ(clip.translations_ls(2)[0], Vec3(2, 0, 0));
+  EXPECT_EQ(clip.rotations_ls(2).size(), static_cast<std::size_t>(clip.joint_count()));
+}
+
 TEST(Resample, HalvesTheRateWithSlerp) {
   Clip clip(make_arm(), 60.0, 5);
   for (int f = 0; f < 5; ++f) {

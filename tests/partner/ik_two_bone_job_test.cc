@@ -68,7 +68,8 @@ struct Solve {
 };
 
 // Runs the job on the chain, writes the corrected local rotations back and redoes FK.
-Solve solve(Chain& c, const Vec3& target, double weight = 1.0, double swivel = 0.0) {
+Solve solve(Chain& c, const Vec3& target, double weight = 1.0, double swivel = 0.0,
+            double soft_reach = 0.0) {
   const Transform s = c.ws(Chain::kShoulder), m = c.ws(Chain::kElbow), e = c.ws(Chain::kWrist);
   Solve out;
   IkTwoBoneJob job;
@@ -80,6 +81,7 @@ Solve solve(Chain& c, const Vec3& target, double weight = 1.0, double swivel = 0
   job.target_ws = target;
   job.weight = weight;
   job.swivel_offset_rad = swivel;
+  job.soft_reach = soft_reach;
   job.start_rotation_ls_out = &c.rotations_ls[Chain::kShoulder];  // in place
   job.mid_rotation_ls_out = &c.rotations_ls[Chain::kElbow];
   job.reached = &out.reached;
@@ -288,19 +290,7 @@ SoftSolve solve_at_distance(double distance, double soft_reach) {
   Chain c(Transform(), 1.0);
   const Vec3 s = c.positions_ws[Chain::kShoulder];
   const Vec3 direction = Vec3(0.6, -0.3, 0.5).normalized();
-  const Transform sw = c.ws(Chain::kShoulder), m = c.ws(Chain::kElbow), e = c.ws(Chain::kWrist);
-  IkTwoBoneJob job;
-  job.start_joint_ws = &sw;
-  job.mid_joint_ws = &m;
-  job.end_joint_ws = &e;
-  job.start_rotation_ls = &c.rotations_ls[Chain::kShoulder];
-  job.mid_rotation_ls = &c.rotations_ls[Chain::kElbow];
-  job.target_ws = s + distance * direction;
-  job.soft_reach = soft_reach;
-  job.start_rotation_ls_out = &c.rotations_ls[Chain::kShoulder];
-  job.mid_rotation_ls_out = &c.rotations_ls[Chain::kElbow];
-  EXPECT_TRUE(job.run());
-  c.fk();
+  EXPECT_TRUE(solve(c, s + distance * direction, 1.0, 0.0, soft_reach).ok);
   const Vec3 upper = c.positions_ws[Chain::kShoulder] - c.positions_ws[Chain::kElbow];
   const Vec3 lower = c.positions_ws[Chain::kWrist] - c.positions_ws[Chain::kElbow];
   return {std::acos(std::clamp(upper.normalized().dot(lower.normalized()), -1.0, 1.0)),

@@ -57,6 +57,8 @@ class Clip {
 
   // Multiplies every translation (offsets and animated) by `factor`. Used for unit conversion.
   void scale_lengths(double factor);
+  // Drops every frame from `count` on (0 <= count; a count at or over frame_count keeps all).
+  void keep_first_frames(int count);
 
  private:
   std::shared_ptr<const Skeleton> skeleton_;
