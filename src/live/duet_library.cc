@@ -8,6 +8,7 @@
 #include "duet/follow/copy_places.h"
 #include "duet/follow/model_cache.h"
 #include "duet/io/motion_argument.h"
+#include "duet/motion/head_hands.h"
 
 namespace duet {
 
@@ -103,6 +104,11 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
     Result<FeatureExtractor> extractor = FeatureExtractor::create(
         take.template_motion.clip.skeleton_ptr(), take.template_motion.roles, options.features);
     if (!extractor) return Error{what + ": " + extractor.error().message};
+    if (options.features.input_points == InputPoints::kHeadHands) {
+      Result<Quat> head = head_correction(take.template_motion.clip, take.template_motion.roles);
+      if (!head) return Error{what + ": " + head.error().message};
+      extractor.value().set_head_correction(head.value());
+    }
     raw_features.push_back(extractor.value().extract_clip(take.template_motion.clip));
     total_frames += take.template_motion.clip.frame_count();
     library.takes_.push_back(std::move(take));

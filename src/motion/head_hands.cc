@@ -1,6 +1,8 @@
 #include "duet/motion/head_hands.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "duet/math/rotation.h"
 #include "duet/motion/body_space.h"
@@ -38,25 +40,97 @@ bool is_head_hands_input(const JointRoles& roles) {
 
 Quat head_hands_device_correction() { return yaw_rotation(kPi); }
 
-Result<Quat> rest_pose_correction(const Skeleton& skeleton, const JointRoles& roles) {
-  if (is_head_hands_input(roles)) return head_hands_device_correction();
+namespace {
+
+// The rest pose's joint positions (every rotation the identity), stood on +Y when the rig has
+// feet and a head: a rig exported Z-up stands along +Z in its rest pose, so its up is found
+// (feet to head, to the nearest axis) and turned to +Y. `to_y_up` is that turn.
+std::vector<Vec3> upright_rest_positions(const Skeleton& skeleton, const JointRoles& roles,
+                                         Quat& to_y_up) {
   const auto n = static_cast<std::size_t>(skeleton.joint_count());
   std::vector<Vec3> translations(n), positions(n);
   std::vector<Quat> rotations(n, Quat::Identity()), world_rotations(n);
   for (std::size_t j = 0; j < n; ++j) translations[j] = skeleton.joints[j].offset;
   forward_kinematics(skeleton, translations, rotations, positions, world_rotations);
-  // A rig exported Z-up stands along +Z in its rest pose: find its up (feet to head, to the
-  // nearest axis), stand it on +Y to read its heading, and turn the frame back.
-  Quat to_y_up = Quat::Identity();
+  to_y_up = Quat::Identity();
   if (has_feet_and_head(roles, skeleton.joint_count())) {
     to_y_up = rotation_to_y_up(nearest_axis(feet_to_head(positions, roles)));
     for (Vec3& p : positions) p = to_y_up * p;
   }
+  return positions;
+}
+
+// The mean of unit quaternions, each first put in the hemisphere of the first (q and -q are one
+// rotation). Good for rotations that spread over well under a half turn.
+Quat mean_rotation(const std::vector<Quat>& rotations) {
+  Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+  for (const Quat& q : rotations) {
+    const Eigen::Vector4d v = q.coeffs();
+    sum += v.dot(rotations.front().coeffs()) < 0.0 ? Eigen::Vector4d(-v) : v;
+  }
+  Quat mean;
+  mean.coeffs() = sum.normalized();
+  return mean;
+}
+
+}  // namespace
+
+Result<Quat> rest_pose_correction(const Skeleton& skeleton, const JointRoles& roles) {
+  if (is_head_hands_input(roles)) return head_hands_device_correction();
+  Quat to_y_up;
+  const std::vector<Vec3> positions = upright_rest_positions(skeleton, roles, to_y_up);
   const double yaw = body_heading_yaw(positions, roles);
   if (!std::isfinite(yaw)) {
     return Error{"the rest pose has no heading (hip joints at one place?)"};
   }
   return to_y_up.conjugate() * yaw_rotation(yaw);
+}
+
+bool rest_pose_stands(const Skeleton& skeleton, const JointRoles& roles) {
+  if (!has_feet_and_head(roles, skeleton.joint_count())) return true;  // nothing to tell by
+  for (Role role : {Role::kLeftHip, Role::kRightHip}) {
+    if (roles[role] < 0 || roles[role] >= skeleton.joint_count()) return true;
+  }
+  Quat to_y_up;
+  const std::vector<Vec3> positions = upright_rest_positions(skeleton, roles, to_y_up);
+  auto height_of = [&](Role role) { return positions[static_cast<std::size_t>(roles[role])].y(); };
+  const double pelvis = pelvis_centre(positions, roles).y();
+  const double lowest = std::min(height_of(Role::kLeftAnkle), height_of(Role::kRightAnkle));
+  const double height = height_of(Role::kHead) - lowest;
+  if (!(height > 0.0)) return false;
+  // A standing body's ankles are about half its height below the pelvis (0.45-0.5 in the salsa,
+  // ASF and handshake rigs' rest poses), its head about 0.4 above it.
+  return height_of(Role::kLeftAnkle) < pelvis - 0.3 * height &&
+         height_of(Role::kRightAnkle) < pelvis - 0.3 * height &&
+         height_of(Role::kHead) > pelvis + 0.2 * height;
+}
+
+Result<Quat> head_correction(const Clip& full_body, const JointRoles& roles) {
+  if (rest_pose_stands(full_body.skeleton(), roles)) {
+    return rest_pose_correction(full_body.skeleton(), roles);
+  }
+  const int head = roles[Role::kHead];
+  if (head < 0 || head >= full_body.joint_count()) return Error{"no joint for role head"};
+  const auto n = static_cast<std::size_t>(full_body.joint_count());
+  std::vector<Vec3> positions(n);
+  std::vector<Quat> world(n);
+  std::vector<Quat> per_frame;
+  per_frame.reserve(static_cast<std::size_t>(full_body.frame_count()));
+  for (int f = 0; f < full_body.frame_count(); ++f) {
+    forward_kinematics(full_body.skeleton(), full_body.translations_ls(f),
+                       full_body.rotations_ls(f), positions, world);
+    const double yaw = body_heading_yaw(positions, roles);
+    // R_head * correction = the pelvis's heading frame, frame by frame.
+    if (std::isfinite(yaw)) {
+      per_frame.push_back(world[static_cast<std::size_t>(head)].conjugate() * yaw_rotation(yaw));
+    }
+  }
+  if (per_frame.empty()) {
+    return Error{
+        "the rest pose does not stand and no frame has a heading (hip joints at one place?), so "
+        "where the head faces is unknown"};
+  }
+  return mean_rotation(per_frame);
 }
 
 Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles) {
@@ -67,7 +141,7 @@ Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles) {
                    " (three points need a head and two wrists)"};
     }
   }
-  Result<Quat> correction = rest_pose_correction(full_body.skeleton(), roles);
+  Result<Quat> correction = head_correction(full_body, roles);
   if (!correction) return correction.error();
   // R_device * device_correction = R_world * rest correction: the same canonical frame.
   const Quat to_device = correction.value() * head_hands_device_correction().conjugate();

@@ -23,7 +23,7 @@ Result<HeadHandsBody> HeadHandsBody::build(const Clip& template_clip,
   if (head < 0 || head >= template_clip.joint_count()) {
     return Error{"the template has no head joint (role head)"};
   }
-  Result<Quat> correction = rest_pose_correction(template_clip.skeleton(), template_roles);
+  Result<Quat> correction = head_correction(template_clip, template_roles);
   if (!correction) return Error{"the template: " + correction.error().message};
   HeadHandsBody body;
   body.template_correction_ = correction.value();

@@ -24,8 +24,9 @@ struct NonDanceResult {
 };
 
 // Every frame of `input` (any rig whose body roles are known) through a follow session of
-// `library` with `tracker`, at the clip's own timing. An error when the session cannot be made
-// (the rig lacks roles the features need).
+// `library` with `tracker`, at the clip's own timing; for a three-point library, the clip's head
+// and hands (head_hands_clip), as a headset would give them. An error when the session cannot be
+// made (the rig lacks roles the features need).
 Result<NonDanceResult> follow_non_dance(const DuetLibrary& library, const LoadedMotion& input,
                                         std::string name, std::unique_ptr<Tracker> tracker);
 

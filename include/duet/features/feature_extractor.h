@@ -67,6 +67,11 @@ class FeatureExtractor {
   // Raw features of every frame of a clip (a fresh context, frame times from the clip's rate).
   FeatureMatrix extract_clip(const Clip& clip) const;
 
+  // Head and hands from a full-body rig: the head's correction, which create() reads from the
+  // rest pose. A template gives head_correction(clip, roles) here, right also for a rig whose
+  // rest pose does not stand.
+  void set_head_correction(const Quat& correction) noexcept { head_correction_ = correction; }
+
  private:
   FeatureExtractor() = default;
   // A role's point in the canonical body (see BodySegment): the pelvis centre for kHips, the

@@ -69,7 +69,8 @@ struct FeatureSpec {
   // ASF fit of take 01 the hands sit 10 cm wider and 9 cm lower below the head than on the
   // library's BVH, 0.4-0.95 standard deviations per dimension, and at weight 1 that recording was
   // followed on 36 % of frames, 94 % lost. 0.5: 92 % (docs/evaluation.md, "Three points on
-  // another rig"); below it the Bandai dance and wave stop being lost.
+  // another rig"), at a price: the Bandai dance and wave as three points are lost on 85 / 80 % of
+  // frames (0.7: 100 / 97.5 %, the recording 78 %); below 0.5 they pass for salsa.
   double head_hands_posture_weight = 0.5;
   // The posture block's weight for these input points.
   double posture_block_weight() const {

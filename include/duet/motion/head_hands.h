@@ -6,7 +6,8 @@
 // Orientation convention (the devices', WebXR's and OpenXR's): the identity faces -Z with +Y up.
 // From a full-body take, a point's orientation is its joint's world rotation relative to the rest
 // pose, turned so the rest pose faces -Z: a dancer standing in the rest pose looks straight ahead
-// with the "controllers" pointing forward.
+// with the "controllers" pointing forward. A rig whose rest pose is no standing body turns the
+// head, on average over the take, to where its pelvis faces instead (head_correction).
 #pragma once
 
 #include <memory>
@@ -37,8 +38,20 @@ bool is_head_hands_input(const JointRoles& roles);
 Quat head_hands_device_correction();
 Result<Quat> rest_pose_correction(const Skeleton& skeleton, const JointRoles& roles);
 
+// Whether a full-body rig's rest pose (every rotation the identity) is a standing body, the
+// premise of rest_pose_correction: both ankles well below the pelvis and the head above it, after
+// the rig's up turn. The Bandai rig's rest pose is not (every bone along one axis, one leg up):
+// its rest heading put the head of its own clips 40-50 degrees off the pelvis's heading.
+bool rest_pose_stands(const Skeleton& skeleton, const JointRoles& roles);
+
+// The head's correction for a full-body clip: rest_pose_correction when the rest pose stands,
+// otherwise the one that turns the head, on average over the clip, to the pelvis's heading (a
+// dancer looks where the body faces, give or take a turn of the head).
+Result<Quat> head_correction(const Clip& full_body, const JointRoles& roles);
+
 // The three points of a full-body clip (any rig with head and wrist roles), on the head-and-hands
-// skeleton, at the clip's rate: what a headset and controllers would have reported.
+// skeleton, at the clip's rate: what a headset and controllers would have reported. The head's
+// orientation goes through head_correction.
 Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles);
 
 }  // namespace duet

@@ -43,7 +43,7 @@ class HeadHandsBody {
  private:
   std::vector<Transform> head_in_body_;
   double template_head_height_m_ = 0.0;
-  Quat template_correction_ = Quat::Identity();  // rest_pose_correction of the template's rig
+  Quat template_correction_ = Quat::Identity();  // head_correction of the template
 };
 
 }  // namespace duet
