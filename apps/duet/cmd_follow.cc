@@ -52,8 +52,10 @@ Status write_partner_on_rig(const FollowArgs& args, const Clip& partner,
   }
   Result<LoadedMotion> rig = load_motion(paths.value(), options);
   if (!rig) return Error{"--partner-rig: " + rig.error().message};
+  RetargetOptions retarget;
+  set_head_corrections(retarget, partner, partner_roles, rig.value().clip, rig.value().roles);
   Result<Clip> moved = retarget_clip(partner, partner_roles, rig.value().clip.skeleton_ptr(),
-                                     rig.value().roles, {}, "the partner", args.partner_rig);
+                                     rig.value().roles, retarget, "the partner", args.partner_rig);
   if (!moved) return Error{"--partner-rig: " + moved.error().message};
   turn_to_file_world(moved.value(), user_to_y_up);  // into the user's world
   return write_bvh(moved.value(), args.output_path,

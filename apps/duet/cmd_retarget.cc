@@ -87,9 +87,13 @@ int run_retarget(const RetargetArgs& args) {
     return kExitFailure;
   }
 
-  // The target: the rig file's skeleton (its motion is not used), or the input's own.
+  // The target: the rig file's skeleton (its motion says only where its head faces, when its
+  // rest pose is no standing body), or the input's own.
   Skeleton rig_skeleton = source.value().clip.skeleton();
   JointRoles rig_roles = source.value().roles;
+  RetargetOptions options;
+  options.stride_scale = args.stride_scale;
+  options.feet_on_floor = !args.no_feet;
   double rig_metres_per_unit = source.value().metres_per_unit;
   std::string rig_name = source.value().description;
   if (!rig_files.empty()) {
@@ -105,6 +109,8 @@ int run_retarget(const RetargetArgs& args) {
     }
     rig_skeleton = rig.value().clip.skeleton();
     rig_roles = rig.value().roles;
+    set_head_corrections(options, source.value().clip, source.value().roles, rig.value().clip,
+                         rig_roles);
     rig_metres_per_unit = rig.value().metres_per_unit;
     rig_name = rig.value().description;
   }
@@ -114,9 +120,6 @@ int run_retarget(const RetargetArgs& args) {
   }
   auto target = std::make_shared<const Skeleton>(writable(std::move(rig_skeleton)));
 
-  RetargetOptions options;
-  options.stride_scale = args.stride_scale;
-  options.feet_on_floor = !args.no_feet;
   Result<Retargeter> retargeter =
       Retargeter::create(source.value().clip.skeleton_ptr(), source.value().roles, target,
                          rig_roles, options, source.value().description, rig_name);
@@ -160,7 +163,8 @@ Command register_retarget(CLI::App& app) {
       ->expected(1, 2)
       ->check(motion_word_check());
   app.add_option("--rig", args->rig,
-                 "The target skeleton: a .bvh file (its motion is ignored), or an .asf and an "
+                 "The target skeleton: a .bvh file (its motion only tells where its head faces "
+                 "when its rest pose is no standing body), or an .asf and an "
                  ".amc file (two words, or SKELETON.asf+MOTION.amc); the output is written in its "
                  "units. Put it after the input (it takes up to two files)")
       ->expected(1, 2)

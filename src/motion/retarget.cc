@@ -7,6 +7,7 @@
 
 #include "duet/motion/body_space.h"
 #include "duet/motion/forward_kinematics.h"
+#include "duet/motion/head_hands.h"
 
 namespace duet {
 
@@ -277,6 +278,20 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
     if (!free(tj) || !is_ancestor(t, tp, tj) || !is_ancestor(s, sp, sj)) continue;
     rule_of(tj) = {Rule::kFollow, sj, -1, -1, tp, sp, Quat::Identity()};
   }
+  // The head faces as the source's does, when both rigs say where their heads face.
+  if (options.source_head_correction && options.target_head_correction) {
+    const int th = target_roles[Role::kHead];
+    if (free(th) || rule_of(th).rule == Rule::kFollow) {
+      rule_of(th) = {Rule::kFacing,
+                     source_roles[Role::kHead],
+                     -1,
+                     -1,
+                     -1,
+                     -1,
+                     (*options.source_head_correction * options.target_head_correction->conjugate())
+                         .normalized()};
+    }
+  }
   // Joints between two roles copy the joint at the same place on the source's path, when the
   // paths have the same length.
   std::vector<int> role_of_target(static_cast<std::size_t>(t.joint_count()), -1);
@@ -417,6 +432,9 @@ void Retargeter::retarget_frame(std::span<const Vec3> source_translations_ls,
         world = ok ? source_frame * local_frame.conjugate() : ws(rule.source) * rule.alignment;
         break;
       }
+      case Rule::kFacing:
+        world = ws(rule.source) * rule.alignment;
+        break;
       case Rule::kFollow: {
         const Quat& q = rules_[static_cast<std::size_t>(rule.parent_role)].alignment;
         world = target_world_[static_cast<std::size_t>(rule.parent_role)] * q.conjugate() *
@@ -448,6 +466,22 @@ void Retargeter::retarget_frame(std::span<const Vec3> source_translations_ls,
     shift.y() = k * source_low - target_low;
   }
   target_translations_ls[0] = shift;
+}
+
+void set_head_corrections(RetargetOptions& options, const Clip& source,
+                          const JointRoles& source_roles, const Clip& target_motion,
+                          const JointRoles& target_roles) {
+  options.source_head_correction.reset();
+  options.target_head_correction.reset();
+  if (rest_pose_stands(source.skeleton(), source_roles) &&
+      rest_pose_stands(target_motion.skeleton(), target_roles)) {
+    return;
+  }
+  Result<Quat> from = head_correction(source, source_roles);
+  Result<Quat> to = head_correction(target_motion, target_roles);
+  if (!from || !to) return;
+  options.source_head_correction = from.value();
+  options.target_head_correction = to.value();
 }
 
 Result<Clip> retarget_clip(const Clip& source, const JointRoles& source_roles,

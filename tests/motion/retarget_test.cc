@@ -14,6 +14,7 @@
 #include "duet/math/rotation.h"
 #include "duet/motion/body_space.h"
 #include "duet/motion/forward_kinematics.h"
+#include "duet/motion/head_hands.h"
 #include "duet/motion/rig_variants.h"
 
 namespace duet {
@@ -189,6 +190,66 @@ TEST(Retarget, TheBandaiRigsClaviclesKeepTheShoulderLine) {
   const Stats s = stats(errors);
   std::printf("shoulder line on the Bandai rig: median %.2f deg, max %.2f deg\n", s.median, s.max);
   EXPECT_LT(s.median, 3.0);
+}
+
+// Median over the frames of the head's heading against the pelvis's, in degrees, with the head
+// turned by `head_correction` (the rig's: where its head faces).
+double median_head_off_pelvis_deg(const Clip& clip, const JointRoles& roles,
+                                  const Quat& head_correction) {
+  std::vector<Vec3> positions(static_cast<std::size_t>(clip.joint_count()));
+  std::vector<Quat> world(positions.size());
+  std::vector<double> off;
+  for (int f = 0; f < clip.frame_count(); ++f) {
+    forward_kinematics(clip.skeleton(), clip.translations_ls(f), clip.rotations_ls(f), positions,
+                       world);
+    const Quat head = world[static_cast<std::size_t>(roles[Role::kHead])] * head_correction;
+    off.push_back(rad_to_deg(
+        std::remainder(heading_yaw(head) - body_heading_yaw(positions, roles), 2.0 * kPi)));
+  }
+  return stats(off).median;
+}
+
+TEST(Retarget, TheHeadFacesAsTheSourcesOnARigWhoseRestPoseIsNoBody) {
+  // The Bandai rig's rest pose says nothing of where its head faces: through the neck's rest
+  // alignment, take 01 on it held its head 98 degrees off where the Bandai clips hold theirs, and
+  // the Bandai walk on the salsa rig 95 degrees off. Each rig's head correction (the rest pose's,
+  // or for the Bandai rig its own motion's) turns the head to face as the source's does.
+  const LoadedMotion& src = salsa();
+  const LoadedMotion bandai = load({data("bandai/dataset-1_walk_normal_001.bvh")});
+  Result<Quat> salsa_head = head_correction(src.clip, src.roles);
+  Result<Quat> bandai_head = head_correction(bandai.clip, bandai.roles);
+  ASSERT_TRUE(salsa_head && bandai_head);
+
+  RetargetOptions there_options;
+  set_head_corrections(there_options, src.clip, src.roles, bandai.clip, bandai.roles);
+  ASSERT_TRUE(there_options.source_head_correction && there_options.target_head_correction);
+  Result<Clip> there =
+      retarget_clip(src.clip, src.roles, bandai.clip.skeleton_ptr(), bandai.roles, there_options);
+  ASSERT_TRUE(there) << there.error().message;
+  const double take = median_head_off_pelvis_deg(src.clip, src.roles, salsa_head.value());
+  const double on_bandai =
+      median_head_off_pelvis_deg(there.value(), bandai.roles, bandai_head.value());
+  expect_directions("salsa -> Bandai rig, head correction",
+                    direction_errors(src.clip, src.roles, there.value(), bandai.roles, false), 2.0);
+
+  RetargetOptions back_options;
+  set_head_corrections(back_options, bandai.clip, bandai.roles, src.clip, src.roles);
+  Result<Clip> walk =
+      retarget_clip(bandai.clip, bandai.roles, src.clip.skeleton_ptr(), src.roles, back_options);
+  ASSERT_TRUE(walk) << walk.error().message;
+  const double walk_on_salsa =
+      median_head_off_pelvis_deg(walk.value(), src.roles, salsa_head.value());
+  std::printf(
+      "head off the pelvis, median: take 01 %.1f, on the Bandai rig %.1f; the Bandai "
+      "walk on the salsa rig %.1f degrees\n",
+      take, on_bandai, walk_on_salsa);
+  EXPECT_NEAR(on_bandai, take, 3.0);
+  EXPECT_LT(std::abs(walk_on_salsa), 5.0);
+
+  // Two rigs whose rest poses stand keep the rest alignment (exact both ways).
+  RetargetOptions standing;
+  set_head_corrections(standing, src.clip, src.roles, asf().clip, asf().roles);
+  EXPECT_FALSE(standing.source_head_correction || standing.target_head_correction);
 }
 
 TEST(Retarget, OntoAProportionedRigKeepsDirectionsFeetAndScaledStrides) {

@@ -49,7 +49,23 @@ struct RetargetOptions {
   // Put the target's lowest foot point at the source's (scaled) every frame. Off: the pelvis
   // centre's height is the source's times the stride scale.
   bool feet_on_floor = true;
+  // Each rig's head correction (head_hands.h, head_correction: the head joint's world rotation
+  // times it faces where the body faces). With both, the target's head faces as the source's
+  // does, R_target = R_source * source_head_correction * target_head_correction^-1, instead of
+  // keeping the source head's turn on its neck through the rest poses' alignment of the neck,
+  // which is arbitrary for a rig whose rest pose is no body: take 01 on the Bandai rig had its
+  // head 98 degrees off where the Bandai rig's own clips hold theirs. set_head_corrections().
+  std::optional<Quat> source_head_correction;
+  std::optional<Quat> target_head_correction;
 };
+
+// Sets `options`' head corrections when either rig's rest pose does not stand
+// (rest_pose_stands), each from that rig's own motion (head_correction; `target_motion` is a clip
+// of the target rig, such as the --rig file's). Leaves them unset when both rest poses stand
+// (the rest alignment is then exact both ways) or when a rig's motion cannot tell.
+void set_head_corrections(RetargetOptions& options, const Clip& source,
+                          const JointRoles& source_roles, const Clip& target_motion,
+                          const JointRoles& target_roles);
 
 // Built once per pair of rigs (allocates); retarget_frame() then allocates nothing. Not
 // thread-safe: it owns scratch buffers, so use one per thread. Both skeletons are in metres.
@@ -76,10 +92,12 @@ class Retargeter {
   std::shared_ptr<const Skeleton> target_ptr() const { return target_; }
 
   // How a target joint gets its rotation (public for the implementation's helpers only).
-  enum class Rule : int { kRest, kCopy, kDirection, kFrame, kFollow };
+  // kFacing: the world rotation of the source joint times the alignment (the head, with
+  // RetargetOptions' head corrections).
+  enum class Rule : int { kRest, kCopy, kDirection, kFrame, kFollow, kFacing };
   struct JointRule {
     Rule rule = Rule::kRest;
-    int source = -1;              // kCopy/kDirection/kFrame/kFollow: the source joint it follows
+    int source = -1;  // kCopy/kDirection/kFrame/kFollow/kFacing: the source joint it follows
     int target_end = -1;          // kDirection: the target child role joint (bone end)
     int source_end = -1;          // kDirection: the source child role joint
     int parent_role = -1;         // kCopy/kFollow: the target role joint whose alignment applies
