@@ -59,6 +59,9 @@ int run_inspect(const InspectArgs& args) {
   const Skeleton& skeleton = clip.skeleton();
   const std::vector<std::string> problems = follower_problems(motion);
   const BodyDimensions& body = motion.body;
+  // Whether the rest pose is a standing body can be told only with every role found.
+  const bool full_body_roles =
+      motion.role_detection.complete() && !is_head_hands_input(motion.roles);
 
   Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity());
   Vec3 high = -low;
@@ -109,6 +112,8 @@ int run_inspect(const InspectArgs& args) {
     doc["roles_problem"] = motion.role_detection.problem;
     doc["can_drive_follower"] = problems.empty();
     doc["input_points"] = is_head_hands_input(motion.roles) ? "head,hands" : "full";
+    doc["rest_pose_stands"] =
+        full_body_roles ? nlohmann::json(rest_pose_stands(skeleton, motion.roles)) : nullptr;
     doc["follower_problems"] = problems;
     doc["bounding_box_m"] = {{"min", {low.x(), low.y(), low.z()}},
                              {"max", {high.x(), high.y(), high.z()}}};
@@ -163,6 +168,13 @@ int run_inspect(const InspectArgs& args) {
     fmt::print("  {:<15} {:<16} {}\n", role_name(static_cast<Role>(r)),
                joint_name(skeleton, joint), motion.role_detection.notes[static_cast<std::size_t>(r)]);
   }
+  if (full_body_roles) {
+    fmt::print("rest pose:   {}\n",
+               rest_pose_stands(skeleton, motion.roles)
+                   ? "a standing body"
+                   : "no standing body: where the head faces (three points, retargeting) is read "
+                     "from the motion");
+  }
   if (problems.empty() && is_head_hands_input(motion.roles)) {
     fmt::print("follower:    this file can drive the three-point follower (head and hands)\n");
   } else if (problems.empty()) {
@@ -182,7 +194,9 @@ int run_inspect(const InspectArgs& args) {
 Command register_inspect(CLI::App& app) {
   auto args = std::make_shared<InspectArgs>();
   app.footer(
-      "Prints joints, frames, frame rate, units and how they were decided, the estimated body height, "
+      "Prints joints, frames, frame rate, units and how they were decided, the estimated body "
+      "height, "
+      "whether the rest pose is a standing body, "
       "each role's joint and how it was found (built-in map, joint names or hierarchy), and "
       "whether the file can drive the follower (and why not). Exits 0 even when roles are "
       "missing.");

@@ -41,6 +41,17 @@ TEST(CliInspect, ReadsAsfAmcAndTheHandshakeConvention) {
   EXPECT_EQ(nlohmann::json::parse(r.output)["convention"], "cmu-bvh");
 }
 
+TEST(CliInspect, SaysWhenTheRestPoseIsNoStandingBody) {
+  // The Bandai rig's rest pose has every bone along one axis: where its head faces must then be
+  // read from its motion (three points, retargeting), and inspect says so.
+  CommandResult r = run_duet("inspect " + data_path("bandai/dataset-1_walk_normal_001.bvh"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("rest pose:   no standing body"), std::string::npos) << r.output;
+  r = run_duet("inspect --json --fps 60 " + kLeader);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(r.output)["rest_pose_stands"], true);
+}
+
 TEST(CliInspect, BadInputFailsWithReason) {
   CommandResult r = run_duet("inspect /nonexistent.bvh");
   EXPECT_EQ(r.exit_code, 2);
