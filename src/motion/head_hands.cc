@@ -143,7 +143,7 @@ Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles) {
   }
   Result<Quat> correction = head_correction(full_body, roles);
   if (!correction) return correction.error();
-  // R_device * device_correction = R_world * rest correction: the same canonical frame.
+  // R_device * device_correction = R_world * head correction: the same canonical frame.
   const Quat to_device = correction.value() * head_hands_device_correction().conjugate();
   Clip points(make_head_hands_skeleton(), full_body.frame_rate(), full_body.frame_count());
   const auto n = static_cast<std::size_t>(full_body.joint_count());
