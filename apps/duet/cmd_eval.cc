@@ -53,6 +53,7 @@ struct EvalArgs {
   std::string input_points = "full";
   double point_noise_mm = 5.0;
   double point_noise_deg = 1.0;
+  std::vector<double> device_offsets_cm;  // eyes forward, eyes up, grip; empty: at the joints
   // Tuning of the "hmm" tracker (FollowParams fields); unset keeps the follower's defaults.
   std::optional<float> jump_hold;
   std::optional<int> jump_tolerance;
@@ -253,6 +254,9 @@ int run_eval(EvalArgs& args) {
     return usage_error("--input-points: '" + args.input_points +
                        "' is neither full nor head,hands");
   }
+  if (!args.device_offsets_cm.empty() && features.input_points != InputPoints::kHeadHands) {
+    return usage_error("--device-offsets-cm: applies to three points (--input-points head,hands)");
+  }
 
   std::string gnuplot;
   if (!args.plots_dir.empty()) {
@@ -329,6 +333,11 @@ int run_eval(EvalArgs& args) {
       eval_case.recipe.head_hands = true;
       eval_case.recipe.point_noise.position_m = factor * args.point_noise_mm / 1000.0;
       eval_case.recipe.point_noise.rotation_deg = factor * args.point_noise_deg;
+      if (args.device_offsets_cm.size() == 3) {
+        eval_case.recipe.point_noise.offsets.eyes_m =
+            Vec3(0.0, args.device_offsets_cm[1], args.device_offsets_cm[0]) / 100.0;
+        eval_case.recipe.point_noise.offsets.grip_m = args.device_offsets_cm[2] / 100.0;
+      }
     }
   }
 
@@ -473,6 +482,15 @@ Command register_eval(CLI::App& app) {
   app.add_option("--point-noise-deg", args->point_noise_deg,
                  "Three points: orientation noise of each point, RMS degrees (default 1)")
       ->check(number_between(0.0, 45.0, "point noise"));
+  app.add_option("--device-offsets-cm", args->device_offsets_cm,
+                 "Three points: where the devices sit against the head and wrist joints, "
+                 "FORWARD,UP,GRIP in cm: the headset's eyes FORWARD in front of and UP above the "
+                 "head joint, each controller's grip GRIP past the wrist along the forearm "
+                 "(e.g. 8,7,8; default: at the joints). The partner metrics still score the real "
+                 "wrists")
+      ->expected(3)
+      ->delimiter(',')
+      ->check(number_between(-30.0, 30.0, "device offset"));
   app.add_flag("--beam", args->beam,
                "Run the hmm and hmm-paper trackers in beam mode (docs/follower.md "
                "\"Beam mode\"; the partner metrics keep the exact step)");

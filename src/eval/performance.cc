@@ -459,7 +459,7 @@ Performance with_sensor_noise(Performance performance, const SensorNoiseOptions&
 }
 
 Result<Performance> with_head_hands(Performance performance, const PointNoiseOptions& noise) {
-  Result<Clip> points = head_hands_clip(performance.motion, performance.roles);
+  Result<Clip> points = head_hands_clip(performance.motion, performance.roles, noise.offsets);
   if (!points) return points.error();
   performance.motion = std::move(points).value();
   performance.roles = head_hands_roles();

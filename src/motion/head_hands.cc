@@ -133,12 +133,21 @@ Result<Quat> head_correction(const Clip& full_body, const JointRoles& roles) {
   return mean_rotation(per_frame);
 }
 
-Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles) {
+Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles,
+                             const DevicePointOffsets& offsets) {
   for (Role role : {Role::kHead, Role::kLeftWrist, Role::kRightWrist}) {
     const int joint = roles[role];
     if (joint < 0 || joint >= full_body.joint_count()) {
       return Error{"no joint for role " + std::string(role_name(role)) +
                    " (three points need a head and two wrists)"};
+    }
+  }
+  if (offsets.grip_m != 0.0) {
+    for (Role role : {Role::kLeftElbow, Role::kRightElbow}) {
+      if (roles[role] < 0 || roles[role] >= full_body.joint_count()) {
+        return Error{"no joint for role " + std::string(role_name(role)) +
+                     " (a grip offset goes along the forearm)"};
+      }
     }
   }
   Result<Quat> correction = head_correction(full_body, roles);
@@ -150,12 +159,20 @@ Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles) {
   std::vector<Vec3> positions(n);
   std::vector<Quat> rotations(n);
   const int sources[] = {roles[Role::kHead], roles[Role::kLeftWrist], roles[Role::kRightWrist]};
+  const int elbows[] = {-1, roles[Role::kLeftElbow], roles[Role::kRightElbow]};
   for (int f = 0; f < full_body.frame_count(); ++f) {
     forward_kinematics(full_body.skeleton(), full_body.translations_ls(f),
                        full_body.rotations_ls(f), positions, rotations);
     for (int p = 0; p < 3; ++p) {
       const auto source = static_cast<std::size_t>(sources[p]);
-      points.translations_ls(f)[static_cast<std::size_t>(p + 1)] = positions[source];
+      Vec3 point = positions[source];
+      if (p == 0) {
+        point += rotations[source] * correction.value() * offsets.eyes_m;
+      } else if (offsets.grip_m != 0.0) {
+        const Vec3 forearm = positions[source] - positions[static_cast<std::size_t>(elbows[p])];
+        if (forearm.norm() > 1e-9) point += offsets.grip_m * forearm.normalized();
+      }
+      points.translations_ls(f)[static_cast<std::size_t>(p + 1)] = point;
       points.rotations_ls(f)[static_cast<std::size_t>(p + 1)] =
           (rotations[source] * to_device).normalized();
     }

@@ -124,6 +124,13 @@ TEST(CliEval, BadOptionsExitTwoAndBadFilesExitOne) {
   r = run_duet("eval " + pairs + " --no-partner-metrics --partner-csv x.csv");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--partner-csv"), std::string::npos) << r.output;
+  r = run_duet("eval " + pairs + " --device-offsets-cm 8,7,8");  // full body: no devices
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--device-offsets-cm"), std::string::npos) << r.output;
+  r = run_duet("eval " + pairs + " --input-points head,hands --device-offsets-cm 8,7");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = run_duet("eval " + pairs + " --input-points head,hands --device-offsets-cm 8,7,80");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
 
   const auto dir = scratch_dir("bad");
   const std::string garbage = (dir / "garbage.bvh").string();

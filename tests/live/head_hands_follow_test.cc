@@ -177,6 +177,50 @@ TEST(HeadHandsFollow, ADanceOnARigWhoseRestPoseDoesNotStandIsFollowedFromItsThre
   EXPECT_LT(result.value().lost_fraction(), 0.1);
 }
 
+TEST(HeadHandsFeatures, DeviceOffsetsPutTheEyesAndGripsWhereTheySit) {
+  // A headset's eyes sit in front of and above the head joint, a controller's grip past the
+  // wrist along the forearm: every frame, at exactly that offset, in the head's facing frame and
+  // along the forearm as the take moves.
+  const LoadedMotion take = load_take("60_07");
+  DevicePointOffsets offsets;
+  offsets.eyes_m = Vec3(0.0, 0.07, 0.08);
+  offsets.grip_m = 0.08;
+  Result<Clip> joints = head_hands_clip(take.clip, take.roles);
+  Result<Clip> devices = head_hands_clip(take.clip, take.roles, offsets);
+  ASSERT_TRUE(joints && devices);
+  std::vector<Vec3> positions(static_cast<std::size_t>(take.clip.joint_count()));
+  std::vector<Quat> world(positions.size());
+  for (int f = 0; f < take.clip.frame_count(); f += 97) {
+    forward_kinematics(take.clip.skeleton(), take.clip.translations_ls(f),
+                       take.clip.rotations_ls(f), positions, world);
+    const auto at = [&](const Clip& c, int j) {
+      return Vec3(c.translations_ls(f)[static_cast<std::size_t>(j)]);
+    };
+    // The eyes: the offset turned by the head's canonical orientation (device * correction).
+    const Quat head = devices.value().rotations_ls(f)[kPointsHead] * head_hands_device_correction();
+    EXPECT_LT(
+        (at(devices.value(), kPointsHead) - at(joints.value(), kPointsHead) - head * offsets.eyes_m)
+            .norm(),
+        1e-9);
+    // Forward is where the head faces: the eyes are in front of the joint in the heading frame.
+    const Vec3 eyes = yaw_rotation(-heading_yaw(head)) *
+                      (at(devices.value(), kPointsHead) - at(joints.value(), kPointsHead));
+    EXPECT_GT(eyes.z(), 0.0);
+    const Vec3 forearm = positions[static_cast<std::size_t>(take.roles[Role::kLeftWrist])] -
+                         positions[static_cast<std::size_t>(take.roles[Role::kLeftElbow])];
+    EXPECT_LT((at(devices.value(), kPointsLeftHand) - at(joints.value(), kPointsLeftHand) -
+               0.08 * forearm.normalized())
+                  .norm(),
+              1e-9);
+  }
+  // A grip needs the elbows to know the forearm.
+  JointRoles no_elbow = take.roles;
+  no_elbow.joints[static_cast<std::size_t>(Role::kLeftElbow)] = -1;
+  Result<Clip> bad = head_hands_clip(take.clip, no_elbow, offsets);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("left_elbow"), std::string::npos) << bad.error().message;
+}
+
 TEST(HeadHandsFeatures, IndependentOfThePlaceInTheRoomAndOfBodySize) {
   const LoadedMotion take = load_take("60_07");
   Performance base;

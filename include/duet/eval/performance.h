@@ -27,6 +27,7 @@
 #include "duet/base/result.h"
 #include "duet/math/types.h"
 #include "duet/motion/clip.h"
+#include "duet/motion/head_hands.h"
 #include "duet/motion/skeleton_map.h"
 
 namespace duet {
@@ -211,6 +212,8 @@ struct PointNoiseOptions {
   double position_m = 0.005;
   double rotation_deg = 1.0;
   std::uint64_t seed = 1;
+  // Where the devices sit against the joints (the eyes, the grips); zero: at the joints.
+  DevicePointOffsets offsets;
 };
 Result<Performance> with_head_hands(Performance performance, const PointNoiseOptions& noise);
 

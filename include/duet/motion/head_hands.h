@@ -49,9 +49,19 @@ bool rest_pose_stands(const Skeleton& skeleton, const JointRoles& roles);
 // dancer looks where the body faces, give or take a turn of the head).
 Result<Quat> head_correction(const Clip& full_body, const JointRoles& roles);
 
-// The three points of a full-body clip (any rig with head and wrist roles), on the head-and-hands
-// skeleton, at the clip's rate: what a headset and controllers would have reported. The head's
-// orientation goes through head_correction.
-Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles);
+// Where a headset and two controllers sit against the head and wrist joints: the eyes in the
+// head's canonical frame (x left, y up, z forward), the controllers' grips past the wrist along
+// the forearm (elbow -> wrist). Zero: at the joints themselves.
+struct DevicePointOffsets {
+  Vec3 eyes_m = Vec3::Zero();
+  double grip_m = 0.0;
+  bool any() const { return eyes_m.squaredNorm() > 0.0 || grip_m != 0.0; }
+};
+
+// The three points of a full-body clip (any rig with head and wrist roles; elbow roles too for a
+// grip offset), on the head-and-hands skeleton, at the clip's rate: what a headset and
+// controllers would have reported. The head's orientation goes through head_correction.
+Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles,
+                             const DevicePointOffsets& offsets = {});
 
 }  // namespace duet
