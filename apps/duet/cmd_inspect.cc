@@ -195,9 +195,8 @@ Command register_inspect(CLI::App& app) {
   auto args = std::make_shared<InspectArgs>();
   app.footer(
       "Prints joints, frames, frame rate, units and how they were decided, the estimated body "
-      "height, "
-      "whether the rest pose is a standing body, "
-      "each role's joint and how it was found (built-in map, joint names or hierarchy), and "
+      "height, whether the rest pose is a standing body, each role's joint and how it was found "
+      "(built-in map, joint names or hierarchy), and "
       "whether the file can drive the follower (and why not). Exits 0 even when roles are "
       "missing.");
   app.add_option("files", args->files, "A .bvh file, or an .asf and an .amc file")

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <utility>
 
 #include "apps/run_command.h"
 #include "duet/eval/partner_run.h"
@@ -109,28 +110,26 @@ TEST(CliEval, RunsCasesAndWritesTableCsvAndPlots) {
 
 TEST(CliEval, BadOptionsExitTwoAndBadFilesExitOne) {
   const std::string pairs = pair("10") + " --fps 60";
-  auto r = run_duet("eval " + pairs + " --cases clean,bogus");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("unknown case 'bogus'"), std::string::npos) << r.output;
-  r = run_duet("eval " + pairs + " --takes 1");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("--takes 1"), std::string::npos) << r.output;
-  r = run_duet("eval " + pairs + " --trackers hmm,magic");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  r = run_duet("eval " + pairs + " --sigma -1");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  r = run_duet("eval " + pairs + " --trace-case nothing");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  r = run_duet("eval " + pairs + " --no-partner-metrics --partner-csv x.csv");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("--partner-csv"), std::string::npos) << r.output;
-  r = run_duet("eval " + pairs + " --device-offsets-cm 8,7,8");  // full body: no devices
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("--device-offsets-cm"), std::string::npos) << r.output;
-  r = run_duet("eval " + pairs + " --input-points head,hands --device-offsets-cm 8,7");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  r = run_duet("eval " + pairs + " --input-points head,hands --device-offsets-cm 8,7,80");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
+  // Each bad command line, and what its message must name ("" for the exit code alone).
+  const std::pair<std::string, std::string> bad_options[] = {
+      {"--cases clean,bogus", "unknown case 'bogus'"},
+      {"--takes 1", "--takes 1"},
+      {"--trackers hmm,magic", ""},
+      {"--sigma -1", ""},
+      {"--trace-case nothing", ""},
+      {"--no-partner-metrics --partner-csv x.csv", "--partner-csv"},
+      {"--device-offsets-cm 8,7,8", "--device-offsets-cm"},  // full body: no devices
+      {"--input-points head,hands --device-offsets-cm 8,7", ""},
+      {"--input-points head,hands --device-offsets-cm 8,7,80", ""},
+  };
+  testing::CommandResult r;
+  for (const auto& [options, named] : bad_options) {
+    r = run_duet("eval " + pairs + " " + options);
+    EXPECT_EQ(r.exit_code, 2) << options << ": " << r.output;
+    if (!named.empty()) {
+      EXPECT_NE(r.output.find(named), std::string::npos) << r.output;
+    }
+  }
 
   const auto dir = scratch_dir("bad");
   const std::string garbage = (dir / "garbage.bvh").string();
