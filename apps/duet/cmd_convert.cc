@@ -13,6 +13,7 @@
 #include "duet/motion/head_hands.h"
 #include "duet/motion/limits.h"
 #include "duet/motion/resample.h"
+#include "input_points.h"
 #include "library_options.h"
 #include "motion_options.h"
 #include "number_checks.h"
@@ -28,11 +29,14 @@ struct ConvertArgs {
   std::optional<double> output_fps;
   std::optional<double> output_units_per_metre;  // default: units duet reads back unaided
   std::string points;  // "head,hands": write the three-point CSV of the motion
+  std::vector<double> device_offsets_cm;  // where the points sit; empty: at the joints
 };
 
 // The three points a headset and controllers would have reported (duet/io/points_csv.h).
-int write_points(const LoadedMotion& loaded, const Clip& clip, const std::string& output) {
-  Result<Clip> points = head_hands_clip(clip, loaded.roles);
+int write_points(const LoadedMotion& loaded, const Clip& clip, const ConvertArgs& args) {
+  const std::string& output = args.output;
+  Result<Clip> points =
+      head_hands_clip(clip, loaded.roles, device_offsets_from_cm(args.device_offsets_cm));
   if (!points) {
     fmt::print(stderr, "duet convert: {}: {}\n", loaded.description, points.error().message);
     return kExitFailure;
@@ -54,6 +58,10 @@ int run_convert(const ConvertArgs& args) {
                "head,hands (or name a .bvh output)\n",
                args.output);
     return kExitFailure;
+  }
+  if (args.points.empty() && !args.device_offsets_cm.empty()) {
+    fmt::print(stderr, "duet convert: --device-offsets-cm applies to --points head,hands\n");
+    return kExitUsage;
   }
   MotionLoadOptions load_options;
   if (!make_load_options(args.input, load_options)) return kExitFailure;
@@ -85,7 +93,7 @@ int run_convert(const ConvertArgs& args) {
     }
     clip = resample(clip, *args.output_fps);
   }
-  if (!args.points.empty()) return write_points(loaded.value(), clip, args.output);
+  if (!args.points.empty()) return write_points(loaded.value(), clip, args);
   // The BVH keeps the source's world: a Z-up file stays Z-up (the points CSV above is Y-up, as
   // headsets report).
   turn_to_file_world(clip, loaded.value().file_to_y_up());
@@ -130,6 +138,9 @@ Command register_convert(CLI::App& app) {
                  "Write only the head and both hands as a three-point CSV (the only value: "
                  "head,hands; docs/file-formats.md)")
       ->check(CLI::IsMember({"head,hands"}));
+  add_device_offsets_option(app, args->device_offsets_cm,
+                            "The points are put there: what a headset and controllers would "
+                            "record (default: at the joints)");
   app.add_option("--input-fps", args->input.fps, "Frame rate of the input, overriding its header")
       ->check(fps_check());
   app.add_option("--scale", args->input.scale,

@@ -21,6 +21,7 @@
 #include "eval_non_dance.h"
 #include "eval_recorded.h"
 #include "eval_rigs.h"
+#include "input_points.h"
 #include "library_options.h"
 #include "motion_options.h"
 #include "number_checks.h"
@@ -54,6 +55,7 @@ struct EvalArgs {
   double point_noise_mm = 5.0;
   double point_noise_deg = 1.0;
   std::vector<double> device_offsets_cm;  // eyes forward, eyes up, grip; empty: at the joints
+  std::vector<double> taken_out_cm;       // what the follower takes out; empty: nothing
   // Tuning of the "hmm" tracker (FollowParams fields); unset keeps the follower's defaults.
   std::optional<float> jump_hold;
   std::optional<int> jump_tolerance;
@@ -254,8 +256,11 @@ int run_eval(EvalArgs& args) {
     return usage_error("--input-points: '" + args.input_points +
                        "' is neither full nor head,hands");
   }
-  if (!args.device_offsets_cm.empty() && features.input_points != InputPoints::kHeadHands) {
-    return usage_error("--device-offsets-cm: applies to three points (--input-points head,hands)");
+  if ((!args.device_offsets_cm.empty() || !args.taken_out_cm.empty()) &&
+      features.input_points != InputPoints::kHeadHands) {
+    return usage_error(std::string(args.device_offsets_cm.empty() ? "--taken-out-offsets-cm"
+                                                                  : "--device-offsets-cm") +
+                       ": applies to three points (--input-points head,hands)");
   }
 
   std::string gnuplot;
@@ -333,11 +338,8 @@ int run_eval(EvalArgs& args) {
       eval_case.recipe.head_hands = true;
       eval_case.recipe.point_noise.position_m = factor * args.point_noise_mm / 1000.0;
       eval_case.recipe.point_noise.rotation_deg = factor * args.point_noise_deg;
-      if (args.device_offsets_cm.size() == 3) {
-        eval_case.recipe.point_noise.offsets.eyes_m =
-            Vec3(0.0, args.device_offsets_cm[1], args.device_offsets_cm[0]) / 100.0;
-        eval_case.recipe.point_noise.offsets.grip_m = args.device_offsets_cm[2] / 100.0;
-      }
+      eval_case.recipe.point_noise.offsets = device_offsets_from_cm(args.device_offsets_cm);
+      eval_case.recipe.point_noise.taken_out = device_offsets_from_cm(args.taken_out_cm);
     }
   }
 
@@ -482,12 +484,14 @@ Command register_eval(CLI::App& app) {
   app.add_option("--point-noise-deg", args->point_noise_deg,
                  "Three points: orientation noise of each point, RMS degrees (default 1)")
       ->check(number_between(0.0, 45.0, "point noise"));
-  app.add_option("--device-offsets-cm", args->device_offsets_cm,
-                 "Three points: where the devices sit against the head and wrist joints, "
-                 "FORWARD,UP,GRIP in cm: the headset's eyes FORWARD in front of and UP above the "
-                 "head joint, each controller's grip GRIP past the wrist along the forearm "
-                 "(e.g. 8,7,8; default: at the joints). The partner metrics still score the real "
-                 "wrists")
+  add_device_offsets_option(app, args->device_offsets_cm,
+                            "The performance's points are put there (e.g. 6,6,7; default: at the "
+                            "joints); the partner metrics still score the real wrists");
+  app.add_option("--taken-out-offsets-cm", args->taken_out_cm,
+                 "Three points: the device offsets the follower is told and takes out after the "
+                 "sensor noise, FORWARD,UP,GRIP in cm as duet follow's and duet serve's "
+                 "--device-offsets-cm (default: none). With --device-offsets-cm, how a wrong "
+                 "calibration costs")
       ->expected(3)
       ->delimiter(',')
       ->check(number_between(-30.0, 30.0, "device offset"));

@@ -35,6 +35,7 @@ struct FollowArgs {
   std::string user_output_path;
   std::string truth_path;
   std::string input_points;  // "", "full" or "head,hands" (--input-points)
+  std::vector<double> device_offsets_cm;  // taken out of a three-point recording; empty: none
   std::string partner_rig;  // a motion word whose skeleton the partner is written on
   MotionFileOptions partner_rig_motion;
   bool allow_lost = false;
@@ -134,6 +135,10 @@ int run_follow(const FollowArgs& args) {
   if (!input) {
     fmt::print(stderr, "duet follow: {}\n", input.error().message);
     return kExitFailure;
+  }
+  if (Status s = take_out_device_offsets(args.device_offsets_cm, input.value()); !s) {
+    fmt::print(stderr, "duet follow: {}\n", s.error().message);
+    return kExitUsage;
   }
   // Three points (a headset's recording, or --input-points head,hands) pick the three-point
   // follower; the library's templates then give the same three points.
@@ -275,6 +280,9 @@ Command register_follow(CLI::App& app) {
       ->required();
   app.add_option("--input-points", args->input_points, kInputPointsHelp)
       ->check(CLI::IsMember({"full", "head,hands"}));
+  add_device_offsets_option(app, args->device_offsets_cm,
+                            "Taken out of a three-point recording before following (a recording "
+                            "of duet serve --source xr has them out already; default: none)");
   add_motion_file_options(app, args->input_motion, "input-");
   add_tracker_options(app, args->tracker);
   add_partner_options(app, args->partner);

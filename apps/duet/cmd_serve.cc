@@ -40,6 +40,7 @@ struct ServeArgs {
   std::optional<double> source_scale;
   std::string source_map;
   std::string input_points;  // "", "full" or "head,hands"
+  std::vector<double> device_offsets_cm;  // empty: typical_headset_offsets for xr, else none
   std::string http = "127.0.0.1:8080";
   std::optional<std::string> token;
   std::string web;
@@ -158,6 +159,9 @@ Result<std::unique_ptr<FrameSource>> make_source(const SourceSpec& spec, const S
       if (!ok) return Error{"bad --source-map"};
       Result<LoadedMotion> motion = load_motion({spec.path}, options);
       if (!motion) return motion.error();
+      if (Status s = take_out_device_offsets(args.device_offsets_cm, motion.value()); !s) {
+        return s.error();
+      }
       Result<InputPoints> points = choose_input_points(args.input_points, motion.value());
       if (!points) return points.error();
       Result<ReplaySource> replay = ReplaySource::create(std::move(motion).value(), spec.replay,
@@ -222,8 +226,12 @@ Result<std::unique_ptr<FrameSource>> make_source(const SourceSpec& spec, const S
     case SourceKind::kXr: {
       SourceSkeleton skeleton{make_head_hands_skeleton(), head_hands_roles(), 1.0,
                               args.source_fps ? *args.source_fps : 72.0};
+      PoseSourceOptions options;
+      options.device_offsets = args.device_offsets_cm.empty()
+                                   ? typical_headset_offsets()
+                                   : device_offsets_from_cm(args.device_offsets_cm);
       return std::unique_ptr<FrameSource>(std::make_unique<PoseSource>(
-          std::move(skeleton), PoseSourceOptions{},
+          std::move(skeleton), options,
           "a VR headset and two controllers (xr_pose messages over the WebSocket)"));
     }
   }
@@ -242,6 +250,11 @@ Result<InputPoints> serve_input_points(const SourceSpec& spec, const ServeArgs& 
       return Error{"--input-points full: the source gives only a head and two hands"};
     }
     return InputPoints::kHeadHands;
+  }
+  if (!args.device_offsets_cm.empty() && spec.kind != SourceKind::kReplay) {
+    return Error{
+        "--device-offsets-cm applies to three points (--source xr, or a replayed "
+        "three-point recording)"};
   }
   if (asked == InputPoints::kHeadHands && spec.kind != SourceKind::kReplay) {
     return Error{"--input-points head,hands applies to a replayed file (a live body source "
@@ -405,6 +418,10 @@ Command register_serve(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--input-points", args->input_points, kInputPointsHelp)
       ->check(CLI::IsMember({"full", "head,hands"}));
+  add_device_offsets_option(app, args->device_offsets_cm,
+                            "Taken out before following: --source xr default 6,6,7 (a typical "
+                            "headset user; 0,0,0 leaves the points as sent), a replayed "
+                            "three-point recording default none");
   app.add_option("--source-skeleton", args->source_skeleton,
                  "BVH whose hierarchy describes the live stream (neuron; ws without a skeleton)")
       ->check(CLI::ExistingFile);

@@ -1,6 +1,7 @@
 #include "input_points.h"
 
 #include "duet/motion/head_hands.h"
+#include "number_checks.h"
 
 namespace duet::app {
 
@@ -28,6 +29,40 @@ Result<InputPoints> choose_input_points(const std::string& option, LoadedMotion&
   motion.body = BodyDimensions{};
   motion.metres_per_unit = 1.0;
   return InputPoints::kHeadHands;
+}
+
+CLI::Option* add_device_offsets_option(CLI::App& app, std::vector<double>& cm,
+                                       const std::string& what) {
+  return app
+      .add_option("--device-offsets-cm", cm,
+                  "Three points: where the devices sit against the head and wrist joints, "
+                  "FORWARD,UP,GRIP in cm: the headset's eyes FORWARD in front of and UP above the "
+                  "head joint, each controller's grip GRIP past the wrist along the hand, on the "
+                  "grip's +Y axis (WebXR's grip space). " +
+                      what)
+      ->expected(3)
+      ->delimiter(',')
+      ->check(number_between(-30.0, 30.0, "device offset"));
+}
+
+DevicePointOffsets device_offsets_from_cm(const std::vector<double>& cm) {
+  if (cm.size() != 3) return DevicePointOffsets{};
+  return DevicePointOffsets::from_cm(cm[0], cm[1], cm[2]);
+}
+
+Status take_out_device_offsets(const std::vector<double>& cm, LoadedMotion& motion) {
+  if (cm.empty()) return Ok{};
+  if (!is_head_hands_input(motion.roles) || motion.clip.joint_count() != kHeadHandsJointCount) {
+    return Error{"--device-offsets-cm: " + motion.description +
+                 " is no recording of three devices (a full body, and three points made from "
+                 "one, are at the joints already)"};
+  }
+  DevicePointOffsets offsets = device_offsets_from_cm(cm);
+  // In the file's units.
+  offsets.eyes_m /= motion.metres_per_unit;
+  offsets.grip_m /= motion.metres_per_unit;
+  device_points_to_joints(offsets, motion.clip);
+  return Ok{};
 }
 
 }  // namespace duet::app

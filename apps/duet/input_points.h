@@ -4,11 +4,14 @@
 // against full-body truth).
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
 
 #include "duet/base/result.h"
 #include "duet/features/feature_spec.h"
 #include "duet/io/motion_file.h"
+#include "duet/motion/device_points.h"
 
 namespace duet::app {
 
@@ -19,5 +22,17 @@ inline constexpr const char* kInputPointsHelp =
 // `option` is "", "full" or "head,hands". With head,hands on a full-body motion, `motion` becomes
 // its three points. Errors when the input cannot give what is asked.
 Result<InputPoints> choose_input_points(const std::string& option, LoadedMotion& motion);
+
+// --device-offsets-cm FORWARD,UP,GRIP (duet/motion/device_points.h): where a headset's eyes and
+// the controllers' grips sit against the head and wrist joints. `what` ends the help: what the
+// command does with them.
+CLI::Option* add_device_offsets_option(CLI::App& app, std::vector<double>& cm,
+                                       const std::string& what);
+// The option's numbers as offsets; empty: none.
+DevicePointOffsets device_offsets_from_cm(const std::vector<double>& cm);
+// Takes the offsets `cm` out of `motion`, a recording of three points as the devices reported
+// them (its units from metres_per_unit). Errors when the motion is not three points (a full body,
+// or three points made from one, are at the joints already).
+Status take_out_device_offsets(const std::vector<double>& cm, LoadedMotion& motion);
 
 }  // namespace duet::app

@@ -479,6 +479,7 @@ Result<Performance> with_head_hands(Performance performance, const PointNoiseOpt
       }
     }
   }
+  if (noise.taken_out.any()) device_points_to_joints(noise.taken_out, motion);
   return performance;
 }
 

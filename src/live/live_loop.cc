@@ -115,7 +115,7 @@ void LiveLoop::place_head_hands_user(int take, int frame) noexcept {
     const auto joint = static_cast<std::size_t>(
         user_.roles[side == Side::kLeft ? Role::kLeftWrist : Role::kRightWrist]);
     user_pose_.wrist_rotations_ws[s] =
-        body.template_rotation(out_.user_rotations_ws[joint] * device_correction_);
+        body.template_wrist_rotation(side == Side::kLeft, out_.user_rotations_ws[joint]);
   }
 }
 

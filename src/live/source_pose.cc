@@ -9,7 +9,8 @@ namespace duet {
 PoseSource::PoseSource(SourceSkeleton skeleton, const PoseSourceOptions& options, std::string name)
     : skeleton_(std::move(skeleton)),
       name_(std::move(name)),
-      queue_(skeleton_.joint_count(), options.queue_frames) {}
+      queue_(skeleton_.joint_count(), options.queue_frames),
+      device_offsets_(options.device_offsets) {}
 
 bool PoseSource::reject(const char* why, std::string& reason) noexcept {
   ++stats_.rejected;
@@ -103,6 +104,7 @@ bool PoseSource::push_points(double time_s, std::span<const Vec3> positions,
     slot.translations_ls[p + 1] = positions[p];
     slot.rotations_ls[p + 1] = q;
   }
+  device_points_to_joints(device_offsets_, slot.translations_ls, slot.rotations_ls);
   commit(slot, time_s, arrival);
   return true;
 }

@@ -133,6 +133,34 @@ Result<Quat> head_correction(const Clip& full_body, const JointRoles& roles) {
   return mean_rotation(per_frame);
 }
 
+Result<Quat> rest_grip_frame(const Skeleton& skeleton, const JointRoles& roles, Role wrist_role) {
+  const int wrist = roles[wrist_role];
+  Vec3 bone = Vec3::Zero();
+  for (int j = wrist; j >= 0 && bone.norm() < 1e-6;
+       j = skeleton.joints[static_cast<std::size_t>(j)].parent) {
+    bone = skeleton.joints[static_cast<std::size_t>(j)].offset;
+  }
+  if (bone.norm() < 1e-6) {
+    return Error{"the " + std::string(role_name(wrist_role)) + " joint has no bone to its arm"};
+  }
+  const Vec3 to_arm = -bone.normalized();
+  Quat to_y_up;
+  const std::vector<Vec3> positions = upright_rest_positions(skeleton, roles, to_y_up);
+  const double yaw = body_heading_yaw(positions, roles);
+  const Vec3 forward =
+      to_y_up.conjugate() * (yaw_rotation(std::isfinite(yaw) ? yaw : 0.0) * Vec3::UnitZ());
+  auto square_to_arm = [&](const Vec3& v) { return Vec3(v - v.dot(to_arm) * to_arm); };
+  Vec3 palm = square_to_arm(to_y_up.conjugate() * -Vec3::UnitY());
+  if (palm.norm() < 0.5) palm = square_to_arm(-forward);
+  palm.normalize();
+  const Vec3 x = wrist_role == Role::kRightWrist ? Vec3(-palm) : palm;
+  Eigen::Matrix3d axes;
+  axes.col(0) = x;
+  axes.col(1) = to_arm;
+  axes.col(2) = x.cross(to_arm);
+  return Quat(axes).normalized();
+}
+
 Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles,
                              const DevicePointOffsets& offsets) {
   for (Role role : {Role::kHead, Role::kLeftWrist, Role::kRightWrist}) {
@@ -142,39 +170,33 @@ Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles,
                    " (three points need a head and two wrists)"};
     }
   }
-  if (offsets.grip_m != 0.0) {
-    for (Role role : {Role::kLeftElbow, Role::kRightElbow}) {
-      if (roles[role] < 0 || roles[role] >= full_body.joint_count()) {
-        return Error{"no joint for role " + std::string(role_name(role)) +
-                     " (a grip offset goes along the forearm)"};
-      }
-    }
-  }
   Result<Quat> correction = head_correction(full_body, roles);
   if (!correction) return correction.error();
-  // R_device * device_correction = R_world * head correction: the same canonical frame.
-  const Quat to_device = correction.value() * head_hands_device_correction().conjugate();
+  Result<Quat> left_grip = rest_grip_frame(full_body.skeleton(), roles, Role::kLeftWrist);
+  if (!left_grip) return left_grip.error();
+  Result<Quat> right_grip = rest_grip_frame(full_body.skeleton(), roles, Role::kRightWrist);
+  if (!right_grip) return right_grip.error();
+  // Each point's device rotation from its joint's world rotation: the head's so that
+  // R_device * device_correction = R_world * head correction (the same canonical frame), the
+  // hands' their grip frames.
+  const Quat to_device[] = {correction.value() * head_hands_device_correction().conjugate(),
+                            left_grip.value(), right_grip.value()};
   Clip points(make_head_hands_skeleton(), full_body.frame_rate(), full_body.frame_count());
   const auto n = static_cast<std::size_t>(full_body.joint_count());
   std::vector<Vec3> positions(n);
   std::vector<Quat> rotations(n);
   const int sources[] = {roles[Role::kHead], roles[Role::kLeftWrist], roles[Role::kRightWrist]};
-  const int elbows[] = {-1, roles[Role::kLeftElbow], roles[Role::kRightElbow]};
   for (int f = 0; f < full_body.frame_count(); ++f) {
     forward_kinematics(full_body.skeleton(), full_body.translations_ls(f),
                        full_body.rotations_ls(f), positions, rotations);
     for (int p = 0; p < 3; ++p) {
       const auto source = static_cast<std::size_t>(sources[p]);
-      Vec3 point = positions[source];
-      if (p == 0) {
-        point += rotations[source] * correction.value() * offsets.eyes_m;
-      } else if (offsets.grip_m != 0.0) {
-        const Vec3 forearm = positions[source] - positions[static_cast<std::size_t>(elbows[p])];
-        if (forearm.norm() > 1e-9) point += offsets.grip_m * forearm.normalized();
-      }
-      points.translations_ls(f)[static_cast<std::size_t>(p + 1)] = point;
-      points.rotations_ls(f)[static_cast<std::size_t>(p + 1)] =
-          (rotations[source] * to_device).normalized();
+      const Quat device = (rotations[source] * to_device[p]).normalized();
+      // Where the device sits: device_points_to_joints' inverse.
+      const Vec3 offset = p == 0 ? Vec3(rotations[source] * correction.value() * offsets.eyes_m)
+                                 : Vec3(-offsets.grip_m * (device * Vec3::UnitY()));
+      points.translations_ls(f)[static_cast<std::size_t>(p + 1)] = positions[source] + offset;
+      points.rotations_ls(f)[static_cast<std::size_t>(p + 1)] = device;
     }
   }
   return points;

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "apps/run_command.h"
 
@@ -57,6 +59,77 @@ TEST(CliHeadHands, InputPointsOnAFullBodyTakeFollowsItsThreePoints) {
                                     " --input-fps 60 --input-points head,hands");
   EXPECT_EQ(followed.exit_code, 0) << followed.output;
   EXPECT_NE(followed.output.find("0 jumps"), std::string::npos) << followed.output;
+}
+
+// Each trace row's take and template frame.
+std::vector<std::pair<int, int>> traced_places(const std::string& trace) {
+  std::istringstream rows(read(trace));
+  std::string row;
+  std::getline(rows, row);
+  std::vector<std::pair<int, int>> places;
+  while (std::getline(rows, row)) {
+    int frame = 0, take = 0, template_frame = 0;
+    double time = 0;
+    if (std::sscanf(row.c_str(), "%d,%lf,%d,%d", &frame, &time, &take, &template_frame) == 4) {
+      places.emplace_back(take, template_frame);
+    }
+  }
+  return places;
+}
+
+TEST(CliHeadHands, DeviceOffsetsRecordedAreTakenOut) {
+  // A recording with the devices where a headset user's sit, followed with those offsets taken
+  // out, is followed as the joints' own recording is.
+  const std::string joints = temp("joints.csv"), devices = temp("devices.csv");
+  const std::string joints_trace = temp("joints_trace.csv"), trace = temp("devices_trace.csv");
+  ASSERT_EQ(
+      run_duet("convert " + kTake + " --input-fps 60 --points head,hands -o " + joints).exit_code,
+      0);
+  CommandResult converted = run_duet("convert " + kTake +
+                                     " --input-fps 60 --points head,hands --device-offsets-cm "
+                                     "6,6,7 -o " +
+                                     devices);
+  ASSERT_EQ(converted.exit_code, 0) << converted.output;
+  ASSERT_NE(read(joints), read(devices));
+  ASSERT_EQ(run_duet("follow --library " + kSalsaLibrary + " --input " + joints + " --trace " +
+                     joints_trace)
+                .exit_code,
+            0);
+  CommandResult followed = run_duet("follow --library " + kSalsaLibrary + " --input " + devices +
+                                    " --device-offsets-cm 6,6,7 --trace " + trace);
+  ASSERT_EQ(followed.exit_code, 0) << followed.output;
+  const auto expected = traced_places(joints_trace), got = traced_places(trace);
+  ASSERT_EQ(got.size(), expected.size());
+  ASSERT_GT(got.size(), 2000u);
+  std::size_t same = 0;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    same += (got[i].first == expected[i].first && std::abs(got[i].second - expected[i].second) <= 1)
+                ? 1
+                : 0;
+  }
+  EXPECT_GE(same, got.size() * 99 / 100);
+
+  // Only a recording of devices has offsets to take out.
+  CommandResult body = run_duet("follow --library " + kSalsaLibrary + " --input " + kTake +
+                                " --input-fps 60 --device-offsets-cm 6,6,7");
+  EXPECT_EQ(body.exit_code, 2);
+  EXPECT_NE(body.output.find("no recording of three devices"), std::string::npos) << body.output;
+  CommandResult no_points =
+      run_duet("convert " + kTake + " --device-offsets-cm 6,6,7 -o " + temp("body.bvh"));
+  EXPECT_EQ(no_points.exit_code, 2);
+  EXPECT_NE(no_points.output.find("--points head,hands"), std::string::npos) << no_points.output;
+  CommandResult serve = run_duet("serve --library " + kSalsaLibrary +
+                                 " --source ws --device-offsets-cm 6,6,7 --no-record");
+  EXPECT_EQ(serve.exit_code, 2);
+  EXPECT_NE(serve.output.find("--device-offsets-cm applies to three points"), std::string::npos)
+      << serve.output;
+  CommandResult far = run_duet("follow --library " + kSalsaLibrary + " --input " + devices +
+                               " --device-offsets-cm 6,6,40");
+  EXPECT_EQ(far.exit_code, 2);
+  EXPECT_NE(far.output.find("device offset"), std::string::npos) << far.output;
+  for (const std::string& path : {joints, devices, joints_trace, trace}) {
+    std::filesystem::remove(path);
+  }
 }
 
 TEST(CliHeadHands, OptionsThatCannotApplySaySo) {

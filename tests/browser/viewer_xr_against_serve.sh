@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Browser test of the headset path (issue 12): `duet serve --source xr` with the salsa library,
-# a three-point recording of take 60_07 made by `duet convert --points head,hands`, and the
+# a three-point recording of take 60_07 made by `duet convert --points head,hands` with the
+# devices where a headset user's sit (the server's default --device-offsets-cm 6,6,7), and the
 # viewer in headless Chromium with the emulated headset (?xr-emulate=1) playing the recording
 # as the headset's and controllers' poses (web/tests/xr_headset.test.mjs).
 #   tests/browser/viewer_xr_against_serve.sh DUET_BINARY DATA_DIR
@@ -22,7 +23,7 @@ trap cleanup EXIT
 
 recording="$work/60_07_points.csv"
 "$duet" convert "$data/cmu-salsa/bvh/60/60_07_scaled.bvh" --input-fps 60 --points head,hands \
-  -o "$recording" >/dev/null
+  --device-offsets-cm 6,6,7 -o "$recording" >/dev/null
 
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 log="$work/serve.log"

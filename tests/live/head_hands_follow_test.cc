@@ -179,12 +179,10 @@ TEST(HeadHandsFollow, ADanceOnARigWhoseRestPoseDoesNotStandIsFollowedFromItsThre
 
 TEST(HeadHandsFeatures, DeviceOffsetsPutTheEyesAndGripsWhereTheySit) {
   // A headset's eyes sit in front of and above the head joint, a controller's grip past the
-  // wrist along the forearm: every frame, at exactly that offset, in the head's facing frame and
-  // along the forearm as the take moves.
+  // wrist along the hand: every frame, at exactly that offset, in the head's facing frame and
+  // along the grip's arm axis (+Y) as the take moves; and device_points_to_joints takes it out.
   const LoadedMotion take = load_take("60_07");
-  DevicePointOffsets offsets;
-  offsets.eyes_m = Vec3(0.0, 0.07, 0.08);
-  offsets.grip_m = 0.08;
+  const DevicePointOffsets offsets = DevicePointOffsets::from_cm(8.0, 7.0, 8.0);
   Result<Clip> joints = head_hands_clip(take.clip, take.roles);
   Result<Clip> devices = head_hands_clip(take.clip, take.roles, offsets);
   ASSERT_TRUE(joints && devices);
@@ -206,19 +204,52 @@ TEST(HeadHandsFeatures, DeviceOffsetsPutTheEyesAndGripsWhereTheySit) {
     const Vec3 eyes = yaw_rotation(-heading_yaw(head)) *
                       (at(devices.value(), kPointsHead) - at(joints.value(), kPointsHead));
     EXPECT_GT(eyes.z(), 0.0);
+    // The grip's +Y points from the fist to the arm: the forearm (elbow to wrist) runs against it
+    // (the wrist bends it by tens of degrees, never past a right angle).
     const Vec3 forearm = positions[static_cast<std::size_t>(take.roles[Role::kLeftWrist])] -
                          positions[static_cast<std::size_t>(take.roles[Role::kLeftElbow])];
-    EXPECT_LT((at(devices.value(), kPointsLeftHand) - at(joints.value(), kPointsLeftHand) -
-               0.08 * forearm.normalized())
-                  .norm(),
-              1e-9);
+    const Vec3 to_arm = devices.value().rotations_ls(f)[kPointsLeftHand] * Vec3::UnitY();
+    EXPECT_LT(forearm.normalized().dot(to_arm), -0.3) << "frame " << f;
+    EXPECT_LT(
+        (at(devices.value(), kPointsLeftHand) - at(joints.value(), kPointsLeftHand) + 0.08 * to_arm)
+            .norm(),
+        1e-9);
   }
-  // A grip needs the elbows to know the forearm.
-  JointRoles no_elbow = take.roles;
-  no_elbow.joints[static_cast<std::size_t>(Role::kLeftElbow)] = -1;
-  Result<Clip> bad = head_hands_clip(take.clip, no_elbow, offsets);
-  ASSERT_FALSE(bad);
-  EXPECT_NE(bad.error().message.find("left_elbow"), std::string::npos) << bad.error().message;
+  // Taken out, the devices' points are the joints'.
+  Clip back = devices.value();
+  device_points_to_joints(offsets, back);
+  for (int f = 0; f < back.frame_count(); ++f) {
+    for (int j = kPointsHead; j <= kPointsRightHand; ++j) {
+      ASSERT_LT((back.translations_ls(f)[static_cast<std::size_t>(j)] -
+                 joints.value().translations_ls(f)[static_cast<std::size_t>(j)])
+                    .norm(),
+                1e-9)
+          << "frame " << f << " point " << j;
+    }
+  }
+}
+
+TEST(HeadHandsFeatures, AHandsOrientationIsWebXrsGripSpace) {
+  // WebXR's grip space: +Y toward the arm, +X out of the back of the right hand (out of the palm
+  // of the left). In the salsa rig's rest pose (a T-pose, palms down) the left arm runs to +X of
+  // the canonical frame (x left), so the left grip's +Y points to the body (-X) and its +X down;
+  // the right grip's +Y to +X and its +X up.
+  const LoadedMotion take = load_take("60_07");
+  Clip rest = take.clip;
+  for (int f = 0; f < rest.frame_count(); ++f) {
+    for (Quat& q : rest.rotations_ls(f)) q = Quat::Identity();
+  }
+  Result<Clip> points = head_hands_clip(rest, take.roles);
+  ASSERT_TRUE(points);
+  Result<Quat> correction = rest_pose_correction(take.clip.skeleton(), take.roles);
+  ASSERT_TRUE(correction);
+  const auto canonical = [&](int point, const Vec3& axis) {
+    return Vec3(correction.value().conjugate() * (points.value().rotations_ls(0)[point] * axis));
+  };
+  EXPECT_LT(canonical(kPointsLeftHand, Vec3::UnitY()).x(), -0.9);
+  EXPECT_LT(canonical(kPointsLeftHand, Vec3::UnitX()).y(), -0.9);
+  EXPECT_GT(canonical(kPointsRightHand, Vec3::UnitY()).x(), 0.9);
+  EXPECT_GT(canonical(kPointsRightHand, Vec3::UnitX()).y(), 0.9);
 }
 
 TEST(HeadHandsFeatures, IndependentOfThePlaceInTheRoomAndOfBodySize) {

@@ -1,6 +1,7 @@
 // `duet serve --source xr` end to end (issue 12): a headset's and controllers' poses arrive as
 // `xr_pose` messages, the three-point follower follows them and the partner stands in front of
-// the user at life size. The performance is take 60_07 as three points with a headset's noise.
+// the user at life size. The performance is take 60_07 as three points with a headset's noise,
+// the devices where a headset user's sit (the eyes, the grips).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -41,9 +42,14 @@ TEST(ServeXr, AHeadsetIsFollowedAndThePartnerStandsInFront) {
   Performance performance;
   performance.motion = motion.value().clip;
   performance.roles = motion.value().roles;
-  Result<Performance> points = with_head_hands(std::move(performance), PointNoiseOptions{});
+  // The devices where a typical headset user's sit, which the server takes out by default.
+  PointNoiseOptions devices;
+  devices.offsets = typical_headset_offsets();
+  Result<Performance> points = with_head_hands(std::move(performance), devices);
   ASSERT_TRUE(points) << points.error().message;
   const Clip& clip = points.value().motion;
+  Clip joints = clip;
+  device_points_to_joints(typical_headset_offsets(), joints);
 
   WsClient dancer;
   ASSERT_TRUE(dancer.connect(server.port()));
@@ -74,11 +80,13 @@ TEST(ServeXr, AHeadsetIsFollowedAndThePartnerStandsInFront) {
                 std::abs(follower["template_frame"].get<int>() - f) <= 6)
                    ? 1
                    : 0;
-    // The user's head comes back where it was sent; the partner's hips stand a partner's
-    // distance away on the floor plane.
+    // The user's head comes back at the head joint behind the eyes sent; the partner's hips
+    // stand a partner's distance away on the floor plane.
     const Json& head = (*frame)["user"]["positions"][kPointsHead];
     const Json& partner = (*frame)["partner"]["positions"][hips];
-    EXPECT_NEAR(head[1].get<double>(), clip.translations_ls(f)[kPointsHead].y(), 1e-3);
+    for (int axis = 0; axis < 3; ++axis) {
+      EXPECT_NEAR(head[axis].get<double>(), joints.translations_ls(f)[kPointsHead][axis], 1e-3);
+    }
     spacing.push_back(std::hypot(partner[0].get<double>() - head[0].get<double>(),
                                  partner[2].get<double>() - head[2].get<double>()));
   }

@@ -214,6 +214,9 @@ struct PointNoiseOptions {
   std::uint64_t seed = 1;
   // Where the devices sit against the joints (the eyes, the grips); zero: at the joints.
   DevicePointOffsets offsets;
+  // What the follower is told of them and takes out after the noise, as `duet follow
+  // --device-offsets-cm` and `duet serve` do (device_points_to_joints); zero: nothing.
+  DevicePointOffsets taken_out;
 };
 Result<Performance> with_head_hands(Performance performance, const PointNoiseOptions& noise);
 

@@ -8,11 +8,14 @@
 
 #include "duet/base/result.h"
 #include "duet/live/source_frame.h"
+#include "duet/motion/device_points.h"
 
 namespace duet {
 
 struct PoseSourceOptions {
   int queue_frames = 8;  // frames kept between polls; older ones are dropped on overflow
+  // Three points: where the devices sit against the joints, taken out of every xr_pose.
+  DevicePointOffsets device_offsets;
 };
 
 class PoseSource final : public FrameSource {
@@ -29,7 +32,8 @@ class PoseSource final : public FrameSource {
 
   // Three points (the `xr_pose` message; the source's skeleton must be the head-and-hands one,
   // duet/motion/head_hands.h): head, left and right hand positions in metres (within 1 km) and
-  // orientations, 4 numbers each (w, x, y, z). Same checks and queueing as push().
+  // orientations, 4 numbers each (w, x, y, z), moved from the devices to the joints by the
+  // options' device_offsets. Same checks and queueing as push().
   bool push_points(double time_s, std::span<const Vec3> positions,
                    std::span<const double> orientations_wxyz, SteadyClock::time_point arrival,
                    std::string& reason) noexcept;
@@ -43,6 +47,7 @@ class PoseSource final : public FrameSource {
   SourceSkeleton skeleton_;
   std::string name_;
   FrameQueue queue_;
+  DevicePointOffsets device_offsets_;
   bool have_epoch_ = false;
   SteadyClock::time_point epoch_{};
   SourceStats stats_;

@@ -3,17 +3,20 @@
 // motion on a tiny skeleton (an origin and three children), so every reader, source and recorder
 // that moves a skeleton moves three points too.
 //
-// Orientation convention (the devices', WebXR's and OpenXR's): the identity faces -Z with +Y up.
-// From a full-body take, a point's orientation is its joint's world rotation relative to the rest
-// pose, turned so the rest pose faces -Z: a dancer standing in the rest pose looks straight ahead
-// with the "controllers" pointing forward. A rig whose rest pose is no standing body turns the
-// head, on average over the take, to where its pelvis faces instead (head_correction).
+// Orientation convention (the devices', WebXR's and OpenXR's): the head's identity faces -Z with
+// +Y up; a hand's is the grip space of duet/motion/device_points.h (+Y from the fist toward the
+// arm). From a full-body take, the head's orientation is its joint's world rotation relative to
+// the rest pose, turned so the rest pose faces -Z: a dancer standing in the rest pose looks
+// straight ahead. A rig whose rest pose is no standing body turns the head, on average over the
+// take, to where its pelvis faces instead (head_correction). A hand's grip frame turns with the
+// wrist joint, its +Y along the wrist's bone toward the arm.
 #pragma once
 
 #include <memory>
 
 #include "duet/base/result.h"
 #include "duet/motion/clip.h"
+#include "duet/motion/device_points.h"
 #include "duet/motion/skeleton_map.h"
 
 namespace duet {
@@ -49,18 +52,17 @@ bool rest_pose_stands(const Skeleton& skeleton, const JointRoles& roles);
 // dancer looks where the body faces, give or take a turn of the head).
 Result<Quat> head_correction(const Clip& full_body, const JointRoles& roles);
 
-// Where a headset and two controllers sit against the head and wrist joints: the eyes in the
-// head's canonical frame (x left, y up, z forward), the controllers' grips past the wrist along
-// the forearm (elbow -> wrist). Zero: at the joints themselves.
-struct DevicePointOffsets {
-  Vec3 eyes_m = Vec3::Zero();
-  double grip_m = 0.0;
-  bool any() const { return eyes_m.squaredNorm() > 0.0 || grip_m != 0.0; }
-};
+// A hand's grip frame (duet/motion/device_points.h) in the rest pose, rigid with the wrist joint
+// `wrist_role` (left_wrist or right_wrist) from then on: R_grip = R_wrist_world * this. +Y along
+// the wrist's bone toward the arm; the palm's normal the rig's down made square to it (a T-pose's
+// palms face the floor), or its backward when the bone is near vertical; +X out of the back of
+// the right hand, out of the palm of the left. Errors: a wrist with no bone to its arm.
+Result<Quat> rest_grip_frame(const Skeleton& skeleton, const JointRoles& roles, Role wrist_role);
 
-// The three points of a full-body clip (any rig with head and wrist roles; elbow roles too for a
-// grip offset), on the head-and-hands skeleton, at the clip's rate: what a headset and
-// controllers would have reported. The head's orientation goes through head_correction.
+// The three points of a full-body clip (any rig with head and wrist roles), on the head-and-hands
+// skeleton, at the clip's rate: what a headset and controllers held `offsets` from the joints
+// would have reported (device_points_to_joints takes the offsets out again). The head's
+// orientation goes through head_correction.
 Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles,
                              const DevicePointOffsets& offsets = {});
 

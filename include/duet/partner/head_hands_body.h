@@ -6,6 +6,7 @@
 // user's size). Dancing as the template danced, that puts the user's hips where they are.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "duet/base/result.h"
@@ -28,11 +29,12 @@ class HeadHandsBody {
   int frame_count() const noexcept { return static_cast<int>(head_in_body_.size()); }
   // The highest the template's head was (metres): the size the user's head height is compared to.
   double template_head_height_m() const noexcept { return template_head_height_m_; }
-  // A point's world rotation on the template's rig from its canonical rotation: what the
-  // template's wrist would have been turned to (R_world = R_canonical * correction^-1), so the
-  // captured grip offset, carried in the template wrist's frame, can be carried by a controller.
-  Quat template_rotation(const Quat& canonical_ws) const noexcept {
-    return (canonical_ws * template_correction_.conjugate()).normalized();
+  // What the template's wrist would have been turned to holding a controller at `grip_ws` (its
+  // grip space, duet/motion/device_points.h): R_wrist = R_grip * rest grip frame^-1 of the
+  // template's rig, so the captured grip offset, carried in the template wrist's frame, can be
+  // carried by a controller. `left_hand` picks the hand.
+  Quat template_wrist_rotation(bool left_hand, const Quat& grip_ws) const noexcept {
+    return (grip_ws * rest_grips_[left_hand ? 0 : 1].conjugate()).normalized();
   }
 
   // The user's body heading frame from their head's heading frame at template frame `frame`
@@ -43,7 +45,7 @@ class HeadHandsBody {
  private:
   std::vector<Transform> head_in_body_;
   double template_head_height_m_ = 0.0;
-  Quat template_correction_ = Quat::Identity();  // head_correction of the template
+  std::array<Quat, 2> rest_grips_ = {Quat::Identity(), Quat::Identity()};  // left, right
 };
 
 }  // namespace duet
