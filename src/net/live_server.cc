@@ -96,7 +96,9 @@ struct LiveServer::Impl {
     pose = dynamic_cast<PoseSource*>(source.get());
     replay = dynamic_cast<ReplaySource*>(source.get());
     frame.resize(source->source_skeleton().joint_count());
-    hello = std::make_shared<const std::string>(make_hello(*loop, source->describe(), source_kind_name(spec.kind)));
+    if (pose && spec.kind == SourceKind::kXr) device_offsets = pose->device_offsets();
+    hello = std::make_shared<const std::string>(make_hello(
+        *loop, source->describe(), source_kind_name(spec.kind), device_offsets_or_null()));
     initial_params = loop->params();
     wanted_role = loop->role();
   }
@@ -432,8 +434,8 @@ struct LiveServer::Impl {
       }
       if (loaded->loop) {
         loaded->hello = std::make_shared<const std::string>(
-            make_hello(*loaded->loop.value(), source_description,
-                       source_kind_name(spec.kind)));
+            make_hello(*loaded->loop.value(), source_description, source_kind_name(spec.kind),
+                       device_offsets_or_null()));
         if (!stem.empty()) {
           Result<std::unique_ptr<SessionRecorder>> r =
               open_recording(directory, stem, user, *loaded->loop.value());
@@ -587,6 +589,10 @@ struct LiveServer::Impl {
   std::unique_ptr<LiveLoop> other_loop;
   std::shared_ptr<const std::string> other_hello;
   std::string source_description = source->describe();
+  std::optional<DevicePointOffsets> device_offsets;  // the headset source's
+  const DevicePointOffsets* device_offsets_or_null() const {
+    return device_offsets ? &*device_offsets : nullptr;
+  }
   std::thread loader;
   bool loading = false;
   DancerRole wanted_role = DancerRole::kLeader;

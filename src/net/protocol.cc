@@ -163,7 +163,7 @@ bool get_number(const json& value, double& out) {
 }  // namespace
 
 std::string make_hello(const LiveLoop& loop, const std::string& source_description,
-                       std::string_view source_kind) {
+                       std::string_view source_kind, const DevicePointOffsets* device_offsets) {
   const DuetLibrary& library = loop.library();
   json takes = json::array();
   for (std::size_t t = 0; t < library.takes().size(); ++t) {
@@ -182,7 +182,7 @@ std::string make_hello(const LiveLoop& loop, const std::string& source_descripti
                      {"frames", take.template_motion.clip.frame_count()},
                      {"contacts", std::move(intervals)}});
   }
-  const json hello = {
+  json hello = {
       {"type", "hello"},
       {"version", kProtocolVersion},
       {"role", dancer_role_name(loop.role())},
@@ -195,6 +195,11 @@ std::string make_hello(const LiveLoop& loop, const std::string& source_descripti
       {"source", source_description},
       {"source_kind", source_kind},
   };
+  if (device_offsets) {
+    const Vec3& eyes = device_offsets->eyes_m;
+    hello["device_offsets"] = {{"eyes_m", {eyes.x(), eyes.y(), eyes.z()}},
+                               {"grip_m", device_offsets->grip_m}};
+  }
   return hello.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 

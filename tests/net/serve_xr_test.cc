@@ -58,6 +58,9 @@ TEST(ServeXr, AHeadsetIsFollowedAndThePartnerStandsInFront) {
   EXPECT_EQ((*hello)["source_kind"], "xr");  // the viewer sends xr_pose on this
   EXPECT_EQ((*hello)["user_skeleton"]["joints"].size(), 4u);
   EXPECT_EQ((*hello)["user_skeleton"]["roles"]["head"], kPointsHead);
+  // What the server takes out of each pose, for the viewer to draw the devices where they are.
+  EXPECT_NEAR((*hello)["device_offsets"]["grip_m"].get<double>(), 0.07, 1e-12);
+  EXPECT_NEAR((*hello)["device_offsets"]["eyes_m"][2].get<double>(), 0.06, 1e-12);
   const int hips = (*hello)["partner_skeleton"]["roles"]["hips"].get<int>();
 
   const int poses = 600;  // 10 s

@@ -100,6 +100,17 @@ export class StickFigure {
     this.rotations_ws = this.joints.map(() => new THREE.Quaternion());
     this.posed = false;
     this.headHidden_ = false;
+    this.gripOffset_m_ = 0;
+  }
+
+  /**
+   * A headset user's devices, as `hello.device_offsets` gives them: the server moved each
+   * controller's grip `grip_m` along its +Y (WebXR's grip space, toward the arm) to the wrist;
+   * the hand blocks are drawn back at the grips, where the controllers are.
+   */
+  setDeviceOffsets(offsets) {
+    const grip = Number(offsets?.grip_m);
+    this.gripOffset_m_ = this.pointsOnly && Number.isFinite(grip) ? grip : 0;
   }
 
   setColor(color) {
@@ -132,6 +143,10 @@ export class StickFigure {
       joint.position.copy(this.positions_ws[i]);
       joint.quaternion.copy(this.rotations_ws[i]);
       joint.visible = this.shown_[i] && !(this.headHidden_ && i === this.roles.head);
+      if (this.gripOffset_m_ !== 0 && (i === this.roles.left_wrist || i === this.roles.right_wrist)) {
+        const to_arm = joint.userData.toArm ?? (joint.userData.toArm = new THREE.Vector3());
+        joint.position.addScaledVector(to_arm.set(0, 1, 0).applyQuaternion(this.rotations_ws[i]), -this.gripOffset_m_);
+      }
       const bone = this.boneMeshes[i];
       if (!bone) continue;
       const from = this.positions_ws[this.joints[i].parent];

@@ -173,6 +173,7 @@ async function main() {
     state.hello = msg;
     state.role = msg.role === 'partner' ? 'partner' : 'leader';
     state.user = new StickFigure(msg.user_skeleton, kRoleColors[state.role]);
+    state.user.setDeviceOffsets(msg.device_offsets);
     state.partner = new StickFigure(msg.partner_skeleton, kRoleColors[otherRole(state.role)]);
     scene.add(state.user.group, state.partner.group);
     state.user.setHeadHidden(state.cameraMode !== 'orbit');
@@ -611,6 +612,9 @@ async function main() {
         user_head_drawn: drawn(head),
         user_hands_drawn: drawn(state.user?.roles.left_wrist ?? -1) && drawn(state.user?.roles.right_wrist ?? -1),
         user_points_only: !!state.user?.pointsOnly,
+        // How far each hand block is drawn from the server's wrist (the controller's grip offset).
+        user_hand_blocks_from_wrists_m: [state.user?.roles.left_wrist ?? -1, state.user?.roles.right_wrist ?? -1].map(
+          (j) => (j >= 0 ? state.user.jointMeshes[j].position.distanceTo(state.user.positions_ws[j]) : null)),
       };
     },
     /** CSS colours of the figures now: {user, partner}. */

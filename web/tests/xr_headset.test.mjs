@@ -244,6 +244,12 @@ test('a headset playing a three-point recording is followed, the partner in fron
     assert.equal(shot.user_head_drawn, false, "the user's own head is drawn in first person");
     assert.equal(shot.user_points_only, true, 'the user is not drawn as head and hands');
     assert.equal(shot.user_hands_drawn, true, "the user's hands are not drawn");
+    // The server took the controllers' grips to the wrists (hello.device_offsets, 7 cm); the
+    // blocks are drawn back at the grips, where the controllers are.
+    assert.equal(shot.user_hand_blocks_from_wrists_m.length, 2);
+    for (const d of shot.user_hand_blocks_from_wrists_m) {
+      assert.ok(Math.abs(d - 0.07) < 1e-4, `a hand block ${d} m from its wrist, not at the grip 0.07 m away`);
+    }
     // Every XR frame's look after the settling second: hundreds of looks over the whole dance,
     // so the shares below are the dance's, not those of a dozen looks that fell where they fell
     // (one look every half second failed the facing share once in about eight runs under load).

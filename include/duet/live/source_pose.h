@@ -39,6 +39,7 @@ class PoseSource final : public FrameSource {
                    std::string& reason) noexcept;
 
   const SourceSkeleton& source_skeleton() const noexcept override { return skeleton_; }
+  const DevicePointOffsets& device_offsets() const noexcept { return device_offsets_; }
   std::string describe() const override { return name_; }
   bool poll(SteadyClock::time_point now, SourceFrame& out) noexcept override;
   SourceStats stats() const noexcept override;

@@ -13,6 +13,7 @@
 #include "duet/live/live_loop.h"
 #include "duet/live/source_frame.h"
 #include "duet/live/source_replay.h"
+#include "duet/motion/device_points.h"
 
 namespace duet::net {
 
@@ -31,8 +32,11 @@ constexpr std::size_t kMaxJsonValues = 16384;
 // `hello`: skeletons (joints, parents, offsets, roles), takes with their contact intervals, the
 // role, the template frame rate, the corrections, and the source: its description for people and
 // its kind ("replay", "ws", "xr", ...) for clients (the viewer sends headset poses for "xr").
+// `device_offsets` (the headset source's, or null): what the server takes out of each xr_pose, so
+// a viewer can draw the user's devices where they are.
 std::string make_hello(const LiveLoop& loop, const std::string& source_description,
-                       std::string_view source_kind);
+                       std::string_view source_kind,
+                       const DevicePointOffsets* device_offsets = nullptr);
 
 // `frame`: appends to `text` after clearing it. `seq` >= 0 replaces output.seq (the server counts
 // frames across role switches, which change the loop).
