@@ -7,6 +7,8 @@
 // BM_FollowSessionStepScalar/*: the same on the scalar kernels (DUET_SIMD=scalar), same run.
 // BM_FollowSessionStepHeadHands: take 01 as a headset's three points (head and hands) against the
 // library built from the same three points (16 dims).
+// BM_DevicePointsToJoints: one headset pose moved from the devices to the joints (duet serve
+// --source xr does it to every xr_pose before the step above).
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -20,6 +22,7 @@
 #include "duet/io/motion_file.h"
 #include "duet/live/duet_library.h"
 #include "duet/live/follow_session.h"
+#include "duet/motion/device_points.h"
 #include "duet/motion/head_hands.h"
 #include "salsa_pairs.h"
 
@@ -115,6 +118,18 @@ void BM_FollowSessionStepHeadHands(benchmark::State& state) {
   follow_session_step(state, detect_simd_level(), InputPoints::kHeadHands);
 }
 BENCHMARK(BM_FollowSessionStepHeadHands)->Arg(0)->Unit(benchmark::kMicrosecond)->MinTime(3.0);
+
+void BM_DevicePointsToJoints(benchmark::State& state) {
+  const DevicePointOffsets offsets = typical_headset_offsets();
+  std::vector<Vec3> translations(kHeadHandsJointCount, Vec3(0.1, 1.5, -0.2));
+  std::vector<Quat> rotations(kHeadHandsJointCount, Quat(0.9, 0.1, 0.3, 0.2).normalized());
+  for (auto _ : state) {
+    device_points_to_joints(offsets, translations, rotations);
+    benchmark::DoNotOptimize(translations.data());
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_DevicePointsToJoints)->Unit(benchmark::kNanosecond);
 
 }  // namespace
 }  // namespace duet
