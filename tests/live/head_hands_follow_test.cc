@@ -252,6 +252,20 @@ TEST(HeadHandsFeatures, AHandsOrientationIsWebXrsGripSpace) {
   EXPECT_GT(canonical(kPointsRightHand, Vec3::UnitX()).y(), 0.9);
 }
 
+TEST(HeadHandsFeatures, AWristWithNoBoneHasNoGripFrame) {
+  // A wrist at its parent's place, all the way up: nothing says where the arm is.
+  auto skeleton = std::make_shared<Skeleton>();
+  skeleton->joints.push_back(Joint{"root", -1, Vec3::Zero(), {}, false});
+  skeleton->joints.push_back(Joint{"hand", 0, Vec3::Zero(), {}, false});
+  JointRoles roles;
+  roles.joints.fill(-1);
+  roles.joints[static_cast<std::size_t>(Role::kLeftWrist)] = 1;
+  Result<Quat> grip = rest_grip_frame(*skeleton, roles, Role::kLeftWrist);
+  ASSERT_FALSE(grip);
+  EXPECT_NE(grip.error().message.find("left_wrist joint has no bone"), std::string::npos)
+      << grip.error().message;
+}
+
 TEST(HeadHandsFeatures, IndependentOfThePlaceInTheRoomAndOfBodySize) {
   const LoadedMotion take = load_take("60_07");
   Performance base;

@@ -6,6 +6,7 @@
 
 #include "duet/io/bvh.h"
 #include "duet/math/rotation.h"
+#include "duet/motion/head_hands.h"
 
 namespace duet {
 namespace {
@@ -104,6 +105,36 @@ TEST(SourcePose, TimeFromArrivalWhenTheSenderGivesNone) {
   EXPECT_DOUBLE_EQ(frame.time_s, 0.0);
   ASSERT_TRUE(source.poll(t0, frame));
   EXPECT_NEAR(frame.time_s, 0.25, 1e-9);
+}
+
+TEST(SourcePose, AHeadsetsPointsAreMovedFromTheDevicesToTheJoints) {
+  // The headset source takes the devices' offsets out of every xr_pose: the head joint 6 cm
+  // behind and below the eyes in the headset's own frame, each wrist 7 cm along its grip's +Y.
+  PoseSourceOptions options;
+  options.device_offsets = typical_headset_offsets();
+  PoseSource source(SourceSkeleton{make_head_hands_skeleton(), head_hands_roles(), 1.0, 72.0},
+                    options, "xr");
+  // The headset turned 90 degrees left (facing -X), the left grip pointing its +Y down, the
+  // right grip the identity.
+  const Quat head = yaw_rotation(0.5 * kPi);
+  const Quat left = Quat(Eigen::AngleAxisd(kPi, Vec3::UnitX()));
+  const std::vector<Vec3> positions = {Vec3(0.0, 1.6, 0.0), Vec3(0.3, 1.0, -0.3),
+                                       Vec3(-0.3, 1.0, -0.3)};
+  const std::vector<double> orientations = {head.w(), head.x(), head.y(), head.z(),
+                                            left.w(), left.x(), left.y(), left.z(),
+                                            1.0,      0.0,      0.0,      0.0};
+  std::string reason;
+  const auto now = SteadyClock::now();
+  ASSERT_TRUE(source.push_points(1.0, positions, orientations, now, reason)) << reason;
+  SourceFrame frame;
+  frame.resize(kHeadHandsJointCount);
+  ASSERT_TRUE(source.poll(now, frame));
+  // Facing -X, the head joint is 6 cm behind the eyes (+X) and 6 cm below them.
+  EXPECT_LT((frame.translations_ls[kPointsHead] - Vec3(0.06, 1.54, 0.0)).norm(), 1e-9);
+  EXPECT_LT((frame.translations_ls[kPointsLeftHand] - Vec3(0.3, 0.93, -0.3)).norm(), 1e-9);
+  EXPECT_LT((frame.translations_ls[kPointsRightHand] - Vec3(-0.3, 1.07, -0.3)).norm(), 1e-9);
+  // The orientations are passed on as sent.
+  EXPECT_LT(frame.rotations_ls[kPointsHead].angularDistance(head), 1e-9);
 }
 
 }  // namespace
