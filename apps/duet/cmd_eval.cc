@@ -494,7 +494,7 @@ Command register_eval(CLI::App& app) {
                  "calibration costs")
       ->expected(3)
       ->delimiter(',')
-      ->check(number_between(-30.0, 30.0, "device offset"));
+      ->check(number_between(-30.0, 30.0, "cm"));
   app.add_flag("--beam", args->beam,
                "Run the hmm and hmm-paper trackers in beam mode (docs/follower.md "
                "\"Beam mode\"; the partner metrics keep the exact step)");

@@ -42,7 +42,7 @@ CLI::Option* add_device_offsets_option(CLI::App& app, std::vector<double>& cm,
                       what)
       ->expected(3)
       ->delimiter(',')
-      ->check(number_between(-30.0, 30.0, "device offset"));
+      ->check(number_between(-30.0, 30.0, "cm"));
 }
 
 DevicePointOffsets device_offsets_from_cm(const std::vector<double>& cm) {

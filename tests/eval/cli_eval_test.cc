@@ -120,7 +120,9 @@ TEST(CliEval, BadOptionsExitTwoAndBadFilesExitOne) {
       {"--no-partner-metrics --partner-csv x.csv", "--partner-csv"},
       {"--device-offsets-cm 8,7,8", "--device-offsets-cm"},  // full body: no devices
       {"--input-points head,hands --device-offsets-cm 8,7", ""},
-      {"--input-points head,hands --device-offsets-cm 8,7,80", ""},
+      {"--input-points head,hands --device-offsets-cm 8,7,80", "between -30 and 30 cm"},
+      {"--taken-out-offsets-cm 6,6,7", "--taken-out-offsets-cm"},  // full body: no devices
+      {"--input-points head,hands --taken-out-offsets-cm 6,nan,7", "--taken-out-offsets-cm"},
   };
   testing::CommandResult r;
   for (const auto& [options, named] : bad_options) {
