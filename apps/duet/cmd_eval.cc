@@ -487,14 +487,11 @@ Command register_eval(CLI::App& app) {
   add_device_offsets_option(app, args->device_offsets_cm,
                             "The performance's points are put there (e.g. 6,6,7; default: at the "
                             "joints); the partner metrics still score the real wrists");
-  app.add_option("--taken-out-offsets-cm", args->taken_out_cm,
-                 "Three points: the device offsets the follower is told and takes out after the "
-                 "sensor noise, FORWARD,UP,GRIP in cm as duet follow's and duet serve's "
-                 "--device-offsets-cm (default: none). With --device-offsets-cm, how a wrong "
-                 "calibration costs")
-      ->expected(3)
-      ->delimiter(',')
-      ->check(number_between(-30.0, 30.0, "cm"));
+  add_offsets_cm_option(app, "--taken-out-offsets-cm", args->taken_out_cm,
+                        "Three points: the device offsets the follower is told and takes out "
+                        "after the sensor noise, FORWARD,UP,GRIP in cm as duet follow's and duet "
+                        "serve's --device-offsets-cm (default: none). With --device-offsets-cm, "
+                        "how a wrong calibration costs");
   app.add_flag("--beam", args->beam,
                "Run the hmm and hmm-paper trackers in beam mode (docs/follower.md "
                "\"Beam mode\"; the partner metrics keep the exact step)");

@@ -31,18 +31,22 @@ Result<InputPoints> choose_input_points(const std::string& option, LoadedMotion&
   return InputPoints::kHeadHands;
 }
 
-CLI::Option* add_device_offsets_option(CLI::App& app, std::vector<double>& cm,
-                                       const std::string& what) {
-  return app
-      .add_option("--device-offsets-cm", cm,
-                  "Three points: where the devices sit against the head and wrist joints, "
-                  "FORWARD,UP,GRIP in cm: the headset's eyes FORWARD in front of and UP above the "
-                  "head joint, each controller's grip GRIP past the wrist along the hand, on the "
-                  "grip's +Y axis (WebXR's grip space). " +
-                      what)
+CLI::Option* add_offsets_cm_option(CLI::App& app, const std::string& name, std::vector<double>& cm,
+                                   const std::string& help) {
+  return app.add_option(name, cm, help)
       ->expected(3)
       ->delimiter(',')
       ->check(number_between(-30.0, 30.0, "cm"));
+}
+
+CLI::Option* add_device_offsets_option(CLI::App& app, std::vector<double>& cm,
+                                       const std::string& what) {
+  return add_offsets_cm_option(
+      app, "--device-offsets-cm", cm,
+      "Three points: where the devices sit against the head and wrist joints, FORWARD,UP,GRIP in "
+      "cm: the headset's eyes FORWARD in front of and UP above the head joint, each controller's "
+      "grip GRIP past the wrist along the hand, on the grip's +Y axis (WebXR's grip space). " +
+          what);
 }
 
 DevicePointOffsets device_offsets_from_cm(const std::vector<double>& cm) {

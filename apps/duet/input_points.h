@@ -23,6 +23,10 @@ inline constexpr const char* kInputPointsHelp =
 // its three points. Errors when the input cannot give what is asked.
 Result<InputPoints> choose_input_points(const std::string& option, LoadedMotion& motion);
 
+// An option of three device offsets FORWARD,UP,GRIP in cm (duet/motion/device_points.h), each
+// within 30 cm.
+CLI::Option* add_offsets_cm_option(CLI::App& app, const std::string& name, std::vector<double>& cm,
+                                   const std::string& help);
 // --device-offsets-cm FORWARD,UP,GRIP (duet/motion/device_points.h): where a headset's eyes and
 // the controllers' grips sit against the head and wrist joints. `what` ends the help: what the
 // command does with them.

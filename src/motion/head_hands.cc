@@ -1,6 +1,7 @@
 #include "duet/motion/head_hands.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -133,32 +134,37 @@ Result<Quat> head_correction(const Clip& full_body, const JointRoles& roles) {
   return mean_rotation(per_frame);
 }
 
-Result<Quat> rest_grip_frame(const Skeleton& skeleton, const JointRoles& roles, Role wrist_role) {
-  const int wrist = roles[wrist_role];
-  Vec3 bone = Vec3::Zero();
-  for (int j = wrist; j >= 0 && bone.norm() < 1e-6;
-       j = skeleton.joints[static_cast<std::size_t>(j)].parent) {
-    bone = skeleton.joints[static_cast<std::size_t>(j)].offset;
-  }
-  if (bone.norm() < 1e-6) {
-    return Error{"the " + std::string(role_name(wrist_role)) + " joint has no bone to its arm"};
-  }
-  const Vec3 to_arm = -bone.normalized();
+Result<std::array<Quat, 2>> rest_grip_frames(const Skeleton& skeleton, const JointRoles& roles) {
   Quat to_y_up;
   const std::vector<Vec3> positions = upright_rest_positions(skeleton, roles, to_y_up);
   const double yaw = body_heading_yaw(positions, roles);
   const Vec3 forward =
       to_y_up.conjugate() * (yaw_rotation(std::isfinite(yaw) ? yaw : 0.0) * Vec3::UnitZ());
-  auto square_to_arm = [&](const Vec3& v) { return Vec3(v - v.dot(to_arm) * to_arm); };
-  Vec3 palm = square_to_arm(to_y_up.conjugate() * -Vec3::UnitY());
-  if (palm.norm() < 0.5) palm = square_to_arm(-forward);
-  palm.normalize();
-  const Vec3 x = wrist_role == Role::kRightWrist ? Vec3(-palm) : palm;
-  Eigen::Matrix3d axes;
-  axes.col(0) = x;
-  axes.col(1) = to_arm;
-  axes.col(2) = x.cross(to_arm);
-  return Quat(axes).normalized();
+  const Vec3 down = to_y_up.conjugate() * -Vec3::UnitY();
+  std::array<Quat, 2> grips;
+  for (const Role wrist_role : {Role::kLeftWrist, Role::kRightWrist}) {
+    Vec3 bone = Vec3::Zero();
+    for (int j = roles[wrist_role]; j >= 0 && bone.norm() < 1e-6;
+         j = skeleton.joints[static_cast<std::size_t>(j)].parent) {
+      bone = skeleton.joints[static_cast<std::size_t>(j)].offset;
+    }
+    if (bone.norm() < 1e-6) {
+      return Error{"the " + std::string(role_name(wrist_role)) + " joint has no bone to its arm"};
+    }
+    const Vec3 to_arm = -bone.normalized();
+    auto square_to_arm = [&](const Vec3& v) { return Vec3(v - v.dot(to_arm) * to_arm); };
+    Vec3 palm = square_to_arm(down);
+    if (palm.norm() < 0.5) palm = square_to_arm(-forward);
+    palm.normalize();
+    const bool right = wrist_role == Role::kRightWrist;
+    const Vec3 x = right ? Vec3(-palm) : palm;
+    Eigen::Matrix3d axes;
+    axes.col(0) = x;
+    axes.col(1) = to_arm;
+    axes.col(2) = x.cross(to_arm);
+    grips[right ? 1 : 0] = Quat(axes).normalized();
+  }
+  return grips;
 }
 
 Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles,
@@ -172,15 +178,13 @@ Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles,
   }
   Result<Quat> correction = head_correction(full_body, roles);
   if (!correction) return correction.error();
-  Result<Quat> left_grip = rest_grip_frame(full_body.skeleton(), roles, Role::kLeftWrist);
-  if (!left_grip) return left_grip.error();
-  Result<Quat> right_grip = rest_grip_frame(full_body.skeleton(), roles, Role::kRightWrist);
-  if (!right_grip) return right_grip.error();
+  Result<std::array<Quat, 2>> grips = rest_grip_frames(full_body.skeleton(), roles);
+  if (!grips) return grips.error();
   // Each point's device rotation from its joint's world rotation: the head's so that
   // R_device * device_correction = R_world * head correction (the same canonical frame), the
   // hands' their grip frames.
   const Quat to_device[] = {correction.value() * head_hands_device_correction().conjugate(),
-                            left_grip.value(), right_grip.value()};
+                            grips.value()[0], grips.value()[1]};
   Clip points(make_head_hands_skeleton(), full_body.frame_rate(), full_body.frame_count());
   const auto n = static_cast<std::size_t>(full_body.joint_count());
   std::vector<Vec3> positions(n);

@@ -96,7 +96,6 @@ struct LiveServer::Impl {
     pose = dynamic_cast<PoseSource*>(source.get());
     replay = dynamic_cast<ReplaySource*>(source.get());
     frame.resize(source->source_skeleton().joint_count());
-    if (pose && spec.kind == SourceKind::kXr) device_offsets = pose->device_offsets();
     hello = std::make_shared<const std::string>(make_hello(
         *loop, source->describe(), source_kind_name(spec.kind), device_offsets_or_null()));
     initial_params = loop->params();
@@ -589,9 +588,9 @@ struct LiveServer::Impl {
   std::unique_ptr<LiveLoop> other_loop;
   std::shared_ptr<const std::string> other_hello;
   std::string source_description = source->describe();
-  std::optional<DevicePointOffsets> device_offsets;  // the headset source's
+  // What the headset source takes out of each xr_pose (for hello); null for other sources.
   const DevicePointOffsets* device_offsets_or_null() const {
-    return device_offsets ? &*device_offsets : nullptr;
+    return pose && spec.kind == SourceKind::kXr ? &pose->device_offsets() : nullptr;
   }
   std::thread loader;
   bool loading = false;

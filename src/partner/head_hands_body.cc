@@ -26,11 +26,9 @@ Result<HeadHandsBody> HeadHandsBody::build(const Clip& template_clip,
   Result<Quat> correction = head_correction(template_clip, template_roles);
   if (!correction) return Error{"the template: " + correction.error().message};
   HeadHandsBody body;
-  for (const Role wrist : {Role::kLeftWrist, Role::kRightWrist}) {
-    Result<Quat> grip = rest_grip_frame(template_clip.skeleton(), template_roles, wrist);
-    if (!grip) return Error{"the template: " + grip.error().message};
-    body.rest_grips_[wrist == Role::kLeftWrist ? 0 : 1] = grip.value();
-  }
+  Result<std::array<Quat, 2>> grips = rest_grip_frames(template_clip.skeleton(), template_roles);
+  if (!grips) return Error{"the template: " + grips.error().message};
+  body.rest_grips_ = grips.value();
   body.head_in_body_.resize(static_cast<std::size_t>(template_clip.frame_count()));
   const auto n = static_cast<std::size_t>(template_clip.joint_count());
   std::vector<Vec3> positions(n);

@@ -260,7 +260,7 @@ TEST(HeadHandsFeatures, AWristWithNoBoneHasNoGripFrame) {
   JointRoles roles;
   roles.joints.fill(-1);
   roles.joints[static_cast<std::size_t>(Role::kLeftWrist)] = 1;
-  Result<Quat> grip = rest_grip_frame(*skeleton, roles, Role::kLeftWrist);
+  Result<std::array<Quat, 2>> grip = rest_grip_frames(*skeleton, roles);
   ASSERT_FALSE(grip);
   EXPECT_NE(grip.error().message.find("left_wrist joint has no bone"), std::string::npos)
       << grip.error().message;

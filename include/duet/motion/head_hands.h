@@ -12,6 +12,7 @@
 // wrist joint, its +Y along the wrist's bone toward the arm.
 #pragma once
 
+#include <array>
 #include <memory>
 
 #include "duet/base/result.h"
@@ -52,12 +53,12 @@ bool rest_pose_stands(const Skeleton& skeleton, const JointRoles& roles);
 // dancer looks where the body faces, give or take a turn of the head).
 Result<Quat> head_correction(const Clip& full_body, const JointRoles& roles);
 
-// A hand's grip frame (duet/motion/device_points.h) in the rest pose, rigid with the wrist joint
-// `wrist_role` (left_wrist or right_wrist) from then on: R_grip = R_wrist_world * this. +Y along
-// the wrist's bone toward the arm; the palm's normal the rig's down made square to it (a T-pose's
-// palms face the floor), or its backward when the bone is near vertical; +X out of the back of
-// the right hand, out of the palm of the left. Errors: a wrist with no bone to its arm.
-Result<Quat> rest_grip_frame(const Skeleton& skeleton, const JointRoles& roles, Role wrist_role);
+// Each hand's grip frame (duet/motion/device_points.h) in the rest pose, left then right, rigid
+// with its wrist joint from then on: R_grip = R_wrist_world * this. +Y along the wrist's bone
+// toward the arm; the palm's normal the rig's down made square to it (a T-pose's palms face the
+// floor), or its backward when the bone is near vertical; +X out of the back of the right hand,
+// out of the palm of the left. Errors: a wrist with no bone to its arm.
+Result<std::array<Quat, 2>> rest_grip_frames(const Skeleton& skeleton, const JointRoles& roles);
 
 // The three points of a full-body clip (any rig with head and wrist roles), on the head-and-hands
 // skeleton, at the clip's rate: what a headset and controllers held `offsets` from the joints
