@@ -135,34 +135,46 @@ Result<Quat> head_correction(const Clip& full_body, const JointRoles& roles) {
 }
 
 Result<std::array<Quat, 2>> rest_grip_frames(const Skeleton& skeleton, const JointRoles& roles) {
+  const auto in_rig = [&](Role role) {
+    return roles[role] >= 0 && roles[role] < skeleton.joint_count();
+  };
+  // Each wrist's bone toward its arm: its offset, or its parents' where it sits on them.
+  constexpr Role kWrists[] = {Role::kLeftWrist, Role::kRightWrist};
+  std::array<Vec3, 2> to_arm;
+  for (std::size_t hand = 0; hand < 2; ++hand) {
+    Vec3 bone = Vec3::Zero();
+    if (in_rig(kWrists[hand])) {
+      for (int j = roles[kWrists[hand]]; j >= 0 && bone.norm() < 1e-6;
+           j = skeleton.joints[static_cast<std::size_t>(j)].parent) {
+        bone = skeleton.joints[static_cast<std::size_t>(j)].offset;
+      }
+    }
+    if (bone.norm() < 1e-6) {
+      return Error{"the " + std::string(role_name(kWrists[hand])) +
+                   " joint has no bone to its arm"};
+    }
+    to_arm[hand] = -bone.normalized();
+  }
   Quat to_y_up;
   const std::vector<Vec3> positions = upright_rest_positions(skeleton, roles, to_y_up);
-  const double yaw = body_heading_yaw(positions, roles);
+  const double yaw =
+      in_rig(Role::kLeftHip) && in_rig(Role::kRightHip) ? body_heading_yaw(positions, roles) : 0.0;
   const Vec3 forward =
       to_y_up.conjugate() * (yaw_rotation(std::isfinite(yaw) ? yaw : 0.0) * Vec3::UnitZ());
   const Vec3 down = to_y_up.conjugate() * -Vec3::UnitY();
   std::array<Quat, 2> grips;
-  for (const Role wrist_role : {Role::kLeftWrist, Role::kRightWrist}) {
-    Vec3 bone = Vec3::Zero();
-    for (int j = roles[wrist_role]; j >= 0 && bone.norm() < 1e-6;
-         j = skeleton.joints[static_cast<std::size_t>(j)].parent) {
-      bone = skeleton.joints[static_cast<std::size_t>(j)].offset;
-    }
-    if (bone.norm() < 1e-6) {
-      return Error{"the " + std::string(role_name(wrist_role)) + " joint has no bone to its arm"};
-    }
-    const Vec3 to_arm = -bone.normalized();
-    auto square_to_arm = [&](const Vec3& v) { return Vec3(v - v.dot(to_arm) * to_arm); };
+  for (std::size_t hand = 0; hand < 2; ++hand) {
+    const Vec3& arm = to_arm[hand];
+    auto square_to_arm = [&](const Vec3& v) { return Vec3(v - v.dot(arm) * arm); };
     Vec3 palm = square_to_arm(down);
     if (palm.norm() < 0.5) palm = square_to_arm(-forward);
     palm.normalize();
-    const bool right = wrist_role == Role::kRightWrist;
-    const Vec3 x = right ? Vec3(-palm) : palm;
+    const Vec3 x = kWrists[hand] == Role::kRightWrist ? Vec3(-palm) : palm;
     Eigen::Matrix3d axes;
     axes.col(0) = x;
-    axes.col(1) = to_arm;
-    axes.col(2) = x.cross(to_arm);
-    grips[right ? 1 : 0] = Quat(axes).normalized();
+    axes.col(1) = arm;
+    axes.col(2) = x.cross(arm);
+    grips[hand] = Quat(axes).normalized();
   }
   return grips;
 }
