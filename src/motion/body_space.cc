@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "duet/motion/forward_kinematics.h"
@@ -85,7 +86,18 @@ BodyDimensions measure_body(const Skeleton& skeleton, const JointRoles& roles,
   return body;
 }
 
+namespace {
+
+bool has_hips(std::span<const Vec3> positions_ws, const JointRoles& roles) noexcept {
+  const int left = roles[Role::kLeftHip], right = roles[Role::kRightHip];
+  return left >= 0 && right >= 0 &&
+         static_cast<std::size_t>(std::max(left, right)) < positions_ws.size();
+}
+
+}  // namespace
+
 double body_heading_yaw(std::span<const Vec3> positions_ws, const JointRoles& roles) noexcept {
+  if (!has_hips(positions_ws, roles)) return std::numeric_limits<double>::quiet_NaN();
   auto horizontal_unit = [](Vec3 v) {
     v.y() = 0.0;
     const double n = v.norm();
@@ -107,6 +119,8 @@ double body_heading_yaw(std::span<const Vec3> positions_ws, const JointRoles& ro
 }
 
 Vec3 pelvis_centre(std::span<const Vec3> positions_ws, const JointRoles& roles) noexcept {
+  if (!has_hips(positions_ws, roles))
+    return Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
   return 0.5 * (positions_ws[static_cast<std::size_t>(roles[Role::kLeftHip])] +
                 positions_ws[static_cast<std::size_t>(roles[Role::kRightHip])]);
 }

@@ -82,7 +82,7 @@ Result<Quat> rest_pose_correction(const Skeleton& skeleton, const JointRoles& ro
   const std::vector<Vec3> positions = upright_rest_positions(skeleton, roles, to_y_up);
   const double yaw = body_heading_yaw(positions, roles);
   if (!std::isfinite(yaw)) {
-    return Error{"the rest pose has no heading (hip joints at one place?)"};
+    return Error{"the rest pose has no heading (no hip joints, or both at one place)"};
   }
   return to_y_up.conjugate() * yaw_rotation(yaw);
 }
@@ -157,8 +157,7 @@ Result<std::array<Quat, 2>> rest_grip_frames(const Skeleton& skeleton, const Joi
   }
   Quat to_y_up;
   const std::vector<Vec3> positions = upright_rest_positions(skeleton, roles, to_y_up);
-  const double yaw =
-      in_rig(Role::kLeftHip) && in_rig(Role::kRightHip) ? body_heading_yaw(positions, roles) : 0.0;
+  const double yaw = body_heading_yaw(positions, roles);  // NaN without hips: face +Z
   const Vec3 forward =
       to_y_up.conjugate() * (yaw_rotation(std::isfinite(yaw) ? yaw : 0.0) * Vec3::UnitZ());
   const Vec3 down = to_y_up.conjugate() * -Vec3::UnitY();

@@ -266,6 +266,38 @@ TEST(HeadHandsFeatures, AWristWithNoBoneHasNoGripFrame) {
       << grip.error().message;
 }
 
+TEST(HeadHandsFeatures, ARigWithNoHipsHasNoHeadingAndSaysSo) {
+  // A head and two arms on a root, no hip joints: where the body faces is unknown, and asking
+  // for it must say so (it once read the hips' positions out of bounds).
+  auto skeleton = std::make_shared<Skeleton>();
+  skeleton->joints.push_back(Joint{"root", -1, Vec3::Zero(), {}, false});
+  skeleton->joints.push_back(Joint{"head", 0, Vec3(0.0, 0.5, 0.0), {}, false});
+  skeleton->joints.push_back(Joint{"left_hand", 0, Vec3(0.6, 0.3, 0.0), {}, false});
+  skeleton->joints.push_back(Joint{"right_hand", 0, Vec3(-0.6, 0.3, 0.0), {}, false});
+  JointRoles roles;
+  roles.joints.fill(-1);
+  roles.joints[static_cast<std::size_t>(Role::kHips)] = 0;  // a body, not a headset's points
+  roles.joints[static_cast<std::size_t>(Role::kHead)] = 1;
+  roles.joints[static_cast<std::size_t>(Role::kLeftWrist)] = 2;
+  roles.joints[static_cast<std::size_t>(Role::kRightWrist)] = 3;
+  const std::vector<Vec3> positions = {Vec3::Zero(), Vec3(0.0, 0.5, 0.0), Vec3(0.6, 0.3, 0.0),
+                                       Vec3(-0.6, 0.3, 0.0)};
+  EXPECT_TRUE(std::isnan(body_heading_yaw(positions, roles)));
+  EXPECT_TRUE(pelvis_centre(positions, roles).array().isNaN().all());
+  roles.joints[static_cast<std::size_t>(Role::kLeftHip)] = 7;  // outside the rig
+  roles.joints[static_cast<std::size_t>(Role::kRightHip)] = 0;
+  EXPECT_TRUE(std::isnan(body_heading_yaw(positions, roles)));
+
+  const Clip clip(skeleton, 60.0, 3);
+  Result<Quat> correction = head_correction(clip, roles);
+  ASSERT_FALSE(correction);
+  EXPECT_NE(correction.error().message.find("no hip joints"), std::string::npos)
+      << correction.error().message;
+  EXPECT_FALSE(head_hands_clip(clip, roles));
+  // The grips need no heading: the palms face the floor.
+  EXPECT_TRUE(rest_grip_frames(*skeleton, roles));
+}
+
 TEST(HeadHandsFeatures, IndependentOfThePlaceInTheRoomAndOfBodySize) {
   const LoadedMotion take = load_take("60_07");
   Performance base;

@@ -32,11 +32,12 @@ BodyDimensions measure_body(const Skeleton& skeleton, const JointRoles& roles,
 // The body's heading (yaw about +Y, the convention of duet::heading_yaw: 0 faces +Z) from world
 // joint positions: the facing is perpendicular to the mean of the hip line and the shoulder line
 // (right to left, on the floor; the hips alone when the shoulders have no joint). Independent of
-// the root joint's axes.
+// the root joint's axes. NaN when the rig has no hip joints (roles missing or outside positions_ws)
+// or the hips stand at one place.
 double body_heading_yaw(std::span<const Vec3> positions_ws, const JointRoles& roles) noexcept;
 
 // The pelvis centre: the midpoint of the two hip (thigh) joints, which sit at the same place on
-// every rig, unlike the root joint.
+// every rig, unlike the root joint. NaN when the rig has no hip joints.
 Vec3 pelvis_centre(std::span<const Vec3> positions_ws, const JointRoles& roles) noexcept;
 
 }  // namespace duet
