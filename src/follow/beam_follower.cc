@@ -531,7 +531,9 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   context.history_.explained_residual.update(
       result.best_distance_per_dim,
       !result.missing && !result.outlier && !result.in_pause && !result.jumped, dt_s);
-  result.lost = result.lost || unexplained;
+  result.lost =
+      result.lost || context.history_.confirm_unexplained(params, unexplained, result.missing,
+                                                          result.steps / model.frame_rate_hz());
   return result;
 }
 

@@ -35,6 +35,7 @@ FollowParams FollowParams::paper() {
   params.noise_filter_density = 0.0f;
   params.calibrate_confidence = false;
   params.lost_residual_per_dim = std::numeric_limits<float>::infinity();
+  params.lost_confirm_s = 0.0f;
   return params;
 }
 
@@ -101,6 +102,10 @@ Status FollowParams::validate(int num_states) const {
   if (!(lost_residual_per_dim >= 0.0f)) {  // +inf allowed: the fixed lost_distance_per_dim
     return params_error("lost_residual_per_dim must be >= 0, got " +
                         std::to_string(lost_residual_per_dim));
+  }
+  if (!(lost_confirm_s >= 0.0f && lost_confirm_s <= 10.0f)) {
+    return params_error("lost_confirm_s must be in [0, 10] s, got " +
+                        std::to_string(lost_confirm_s));
   }
   if (confidence_window_frames < 0) {
     return params_error("confidence_window_frames must be >= 0, got " +

@@ -15,6 +15,8 @@ void FollowerHistory::reset() noexcept {
   previous_state = -1;
   previous_lost = false;
   previous_outlier = false;
+  lost_by_distance = false;
+  against_s = 0.0;
   tempo.reset();
   jump_gate.reset();
   sensor_noise.reset();

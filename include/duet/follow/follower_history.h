@@ -35,11 +35,30 @@ struct FollowerHistory {
            previous_state >= 0 && !previous_lost && !previous_outlier && jump_gate.settled(params);
   }
 
+  // Whether the input is lost by distance, with hysteresis: it turns lost once past the
+  // noise-scaled lost distance (`unexplained`) on consecutive frames for
+  // FollowParams::lost_confirm_s of input time (`frame_s`: the frame's template steps over the
+  // template rate), and followed again once within it for as long. A frame with no features
+  // changes nothing.
+  bool confirm_unexplained(const FollowParams& params, bool unexplained, bool missing,
+                           double frame_s) noexcept {
+    if (missing) return lost_by_distance;
+    if (unexplained == lost_by_distance) {
+      against_s = 0.0;
+    } else if ((against_s += frame_s) >= params.lost_confirm_s - 1e-6) {
+      lost_by_distance = unexplained;
+      against_s = 0.0;
+    }
+    return lost_by_distance;
+  }
+
   double total_log_likelihood = 0.0;  // a sum over the whole performance, hence double
   long long frames = 0;
   int previous_state = -1;
   bool previous_lost = false;
   bool previous_outlier = false;  // the previous frame's evidence was set aside (outlier gate)
+  bool lost_by_distance = false;  // confirm_unexplained's decision
+  double against_s = 0.0;         // input time the frames have disagreed with it, consecutively
   TempoEstimator tempo;
   JumpGate jump_gate;
   SensorNoiseEstimator sensor_noise;

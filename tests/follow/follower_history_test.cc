@@ -1,0 +1,71 @@
+#include "duet/follow/follower_history.h"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+
+namespace duet {
+namespace {
+
+constexpr double k60Hz = 1.0 / 60.0;
+constexpr double k30Hz = 1.0 / 30.0;
+
+// Feeds `unexplained` for `frames` frames of `frame_s` each; returns the last decision.
+bool feed(FollowerHistory& history, const FollowParams& params, bool unexplained, int frames,
+          double frame_s = k60Hz) {
+  bool lost = false;
+  for (int f = 0; f < frames; ++f) {
+    lost = history.confirm_unexplained(params, unexplained, false, frame_s);
+  }
+  return lost;
+}
+
+TEST(FollowerHistory, LostByDistanceOnlyAfterItHoldsForTheConfirmTime) {
+  const FollowParams params;  // lost_confirm_s 0.05: three frames at 60 Hz, two at 30 Hz
+  ASSERT_FLOAT_EQ(params.lost_confirm_s, 0.05f);
+  FollowerHistory history;
+  EXPECT_FALSE(feed(history, params, true, 2));  // a two-frame flicker
+  EXPECT_FALSE(feed(history, params, false, 1));
+  EXPECT_FALSE(feed(history, params, true, 2));
+  EXPECT_TRUE(feed(history, params, true, 1));  // the third in a row
+  // Followed again only after as long within the distance: a one-frame gap stays lost.
+  EXPECT_TRUE(feed(history, params, false, 2));
+  EXPECT_TRUE(feed(history, params, true, 1));
+  EXPECT_TRUE(feed(history, params, false, 2));
+  EXPECT_FALSE(feed(history, params, false, 1));
+
+  FollowerHistory slow;
+  EXPECT_FALSE(feed(slow, params, true, 1, k30Hz));
+  EXPECT_TRUE(feed(slow, params, true, 1, k30Hz));
+}
+
+TEST(FollowerHistory, AMissingFrameChangesNothingAndResetForgets) {
+  const FollowParams params;
+  FollowerHistory history;
+  EXPECT_FALSE(feed(history, params, true, 2));
+  EXPECT_FALSE(history.confirm_unexplained(params, false, true, k60Hz));  // no features
+  EXPECT_TRUE(feed(history, params, true, 1));  // the run goes on across it
+  EXPECT_TRUE(history.confirm_unexplained(params, false, true, k60Hz));
+  history.reset();
+  EXPECT_FALSE(feed(history, params, true, 2));
+}
+
+TEST(FollowerHistory, ZeroConfirmTimeDecidesEveryFrame) {
+  FollowParams params;
+  params.lost_confirm_s = 0.0f;
+  FollowerHistory history;
+  EXPECT_TRUE(feed(history, params, true, 1));
+  EXPECT_FALSE(feed(history, params, false, 1));
+  EXPECT_TRUE(feed(history, params, true, 1));
+}
+
+TEST(FollowerHistory, TheConfirmTimeIsChecked) {
+  FollowParams params;
+  for (const float bad : {-0.01f, 11.0f, std::numeric_limits<float>::quiet_NaN()}) {
+    params.lost_confirm_s = bad;
+    EXPECT_FALSE(params.validate(10)) << bad;
+  }
+}
+
+}  // namespace
+}  // namespace duet
