@@ -731,6 +731,32 @@ bool PartnerSynthesisJob::run() const noexcept {
   if (p.contact) {
     const HandContacts& contacts = model->contacts();
     const double step = p.ik_fade_s > 0.0 ? dt / p.ik_fade_s : 1.0;
+    // An arm whose IK stops (its fade ended, the user's hand unknown this frame) lets its filtered
+    // correction go the way it came, through the filter and at most ik_correction_max_speed_rad_s,
+    // instead of in one frame: the correction lags the fading IK, and dropping what was left
+    // swung a 1.15x proportioned user's partner's forearm at up to 2500 deg/s (docs/evaluation.md,
+    // "The IK's correction let go"). At a blended jump the blend takes it.
+    const auto release_correction = [&](std::size_t r) {
+      std::array<OneEuroFilter3, 2>& filters = ctx.ik_correction_filter_[r];
+      std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
+      constexpr double kReleasedRad = 1e-4;
+      const bool holding = shown[0].norm() > kReleasedRad || shown[1].norm() > kReleasedRad;
+      if (!p.smooth || (p.blend && jumped) || !filters[0].primed() || !filters[1].primed() ||
+          !holding) {
+        for (OneEuroFilter3& filter : filters) filter.reset();
+        shown = {Vec3::Zero(), Vec3::Zero()};
+        return;
+      }
+      const ArmRoles& arm = kArms[r];
+      const std::array<std::size_t, 2> joints = {static_cast<std::size_t>(roles[arm.shoulder]),
+                                                 static_cast<std::size_t>(roles[arm.elbow])};
+      const double most = p.ik_correction_max_speed_rad_s * dt;
+      for (std::size_t k = 0; k < 2; ++k) {
+        shown[k] = step_towards(shown[k],
+                                filters[k].filter(Vec3::Zero(), dt, p.ik_correction_filter), most);
+        out_r[joints[k]] = (out_r[joints[k]] * exp_map(shown[k])).normalized();
+      }
+    };
     for (std::size_t r = 0; r < 2; ++r) {
       // The template hand in contact with this response hand; the closer one if both are.
       int pair = -1;
@@ -754,7 +780,7 @@ bool PartnerSynthesisJob::run() const noexcept {
       ctx.ik_ramp_[r] = ramp;
       const double weight = smoothstep(ctx.ik_ramp_[r]);
       if (weight <= 0.0 || ctx.ik_pair_[r] < 0) {
-        for (OneEuroFilter3& filter : ctx.ik_correction_filter_[r]) filter.reset();
+        release_correction(r);
         ctx.ik_target_valid_[r] = false;
         continue;
       }
@@ -763,7 +789,7 @@ bool PartnerSynthesisJob::run() const noexcept {
       // captured path while the weight falls.
       const Side ts = template_side(ctx.ik_pair_[r]);
       if (!finite_pose(*user, ts)) {
-        for (OneEuroFilter3& filter : ctx.ik_correction_filter_[r]) filter.reset();
+        release_correction(r);
         ctx.ik_target_valid_[r] = false;
         continue;
       }
@@ -837,7 +863,10 @@ bool PartnerSynthesisJob::run() const noexcept {
       ik.start_rotation_ls_out = &ik_start;
       ik.mid_rotation_ls_out = &ik_mid;
       ik.end_position_ws = &reached_at;
-      if (!ik.run()) continue;
+      if (!ik.run()) {
+        release_correction(r);
+        continue;
+      }
       std::array<OneEuroFilter3, 2>& filters = ctx.ik_correction_filter_[r];
       if (!p.smooth || (p.blend && jumped)) {
         for (OneEuroFilter3& filter : filters) filter.reset();

@@ -369,6 +369,40 @@ TEST(PartnerSynthesis, TheIkAddsAtMostItsSpeedLimitToTheArmUnderJitter) {
   EXPECT_GT(largest[1], 2.0 * largest[0]);
 }
 
+TEST(PartnerSynthesis, AnArmLetsItsCorrectionGoAtTheSpeedLimit) {
+  // Hands held until frame 120 on a standing duet, the user's hand 25 cm off the template's (a
+  // body of other proportions): the correction lags the IK as its weight fades out, and once the
+  // weight is 0 (or the user's hand is unknown for a frame) what is left of it must go at most
+  // ik_correction_max_speed_rad_s, not in one frame, and all of it in the end.
+  const Vec3 grip(0.0, 0.0, 0.04);
+  Duet duet(300, 0, 120, grip);
+  const std::size_t shoulder = static_cast<std::size_t>(duet.roles[Role::kRightShoulder]);
+  const std::size_t elbow = static_cast<std::size_t>(duet.roles[Role::kRightElbow]);
+  PartnerParams params = only(true, true, true, false, false);
+  params.ik_fade_s = 0.05;  // a quick release leaves most of the correction behind
+  Runner run(duet.model, params);
+  Quat previous_shoulder = Quat::Identity(), previous_elbow = Quat::Identity();
+  double largest = 0.0, held = 0.0;
+  for (int f = 0; f < 300; ++f) {
+    UserPose user = user_from(duet.leader, f, duet.roles);
+    user.wrist_positions_ws[0] += Vec3(0.0, -0.25, 0.0);
+    if (f == 80) user.wrist_positions_ws[0].x() = std::numeric_limits<double>::quiet_NaN();
+    run.step(duet.follower, f, user);
+    if (f == 79) held = run.r[elbow].angularDistance(duet.follower.rotations_ls(f)[elbow]);
+    if (f > 40) {  // the contact has faded in
+      largest = std::max({largest, run.r[shoulder].angularDistance(previous_shoulder),
+                          run.r[elbow].angularDistance(previous_elbow)});
+    }
+    previous_shoulder = run.r[shoulder];
+    previous_elbow = run.r[elbow];
+  }
+  EXPECT_GT(held, 0.3);  // the IK bent the elbow well away from the captured arm
+  EXPECT_LE(largest, params.ik_correction_max_speed_rad_s * kDt + 1e-6);
+  // Let go entirely: the captured arm.
+  EXPECT_LT(run.r[shoulder].angularDistance(duet.follower.rotations_ls(299)[shoulder]), 1e-6);
+  EXPECT_LT(run.r[elbow].angularDistance(duet.follower.rotations_ls(299)[elbow]), 1e-6);
+}
+
 TEST(PartnerSynthesis, AHeavilyJitteringWristLeavesTheHandNearTheRealOne) {
   // Hands held throughout, standing; the sensor puts the user's wrist 4 cm per axis off its real
   // place every frame at 30 Hz (4 degrees per joint and axis do that to a salsa dancer's wrist).
