@@ -365,9 +365,8 @@ int run_eval(EvalArgs& args) {
       "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s "
       "(mass {}) noisy_jump_hold {} s jump_old_place_mass {} jump_alike_distance {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
-      "lost_residual_factor {} lost_confirm {} s emission_noise_factor {} emission_noise_allowance "
-      "{} "
-      "noise_filter_density {} noise_filter_allowance {}\n\n",
+      "lost_residual_factor {} lost_confirm {} s emission_noise_factor {} "
+      "emission_noise_allowance {} noise_filter_density {} noise_filter_allowance {}\n\n",
       library->takes().size(), library->model().num_states(), library->frame_rate(),
       args.library.role, takes, options.seed, hmm.self_prob, hmm.next_prob, hmm.skip_prob,
       hmm.leave_prob, hmm.pause_stay_prob, hmm.emission_sigma, hmm.pause_distance_per_dim,

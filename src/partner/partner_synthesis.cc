@@ -734,8 +734,8 @@ bool PartnerSynthesisJob::run() const noexcept {
     // An arm whose IK stops (its fade ended, the user's hand unknown this frame) lets its filtered
     // correction go the way it came, through the filter and at most ik_correction_max_speed_rad_s,
     // instead of in one frame: the correction lags the fading IK, and dropping what was left
-    // swung a 1.15x proportioned user's partner's forearm at up to 2500 deg/s (docs/evaluation.md,
-    // "The IK's correction let go"). At a blended jump the blend takes it.
+    // swung the forearm of a partner of a user of other proportions at up to 2500 deg/s
+    // (docs/evaluation.md, "The IK's correction let go"). At a blended jump the blend takes it.
     const auto release_correction = [&](std::size_t r) {
       std::array<OneEuroFilter3, 2>& filters = ctx.ik_correction_filter_[r];
       std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
