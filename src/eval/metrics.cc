@@ -72,6 +72,7 @@ void MetricsAccumulator::add(std::span<const TruthFrame> truth, std::span<const 
     }
   }
   if (n > 1) duration_s_ += times_s[n - 1] - times_s[0];
+  for (std::size_t i = 1; i < n; ++i) lost_switches_ += estimates[i].lost != estimates[i - 1].lost;
 
   // Reported jumps that answer no true jump: outside every window that opens just before a true
   // jump's pause (or the jump) and closes jump_answer_window_s after the jump.
@@ -131,6 +132,7 @@ void MetricsAccumulator::merge(const MetricsAccumulator& other) {
   misses_ += other.misses_;
   tracked_ += other.tracked_;
   lost_on_tracked_ += other.lost_on_tracked_;
+  lost_switches_ += other.lost_switches_;
   reported_jumps_ += other.reported_jumps_;
   false_jumps_ += other.false_jumps_;
   duration_s_ += other.duration_s_;
@@ -166,6 +168,8 @@ Metrics MetricsAccumulator::summary() const {
   m.false_jumps = false_jumps_;
   m.false_jumps_per_minute =
       duration_s_ > 0.0 ? static_cast<double>(false_jumps_) / (duration_s_ / 60.0) : 0.0;
+  m.lost_switches_per_minute =
+      duration_s_ > 0.0 ? static_cast<double>(lost_switches_) / (duration_s_ / 60.0) : 0.0;
   m.jumps = static_cast<long long>(recovery_s_.size());
   double recovered_sum = 0.0;
   for (const double r : recovery_s_) {

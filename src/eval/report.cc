@@ -29,13 +29,13 @@ void append_csv_row(std::string& out, const std::string& case_name, const std::s
   fmt::format_to(
       std::back_inserter(out),
       "{},{},{},{},{},{},{},{:.5f},{:.5f},{:.5f},{:.5f},{:.2f},{:.2f},{},{},{},{},{:.5f},"
-      "{:.2f},{},{},{:.3f},{:.5f},{:.5f}\n",
+      "{:.2f},{},{},{:.3f},{:.5f},{:.5f},{:.3f}\n",
       case_name, tracker, take, take_name, m.frames, m.scored_frames, m.pause_frames, m.within_50ms,
       m.within_100ms, m.within_300ms, m.miss_fraction, m.mean_error_ms, m.median_error_ms, m.jumps,
       m.recovered_jumps, m.jumps ? number_or_empty(m.median_recovery_s, 4) : "",
       m.recovered_jumps ? number_or_empty(m.mean_recovery_s, 4) : "", m.lost_fraction,
       m.mean_step_us, m.reported_jumps, m.false_jumps, m.false_jumps_per_minute,
-      m.lost_on_tracked_fraction, m.confidence_ece);
+      m.lost_on_tracked_fraction, m.confidence_ece, m.lost_switches_per_minute);
 }
 
 std::string take_name(const EvalReport& report, int take) {
@@ -380,7 +380,7 @@ std::string format_eval_csv(const EvalReport& report) {
       "case,tracker,take,take_name,frames,scored_frames,pause_frames,acc_50ms,acc_100ms,acc_300ms,"
       "miss_fraction,mean_error_ms,median_error_ms,jumps,recovered_jumps,median_recovery_s,"
       "mean_recovery_s,lost_fraction,mean_step_us,reported_jumps,false_jumps,"
-      "false_jumps_per_minute,lost_on_tracked_fraction,confidence_ece\n";
+      "false_jumps_per_minute,lost_on_tracked_fraction,confidence_ece,lost_switches_per_minute\n";
   for (const EvalRow& row : report.rows) {
     for (const auto& [take, metrics] : row.per_take) {
       append_csv_row(out, row.case_name, row.tracker, std::to_string(take), take_name(report, take),

@@ -170,6 +170,16 @@ TEST(Metrics, LostOnTrackedFramesCountsOnlyFramesWithin100Ms) {
   EXPECT_NEAR(m.lost_on_tracked_fraction, 10.0 / 80.0, 1e-12);
 }
 
+TEST(Metrics, LostSwitchesCountEveryChangeOfTheFlagPerMinute) {
+  Trace t(601);  // 10 s at 60 Hz
+  for (int k : {100, 200, 201, 202, 300}) t.estimates[static_cast<std::size_t>(k)].lost = true;
+  // 100 on and off, 200-202 on and off, 300 on and off: 6 changes in 10 s.
+  EXPECT_NEAR(t.metrics().lost_switches_per_minute, 36.0, 1e-9);
+  Trace steady(601);
+  for (int k = 100; k < 601; ++k) steady.estimates[static_cast<std::size_t>(k)].lost = true;
+  EXPECT_NEAR(steady.metrics().lost_switches_per_minute, 6.0, 1e-9);
+}
+
 TEST(Metrics, PoolsPerformances) {
   Trace a(100), b(300);
   for (auto& e : b.estimates) e.take = 2;  // b is all misses

@@ -74,6 +74,9 @@ struct Metrics {
   // Lost among the frames the tracker actually follows (scored, within 100 ms): a lost flag there
   // is a false alarm (issue 11).
   double lost_on_tracked_fraction = 0.0;
+  // How often the lost flag changes (either way) per minute of performance: what a client that
+  // shows or acts on it (OSC /duet/lost, the partner's coasting) sees flicker.
+  double lost_switches_per_minute = 0.0;
   // Jumps the tracker reported (FrameEstimate::jumped) and those that answer no true jump (see
   // MetricsOptions::jump_answer_window_s), per minute of performance.
   long long reported_jumps = 0;
@@ -109,6 +112,7 @@ class MetricsAccumulator {
   CalibrationAccumulator calibration_;
   long long frames_ = 0, pause_frames_ = 0, lost_ = 0, misses_ = 0;
   long long tracked_ = 0, lost_on_tracked_ = 0, reported_jumps_ = 0, false_jumps_ = 0;
+  long long lost_switches_ = 0;
   double duration_s_ = 0.0;
   double step_us_sum_ = 0.0;
 };
