@@ -150,6 +150,17 @@ Vec3 step_towards(const Vec3& from, const Vec3& to, double most) {
   return distance > most ? Vec3(from + (to - from) * (most / distance)) : to;
 }
 
+// One frame of an arm joint's IK correction (a rotation vector): `raw` through the joint's 1-euro
+// filter, then at most `most` from what was shown last frame once the filter has a past. Returns
+// the new `shown`.
+Vec3 step_correction(OneEuroFilter3& filter, Vec3& shown, const Vec3& raw, double dt,
+                     const OneEuroParams& params, double most) {
+  const bool primed = filter.primed();
+  const Vec3 filtered = filter.filter(raw, dt, params);
+  shown = primed ? step_towards(shown, filtered, most) : filtered;
+  return shown;
+}
+
 // A blended place passes the user no nearer than this (pelvis centres, metres) unless an end does.
 constexpr double kKeepOutM = 0.4;
 // The detour is fullest where the line passes nearest, but within this part of the blend, so that
@@ -752,9 +763,9 @@ bool PartnerSynthesisJob::run() const noexcept {
                                                  static_cast<std::size_t>(roles[arm.elbow])};
       const double most = p.ik_correction_max_speed_rad_s * dt;
       for (std::size_t k = 0; k < 2; ++k) {
-        shown[k] = step_towards(shown[k],
-                                filters[k].filter(Vec3::Zero(), dt, p.ik_correction_filter), most);
-        out_r[joints[k]] = (out_r[joints[k]] * exp_map(shown[k])).normalized();
+        const Vec3 c =
+            step_correction(filters[k], shown[k], Vec3::Zero(), dt, p.ik_correction_filter, most);
+        out_r[joints[k]] = (out_r[joints[k]] * exp_map(c)).normalized();
       }
     };
     for (std::size_t r = 0; r < 2; ++r) {
@@ -892,12 +903,8 @@ bool PartnerSynthesisJob::run() const noexcept {
                   : p.ik_correction_clean_cutoff_hz;
         }
         const auto correct = [&](std::size_t k, const Quat& captured, const Quat& solved) {
-          const bool primed = filters[k].primed();
-          Vec3 c = filters[k].filter(log_map(captured.conjugate() * solved), dt, correction_filter);
-          const double most = p.ik_correction_max_speed_rad_s * dt;
-          if (primed) c = step_towards(shown[k], c, most);
-          shown[k] = c;
-          return c;
+          return step_correction(filters[k], shown[k], log_map(captured.conjugate() * solved), dt,
+                                 correction_filter, p.ik_correction_max_speed_rad_s * dt);
         };
         const Vec3 start_correction = correct(0, captured_start, ik_start);
         const Vec3 mid_correction = correct(1, captured_mid, ik_mid);
