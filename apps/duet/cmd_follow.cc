@@ -245,7 +245,15 @@ int run_follow(const FollowArgs& args) {
       corrections_string(loop.value().params()),
       loop.value().params().foot_hold.enabled ? ", foot hold" : "");
   if (truth) print_accuracy_summary(*truth, results, library->frame_rate());
-  if (summary.lost_fraction() <= kMostlyLostFraction) return kExitOk;
+  const float median_tempo = median_followed_tempo(results);
+  if (summary.lost_fraction() <= kMostlyLostFraction) {
+    // Followed, but perhaps in slow or fast motion: the rate is the one cause worth a warning.
+    if (std::optional<std::string> rate =
+            rate_mismatch(user.frame_rate(), library->frame_rate(), median_tempo)) {
+      fmt::print(stderr, "duet follow: warning: {}\n", *rate);
+    }
+    return kExitOk;
+  }
 
   // Most of the input was lost: say why it may be, and fail unless that was the point.
   LostContext context;
@@ -253,10 +261,7 @@ int run_follow(const FollowArgs& args) {
   context.input_rate_hz = user.frame_rate();
   context.library_rate_hz = library->frame_rate();
   parse_dancer_role(args.library.role, context.role);
-  std::vector<float> tempos;
-  for (const FollowResult& r : results) tempos.push_back(r.tempo);
-  std::ranges::nth_element(tempos, tempos.begin() + static_cast<std::ptrdiff_t>(tempos.size() / 2));
-  context.median_tempo = tempos[tempos.size() / 2];
+  context.median_tempo = median_tempo;
   context.other_role_lost_fraction = lost_as_other_role(args, user, input.value().roles, features);
   fmt::print(stderr, "duet follow: {:.0f}% of the input's frames are lost (no part of the library "
              "explains them). Likely causes:\n", 100.0 * summary.lost_fraction());
@@ -306,7 +311,8 @@ Command register_follow(CLI::App& app) {
   add_motion_file_options(app, args->partner_rig_motion, "partner-rig-");
   app.add_flag("--allow-lost", args->allow_lost,
                "Exit 0 even when over half the input's frames are lost (by default duet follow "
-               "then lists the likely causes and exits 3)");
+               "then lists the likely causes and exits 3). A followed input whose median tempo "
+               "is outside 0.66-1.5x the library's gets a warning naming the frame rate to pass");
   app.add_option("--truth", args->truth_path,
                  "Ground truth CSV from `duet improvise` with the same pairs in the same order: "
                  "print the follower's accuracy (a take or frame the library lacks is an error)")

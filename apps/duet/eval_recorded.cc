@@ -1,7 +1,11 @@
 #include "eval_recorded.h"
 
+#include <fmt/format.h>
+
 #include <charconv>
+#include <cmath>
 #include <memory>
+#include <optional>
 
 #include "duet/eval/performance.h"
 #include "duet/io/motion_argument.h"
@@ -31,6 +35,26 @@ std::string take_names(const DuetLibrary& library) {
   return names;
 }
 
+// A recording of a take lasts as long as the take. The same number of frames at another rate is
+// the sign of a wrong header (the CMU salsa BVH files say 120 fps, the takes are 60 Hz): the
+// truth, frame i at the take's moment i / rate, would be off by the ratio on every frame and the
+// case would score near 0 with hardly a frame lost.
+std::optional<std::string> rate_disagreement(const Clip& recording, const Clip& take) {
+  const int frames = recording.frame_count();
+  const int take_frames = take.frame_count();
+  const double same_frames = std::max(2.0, 0.02 * take_frames);
+  const double rate_ratio = recording.frame_rate() / take.frame_rate();
+  if (std::abs(frames - take_frames) > same_frames || std::abs(rate_ratio - 1.0) <= 0.05) {
+    return std::nullopt;
+  }
+  return fmt::format(
+      "the recording has {} frames like the take ({}), but at {:g} fps it lasts {:.1f} s against "
+      "the take's {:.1f} s at {:g} fps: one of the two frame rates is wrong (--recorded-fps {:g} "
+      "reads the recording at the take's; --fps sets the library's)",
+      frames, take_frames, recording.frame_rate(), recording.duration(), take.duration(),
+      take.frame_rate(), take.frame_rate());
+}
+
 }  // namespace
 
 Result<std::vector<EvalCase>> load_recorded_cases(const std::vector<std::string>& entries,
@@ -55,6 +79,9 @@ Result<std::vector<EvalCase>> load_recorded_cases(const std::vector<std::string>
     if (!loaded) return Error{where + ": " + loaded.error().message};
     const DuetTake& source = library.takes()[static_cast<std::size_t>(take)];
     const Clip& template_clip = source.template_motion.clip;
+    if (std::optional<std::string> rates = rate_disagreement(loaded.value().clip, template_clip)) {
+      return Error{where + ": " + *rates};
+    }
     Result<Performance> performance =
         recorded_performance(std::move(loaded.value().clip), loaded.value().roles, take,
                              template_clip.frame_count(), template_clip.frame_rate());

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace duet::app {
@@ -24,6 +26,41 @@ std::string describe_set_aside(const LostSummary& summary) {
                      summary.missing, summary.outliers);
 }
 
+float median_followed_tempo(std::span<const FollowResult> results) {
+  std::vector<float> followed;
+  std::vector<float> all;
+  for (const FollowResult& r : results) {
+    all.push_back(r.tempo);
+    if (!r.lost) followed.push_back(r.tempo);
+  }
+  std::vector<float>& tempos = 10 * followed.size() >= all.size() ? followed : all;
+  if (tempos.empty()) return 1.0f;
+  const auto middle = tempos.begin() + static_cast<std::ptrdiff_t>(tempos.size() / 2);
+  std::ranges::nth_element(tempos, middle);
+  return *middle;
+}
+
+std::optional<std::string> rate_mismatch(double input_rate_hz, double library_rate_hz,
+                                         float median_tempo) {
+  if (median_tempo >= kSlowestDancerTempo && median_tempo <= kFastestDancerTempo) {
+    return std::nullopt;
+  }
+  // The rate at which the input would move at the library's tempo (a 60 Hz take read at 120 fps
+  // moves at 2x), snapped to a capture rate.
+  double rate = input_rate_hz / median_tempo;
+  constexpr std::array<double, 10> kCommonRates{24, 25, 30, 48, 50, 60, 90, 100, 120, 240};
+  for (const double common : kCommonRates) {
+    if (std::abs(rate - common) <= 0.1 * common) {
+      rate = common;
+      break;
+    }
+  }
+  return fmt::format(
+      "rate: the input was read at {:g} fps but moves {:.2f}x as fast as the library ({:g} fps); "
+      "if its header is wrong, pass --input-fps {:.0f}",
+      input_rate_hz, median_tempo, library_rate_hz, rate);
+}
+
 std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostContext& context) {
   std::vector<std::string> causes;
   // The role: the same input followed as the other dancer.
@@ -39,12 +76,9 @@ std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostCon
         100.0 * summary.lost_fraction(), dancer_role_name(other), dancer_role_name(other)));
   }
   // The rate: the follower's tempo far from 1 means the input's clock runs at another speed.
-  if (context.median_tempo > 1.5f || context.median_tempo < 0.66f) {
-    const double rate = context.input_rate_hz * context.median_tempo;
-    causes.push_back(fmt::format(
-        "rate: the input was read at {:g} fps but moves {:.2f}x as fast as the library ({:g} fps); "
-        "if its header is wrong, pass --input-fps {:.0f}",
-        context.input_rate_hz, context.median_tempo, context.library_rate_hz, rate));
+  if (std::optional<std::string> rate = rate_mismatch(
+          context.input_rate_hz, context.library_rate_hz, context.median_tempo)) {
+    causes.push_back(std::move(*rate));
   }
   if (context.input != nullptr) {
     const LoadedMotion& input = *context.input;
@@ -78,7 +112,7 @@ std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostCon
     }
   }
   if (std::abs(context.input_rate_hz - context.library_rate_hz) > 1e-6 &&
-      std::abs(context.median_tempo - 1.0f) <= 0.5f) {
+      !rate_mismatch(context.input_rate_hz, context.library_rate_hz, context.median_tempo)) {
     causes.push_back(fmt::format(
         "rate: the input runs at {:g} fps and the library at {:g} fps (fine if both are right)",
         context.input_rate_hz, context.library_rate_hz));

@@ -36,10 +36,26 @@ struct LostContext {
   double input_rate_hz = 0.0;    // the rate the input was followed at
   double library_rate_hz = 0.0;
   DancerRole role = DancerRole::kLeader;
-  float median_tempo = 1.0f;     // the follower's tempo estimate over the tracked frames
+  float median_tempo = 1.0f;     // median_followed_tempo of the results
   // Lost fraction when the same input is followed as the other dancer (if it was tried).
   std::optional<double> other_role_lost_fraction;
 };
+
+// The follower's median tempo over the frames it did not flag lost (over every frame when fewer
+// than a tenth were followed); 1 without frames.
+float median_followed_tempo(std::span<const FollowResult> results);
+
+// A dancer's own tempo stays within these of the library's (method.md 7 performs 0.7x-1.4x);
+// a median outside them says the input's clock runs at another speed: a wrong frame rate.
+constexpr float kSlowestDancerTempo = 0.66f;
+constexpr float kFastestDancerTempo = 1.5f;
+
+// One line of advice when the median tempo says the input's frame rate is wrong, naming the rate
+// to pass (snapped to a common capture rate when one is near); nothing otherwise. Checked also
+// when the input was followed: a 60 Hz take read at its header's 120 fps is followed at twice the
+// tempo, in fast motion, and none of it is lost.
+std::optional<std::string> rate_mismatch(double input_rate_hz, double library_rate_hz,
+                                         float median_tempo);
 
 // The likely causes, most likely first; one line each, phrased as advice. Never empty.
 std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostContext& context);

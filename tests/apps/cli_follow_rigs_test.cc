@@ -86,6 +86,21 @@ TEST(CliFollowRigs, MostlyLostInputExitsThreeWithCausesUnlessAllowed) {
   EXPECT_EQ(allowed.exit_code, 0) << allowed.output;
 }
 
+TEST(CliFollowRigs, AnInputAtTheWrongRateIsFollowedInFastMotionAndSaid) {
+  // A 60 Hz take read at its header's 120 fps: followed at twice the tempo, no frame lost, so the
+  // lost diagnosis never runs; the rate alone is warned of, with the rate to pass.
+  const std::string input = data_path("cmu-salsa/bvh/60/60_03_scaled.bvh");
+  const testing::CommandResult slow = run_duet("follow" + two_pairs() + " --input " + input);
+  EXPECT_EQ(slow.exit_code, 0) << slow.output;
+  EXPECT_NE(slow.output.find("warning: rate: the input was read at 120"), std::string::npos)
+      << slow.output;
+  EXPECT_NE(slow.output.find("pass --input-fps 60"), std::string::npos) << slow.output;
+  const testing::CommandResult right =
+      run_duet("follow" + two_pairs() + " --input " + input + " --input-fps 60");
+  EXPECT_EQ(right.exit_code, 0) << right.output;
+  EXPECT_EQ(right.output.find("rate:"), std::string::npos) << right.output;
+}
+
 TEST(CliFollowRigs, DancingThePartnersPartIsNamedAsTheLikelyCause) {
   // The follower's file given as the user's while the library expects the leader.
   const testing::CommandResult r =

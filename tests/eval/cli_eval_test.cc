@@ -178,6 +178,19 @@ TEST(CliEval, ScoresARecordingOfATakeOnItsOwnRig) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(CliEval, ARecordingAtAnotherRateThanItsTakeFailsBeforeTheRun) {
+  // The AMC read at the loader's 120 fps default has the take's frame count in half its time:
+  // scored, every frame's truth would be off by 2x (0.3 % within 100 ms with 0.4 % lost).
+  const std::string recording =
+      data_path("cmu-salsa/asf-amc/60.asf") + "+" + data_path("cmu-salsa/asf-amc/60_01.amc");
+  const auto r = run_duet("eval " + pair("01") + " --fps 60 --trackers hmm --recorded 0=" +
+                          recording + " --no-partner-metrics");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("one of the two frame rates is wrong"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--recorded-fps 60"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("evaluating"), std::string::npos) << r.output;
+}
+
 TEST(CliEval, ReportsNonDanceInputAsLost) {
   // Issue 11: motion no part of the library explains (the Bandai walk, dance and wave, on
   // another studio's rig) is reported lost on nearly every frame; a missing clip fails before
