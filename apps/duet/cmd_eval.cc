@@ -71,6 +71,7 @@ struct EvalArgs {
   std::optional<double> tempo_time_constant;
   bool fixed_band = false;
   bool no_outlier_gate = false;
+  bool pause_reported_lost = false;
   std::optional<float> outlier_pause_fraction;
   std::optional<int> dtw_back, dtw_ahead;
   // Feature weights (FeatureSpec); unset keeps the defaults.
@@ -230,6 +231,7 @@ int run_eval(EvalArgs& args) {
   if (args.lost_noise_factor) hmm.lost_noise_factor = *args.lost_noise_factor;
   if (args.lost_residual_factor) hmm.lost_residual_factor = *args.lost_residual_factor;
   if (args.lost_confirm) hmm.lost_confirm_s = *args.lost_confirm;
+  if (args.pause_reported_lost) hmm.pause_reported_lost = true;
   if (args.tempo_time_constant) hmm.tempo_time_constant_s = *args.tempo_time_constant;
   if (args.fixed_band) hmm.tempo_adaptive = false;
   if (args.no_outlier_gate) hmm.gate_outliers = false;
@@ -365,7 +367,7 @@ int run_eval(EvalArgs& args) {
       "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s "
       "(mass {}) noisy_jump_hold {} s jump_old_place_mass {} jump_alike_distance {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
-      "lost_residual_factor {} lost_confirm {} s emission_noise_factor {} "
+      "lost_residual_factor {} lost_confirm {} s{} emission_noise_factor {} "
       "emission_noise_allowance {} noise_filter_density {} noise_filter_allowance {}\n\n",
       library->takes().size(), library->model().num_states(), library->frame_rate(),
       args.library.role, takes, options.seed, hmm.self_prob, hmm.next_prob, hmm.skip_prob,
@@ -375,7 +377,8 @@ int run_eval(EvalArgs& args) {
       hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.jump_settle_mass,
       hmm.noisy_jump_hold_s, hmm.jump_old_place_mass, hmm.jump_alike_distance_per_dim,
       hmm.pause_noise_factor, hmm.lost_residual_per_dim, hmm.lost_noise_factor,
-      hmm.lost_residual_factor, hmm.lost_confirm_s, hmm.emission_noise_factor,
+      hmm.lost_residual_factor, hmm.lost_confirm_s,
+      hmm.pause_reported_lost ? " pause_reported_lost" : "", hmm.emission_noise_factor,
       hmm.emission_noise_allowance, hmm.noise_filter_density, hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
   if (!non_dance.value().empty()) {
@@ -585,6 +588,10 @@ Command register_eval(CLI::App& app) {
                    "lost_confirm_s: the input must stay past the HMM's noise-scaled lost distance "
                    "on consecutive frames this long before it is called lost (all HMM variants)")
       ->check(CLI::Range(0.0, 10.0));
+  tuning->add_flag("--pause-reported-lost", args->pause_reported_lost,
+                   "pause_reported_lost: report frames whose posterior the pause state holds as "
+                   "lost although a template frame explains them (the paper preset's reading; "
+                   "all HMM variants)");
   tuning
       ->add_option("--emission-noise-factor", args->emission_noise_factor,
                    "emission_noise_factor: what the estimated sensor noise adds to the emission's "

@@ -510,6 +510,7 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
                                    context.history_.previous_lost, result, unexplained);
   if (dense && !result.missing) rebuild_beam(context);
 
+  const bool past_ceiling = result.lost;  // the emission's test (false without features)
   result.lost = result.missing ? context.history_.previous_lost : (result.lost || result.in_pause);
   if (params.calibrate_confidence) {
     result.confidence =
@@ -531,9 +532,8 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   context.history_.explained_residual.update(
       result.best_distance_per_dim,
       !result.missing && !result.outlier && !result.in_pause && !result.jumped, dt_s);
-  result.lost =
-      result.lost || context.history_.confirm_unexplained(params, unexplained, result.missing,
-                                                          result.steps / model.frame_rate_hz());
+  result.lost = context.history_.report_lost(params, result.lost, past_ceiling, unexplained,
+                                             result.missing, result.steps / model.frame_rate_hz());
   return result;
 }
 

@@ -36,6 +36,7 @@ FollowParams FollowParams::paper() {
   params.calibrate_confidence = false;
   params.lost_residual_per_dim = std::numeric_limits<float>::infinity();
   params.lost_confirm_s = 0.0f;
+  params.pause_reported_lost = true;
   return params;
 }
 

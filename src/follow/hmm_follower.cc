@@ -235,6 +235,7 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
                         result.steps, params_.confidence_window_frames, result);
   context.history_.jump_gate.apply(model, params_, alpha, 1.0f, context.history_.previous_state,
                                    context.history_.previous_lost, result, unexplained);
+  const bool past_ceiling = result.lost;  // the emission's test (false without features)
   result.lost = result.missing ? context.history_.previous_lost : (result.lost || result.in_pause);
   if (params_.calibrate_confidence) {
     result.confidence =
@@ -256,9 +257,8 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   context.history_.explained_residual.update(
       result.best_distance_per_dim,
       !result.missing && !result.outlier && !result.in_pause && !result.jumped, dt_s);
-  result.lost =
-      result.lost || context.history_.confirm_unexplained(params_, unexplained, result.missing,
-                                                          result.steps / model.frame_rate_hz());
+  result.lost = context.history_.report_lost(params_, result.lost, past_ceiling, unexplained,
+                                             result.missing, result.steps / model.frame_rate_hz());
   return result;
 }
 

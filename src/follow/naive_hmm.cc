@@ -100,6 +100,7 @@ void NaiveHmmFollower::reset() noexcept {
   alpha_.back() = 0.0f;
   previous_state_ = -1;
   previous_lost_ = false;
+  last_past_ceiling_ = false;
   tempo_.reset();
   jump_gate_.reset();
 }
@@ -140,6 +141,7 @@ FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s
   follow_detail::decide(model, alpha_.data(), 1.0f, alpha_[static_cast<std::size_t>(num_states)],
                         previous_state_, result.steps, params_.confidence_window_frames, result);
   jump_gate_.apply(model, params_, alpha_.data(), 1.0f, previous_state_, previous_lost_, result);
+  const bool past_ceiling = result.lost;
   result.lost = result.missing ? previous_lost_ : (result.lost || result.in_pause);
   if (params_.tempo_adaptive) {
     const bool band_move = !result.missing && !result.lost && !result.jumped;
@@ -149,6 +151,11 @@ FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s
   result.tempo = tempo_.dancer_tempo();
   previous_state_ = result.state;
   previous_lost_ = result.lost;
+  // Reported as the exact step does (FollowerHistory::report_lost; no hysteresis at fixed levels).
+  if (!params_.pause_reported_lost) {
+    if (!result.missing) last_past_ceiling_ = past_ceiling;
+    result.lost = last_past_ceiling_;
+  }
   return result;
 }
 

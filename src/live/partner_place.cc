@@ -19,8 +19,11 @@ PartnerPlaceStep PartnerPlace::next(const FollowResult& result, double dt_s,
   }
   const bool timed = std::isfinite(dt_s) && dt_s > 0.0;
   const double tempo = std::isfinite(result.tempo) && result.tempo > 0.0f ? result.tempo : 1.0;
-  lost_s_ = result.lost ? lost_s_ + (timed ? dt_s : 0.0) : 0.0;
-  step.coasting = result.lost && take_ >= 0 && (coasting_ || lost_s_ >= params.coast_after_lost_s);
+  // Between places (the pause state holding the mass) the estimate is not yet decided either,
+  // although the follower does not report it lost (FollowParams::pause_reported_lost).
+  const bool undecided = result.lost || result.in_pause;
+  lost_s_ = undecided ? lost_s_ + (timed ? dt_s : 0.0) : 0.0;
+  step.coasting = undecided && take_ >= 0 && (coasting_ || lost_s_ >= params.coast_after_lost_s);
   if (step.coasting) {
     step.take = take_;
     if (!coasting_) coast_frame_ = frame_;

@@ -59,6 +59,28 @@ TEST(FollowerHistory, ZeroConfirmTimeDecidesEveryFrame) {
   EXPECT_TRUE(feed(history, params, true, 1));
 }
 
+TEST(FollowerHistory, APauseMajorityIsReportedLostOnlyInThePapersReading) {
+  // report_lost(params, gate_lost, past_ceiling, unexplained, missing, frame_s).
+  FollowParams params;
+  FollowerHistory history;
+  // Between places (the gate's flag set by the pause state), the best match explained: not lost.
+  EXPECT_FALSE(history.report_lost(params, true, false, false, false, k60Hz));
+  // Past the fixed ceiling: lost at once, and a frame without features keeps that.
+  EXPECT_TRUE(history.report_lost(params, true, true, true, false, k60Hz));
+  EXPECT_TRUE(history.report_lost(params, true, false, false, true, k60Hz));
+  EXPECT_FALSE(history.report_lost(params, false, false, false, false, k60Hz));
+  // Past the noise-scaled distance: after the confirm time, as confirm_unexplained decides.
+  EXPECT_FALSE(history.report_lost(params, false, false, true, false, k60Hz));
+  EXPECT_FALSE(history.report_lost(params, false, false, true, false, k60Hz));
+  EXPECT_TRUE(history.report_lost(params, false, false, true, false, k60Hz));
+
+  params.pause_reported_lost = true;
+  FollowerHistory paper;
+  EXPECT_TRUE(paper.report_lost(params, true, false, false, false, k60Hz));
+  EXPECT_FALSE(paper.report_lost(params, false, false, false, false, k60Hz));
+  EXPECT_TRUE(FollowParams::paper().pause_reported_lost);
+}
+
 TEST(FollowerHistory, TheConfirmTimeIsChecked) {
   FollowParams params;
   for (const float bad : {-0.01f, 11.0f, std::numeric_limits<float>::quiet_NaN()}) {

@@ -211,6 +211,29 @@ TEST_F(RobustnessTest, AnOutlierFrameIsSetAsideAndASecondInARowIsEvidence) {
   }
 }
 
+TEST_F(RobustnessTest, BetweenPlacesAfterAJumpIsNotLostUnlessThePaperReadingIsAsked) {
+  // Lost means that no template frame explains the input (issue 11). Right after a jump the pause
+  // state holds the mass while the new place gathers evidence, though that place explains the
+  // input exactly: in_pause, not lost. pause_reported_lost (the paper preset) reports it lost.
+  for (const bool paper_reading : {false, true}) {
+    SCOPED_TRACE(paper_reading ? "pause reported lost" : "default");
+    FollowParams params;
+    params.pause_reported_lost = paper_reading;
+    HmmFollower hmm = HmmFollower::create(model_, params).value();
+    track(hmm, 0, 100);
+    int between = 0;
+    FollowResult r;
+    for (int i = 700; i < 720; ++i) {
+      r = hmm.step(template_frame(i), kDt);
+      EXPECT_LT(r.best_distance_per_dim, 1e-6f) << i;
+      between += r.in_pause ? 1 : 0;
+      EXPECT_EQ(r.lost, paper_reading && r.in_pause) << i;
+    }
+    EXPECT_GE(between, 1);
+    EXPECT_EQ(r.state, 719);
+  }
+}
+
 TEST_F(RobustnessTest, SharpEmissionAndDistantPauseNeverUnderflow) {
   // sigma = 0.05 puts log-emissions of other frames around -1e4: exp underflows for everything
   // but the best frame, and the pause emission underflows entirely.

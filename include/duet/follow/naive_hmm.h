@@ -53,6 +53,7 @@ class NaiveHmmFollower final : public Tracker {
   std::vector<float> alpha_, scratch_, distance_sq_;
   int previous_state_ = -1;
   bool previous_lost_ = false;
+  bool last_past_ceiling_ = false;  // the ceiling test of the last frame with features
 };
 
 }  // namespace duet
