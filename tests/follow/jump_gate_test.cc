@@ -178,6 +178,39 @@ TEST(JumpGate, WhileLostTheWanderingMaximumIsNoJumpAndBeingFoundAgainElsewhereIs
   }
 }
 
+TEST(JumpGate, AdriftFromTheFirstFrameIsASpellWithNoPlaceToJumpFrom) {
+  // A performance that begins unexplained (three points' `improv-library`: 17 false jumps in its
+  // first 2.6 s): the maximum hops between takes before any frame was steady. None of it is a
+  // jump, nor is the first place found; from there on, jumps count as usual.
+  const TemplateModel model = two_takes();
+  FollowParams params;
+  params.jump_settle_s = 0.0f;  // settled at once, as after a performance's first 0.3 s
+  params.jump_hold_s = 0.0f;
+  JumpGate gate;
+  int previous = -1;
+  for (const int state : {150, 20, 170, 60, 120, 30}) {
+    const std::vector<float> p = posterior(state);
+    FollowResult r = maximum_at(model, p, state);
+    r.lost = true;
+    gate.apply(model, params, p.data(), 1.0f, previous, previous >= 0, r, true);
+    EXPECT_FALSE(r.jumped) << state;
+    EXPECT_EQ(r.state, state);
+    previous = state;
+  }
+  const std::vector<float> found = posterior(160);
+  FollowResult r = maximum_at(model, found, 160);
+  gate.apply(model, params, found.data(), 1.0f, previous, true, r);
+  EXPECT_FALSE(r.jumped);
+  const std::vector<float> next = posterior(161);
+  r = maximum_at(model, next, 161);
+  gate.apply(model, params, next.data(), 1.0f, 160, false, r);
+  EXPECT_FALSE(r.jumped);
+  const std::vector<float> far = posterior(40);
+  r = maximum_at(model, far, 40);
+  gate.apply(model, params, far.data(), 1.0f, 161, false, r);
+  EXPECT_TRUE(r.jumped);
+}
+
 TEST(JumpGate, AMoveBetweenPlacesThatLookAlikeIsNoJump) {
   // Both takes begin with ten frames of standing still, the same to within 0.001 per dimension.
   FeatureMatrix f = FeatureMatrix::Zero(200, 2);

@@ -71,7 +71,7 @@ class JumpGate {
 
   int steady_state_ = -1;       // the state reported on the last frame not adrift
   int steps_since_steady_ = 0;  // template steps since then
-  bool in_spell_ = false;       // adrift since steady_state_
+  bool in_spell_ = false;       // adrift since steady_state_ (or since the start)
   double settled_s_ = 0.0;    // how long (template time) the estimate has stayed within reach
   int candidate_state_ = -1;  // the far place that currently holds the maximum
   double held_s_ = 0.0;       // how long (template time) it has held it
