@@ -76,8 +76,8 @@ std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostCon
         100.0 * summary.lost_fraction(), dancer_role_name(other), dancer_role_name(other)));
   }
   // The rate: the follower's tempo far from 1 means the input's clock runs at another speed.
-  if (std::optional<std::string> rate = rate_mismatch(
-          context.input_rate_hz, context.library_rate_hz, context.median_tempo)) {
+  if (std::optional<std::string> rate =
+          rate_mismatch(context.input_rate_hz, context.library_rate_hz, context.median_tempo)) {
     causes.push_back(std::move(*rate));
   }
   if (context.input != nullptr) {

@@ -36,7 +36,7 @@ struct LostContext {
   double input_rate_hz = 0.0;    // the rate the input was followed at
   double library_rate_hz = 0.0;
   DancerRole role = DancerRole::kLeader;
-  float median_tempo = 1.0f;     // median_followed_tempo of the results
+  float median_tempo = 1.0f;  // median_followed_tempo of the results
   // Lost fraction when the same input is followed as the other dancer (if it was tried).
   std::optional<double> other_role_lost_fraction;
 };

@@ -183,8 +183,9 @@ TEST(CliEval, ARecordingAtAnotherRateThanItsTakeFailsBeforeTheRun) {
   // scored, every frame's truth would be off by 2x (0.3 % within 100 ms with 0.4 % lost).
   const std::string recording =
       data_path("cmu-salsa/asf-amc/60.asf") + "+" + data_path("cmu-salsa/asf-amc/60_01.amc");
-  const auto r = run_duet("eval " + pair("01") + " --fps 60 --trackers hmm --recorded 0=" +
-                          recording + " --no-partner-metrics");
+  const auto r =
+      run_duet("eval " + pair("01") + " --fps 60 --trackers hmm --recorded 0=" + recording +
+               " --no-partner-metrics");
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("one of the two frame rates is wrong"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("--recorded-fps 60"), std::string::npos) << r.output;

@@ -74,7 +74,7 @@ struct FollowerHistory {
   bool previous_lost = false;
   bool previous_outlier = false;  // the previous frame's evidence was set aside (outlier gate)
   bool lost_by_distance = false;  // confirm_unexplained's decision
-  bool last_past_ceiling = false; // report_lost's ceiling test of the last frame with features
+  bool last_past_ceiling = false;  // report_lost's ceiling test of the last frame with features
   double against_s = 0.0;         // input time the frames have disagreed with it, consecutively
   TempoEstimator tempo;
   JumpGate jump_gate;

@@ -1,9 +1,9 @@
 // Where in the library the partner dances, frame by frame (LiveLoop): the follower's estimate,
-// except while the follower is lost or between places (in_pause). Then its estimate wanders between look-alike places from
-// frame to frame (a headset's three points under noise reported 29 jumps a minute), so after a
-// short spell (PlayheadParams::coast_after_lost_s) the partner dances on by itself from where it
-// was, at the dancer's last tempo, and goes to the follower's place once the dancer is found
-// again. Also decides when the partner jumps (restarts its playhead with a blend).
+// except while the follower is lost or between places (in_pause). Then its estimate wanders between
+// look-alike places from frame to frame (a headset's three points under noise reported 29 jumps a
+// minute), so after a short spell (PlayheadParams::coast_after_lost_s) the partner dances on by
+// itself from where it was, at the dancer's last tempo, and goes to the follower's place once the
+// dancer is found again. Also decides when the partner jumps (restarts its playhead with a blend).
 #pragma once
 
 #include <span>
