@@ -16,7 +16,7 @@ void FollowerHistory::reset() noexcept {
   previous_lost = false;
   previous_outlier = false;
   lost_by_distance = false;
-  last_past_ceiling = false;
+  ceiling_lost.reset();
   against_s = 0.0;
   tempo.reset();
   jump_gate.reset();

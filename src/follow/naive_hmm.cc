@@ -100,7 +100,7 @@ void NaiveHmmFollower::reset() noexcept {
   alpha_.back() = 0.0f;
   previous_state_ = -1;
   previous_lost_ = false;
-  last_past_ceiling_ = false;
+  ceiling_lost_.reset();
   tempo_.reset();
   jump_gate_.reset();
 }
@@ -152,10 +152,7 @@ FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s
   previous_state_ = result.state;
   previous_lost_ = result.lost;
   // Reported as the exact step does (FollowerHistory::report_lost; no hysteresis at fixed levels).
-  if (!params_.pause_reported_lost) {
-    if (!result.missing) last_past_ceiling_ = past_ceiling;
-    result.lost = last_past_ceiling_;
-  }
+  result.lost = ceiling_lost_.report(params_, result.lost, past_ceiling, result.missing);
   return result;
 }
 

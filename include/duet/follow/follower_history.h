@@ -7,6 +7,7 @@
 #include "duet/follow/explained_residual.h"
 #include "duet/follow/follow_params.h"
 #include "duet/follow/jump_gate.h"
+#include "duet/follow/lost_report.h"
 #include "duet/follow/noise_filter.h"
 #include "duet/follow/sensor_noise.h"
 #include "duet/follow/template_model.h"
@@ -52,20 +53,15 @@ struct FollowerHistory {
     return lost_by_distance;
   }
 
-  // The lost flag a step reports (FollowResult::lost), once the frame's other decisions are made.
-  // `gate_lost` is the flag the jump gate and the tempo band went on (past the fixed ceiling or
-  // a pause-state majority), `past_ceiling` the emission's own test, `unexplained` whether the
-  // best match is past the noise-scaled lost distance (decided with confirm_unexplained's
-  // hysteresis). Lost means no part of the library explains the input: a pause-state majority
-  // whose best match is within that distance (the follower still deciding where the user jumped
-  // to) is not lost, unless FollowParams::pause_reported_lost. A missing frame keeps the last
-  // frame's ceiling test.
+  // The lost flag a step reports (FollowResult::lost), once the frame's other decisions are made:
+  // lost means no part of the library explains the input, by the emission's ceiling test
+  // (CeilingLostReport, with `gate_lost` and `past_ceiling`) or by distance (`unexplained`:
+  // the best match is past the noise-scaled lost distance, decided with confirm_unexplained's
+  // hysteresis).
   bool report_lost(const FollowParams& params, bool gate_lost, bool past_ceiling, bool unexplained,
                    bool missing, double frame_s) noexcept {
     const bool by_distance = confirm_unexplained(params, unexplained, missing, frame_s);
-    if (params.pause_reported_lost) return gate_lost || by_distance;
-    if (!missing) last_past_ceiling = past_ceiling;
-    return last_past_ceiling || by_distance;
+    return ceiling_lost.report(params, gate_lost, past_ceiling, missing) || by_distance;
   }
 
   double total_log_likelihood = 0.0;  // a sum over the whole performance, hence double
@@ -74,7 +70,7 @@ struct FollowerHistory {
   bool previous_lost = false;
   bool previous_outlier = false;  // the previous frame's evidence was set aside (outlier gate)
   bool lost_by_distance = false;  // confirm_unexplained's decision
-  bool last_past_ceiling = false;  // report_lost's ceiling test of the last frame with features
+  CeilingLostReport ceiling_lost;  // report_lost's ceiling test
   double against_s = 0.0;         // input time the frames have disagreed with it, consecutively
   TempoEstimator tempo;
   JumpGate jump_gate;

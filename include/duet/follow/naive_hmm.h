@@ -12,6 +12,7 @@
 #include "duet/base/result.h"
 #include "duet/follow/follow_params.h"
 #include "duet/follow/jump_gate.h"
+#include "duet/follow/lost_report.h"
 #include "duet/follow/tempo_band.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tracker.h"
@@ -53,7 +54,7 @@ class NaiveHmmFollower final : public Tracker {
   std::vector<float> alpha_, scratch_, distance_sq_;
   int previous_state_ = -1;
   bool previous_lost_ = false;
-  bool last_past_ceiling_ = false;  // the ceiling test of the last frame with features
+  CeilingLostReport ceiling_lost_;
 };
 
 }  // namespace duet
