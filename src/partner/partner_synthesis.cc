@@ -747,6 +747,25 @@ bool PartnerSynthesisJob::run() const noexcept {
     // instead of in one frame: the correction lags the fading IK, and dropping what was left
     // swung the forearm of a partner of a user of other proportions at up to 2500 deg/s
     // (docs/evaluation.md, "The IK's correction let go"). At a blended jump the blend takes it.
+    // The correction filter's cutoff falls as the arm's target's measured jitter grows (a
+    // steady-state Kalman filter's gain goes as 1 / noise): ik_correction_clean_cutoff_hz on a
+    // clean sensor, where the 1 Hz filter only lagged the correction (a 1.15x body's hands 1 cm
+    // apart), the filter's own min_cutoff_hz from ik_target_jitter_reference_m up. The IK and
+    // the release step the same filter state, so both use it.
+    const bool steady = p.smooth && p.ik_target_jitter_reference_m > 0.0;
+    const auto correction_filter_of = [&](std::size_t r) {
+      OneEuroParams filter = p.ik_correction_filter;
+      if (steady && p.ik_correction_clean_cutoff_hz > filter.min_cutoff_hz) {
+        const double jitter = jitter_rms(ctx.ik_target_jitter_[r]);
+        filter.min_cutoff_hz =
+            jitter * p.ik_correction_clean_cutoff_hz >
+                    filter.min_cutoff_hz * p.ik_target_jitter_reference_m
+                ? std::max(filter.min_cutoff_hz,
+                           filter.min_cutoff_hz * p.ik_target_jitter_reference_m / jitter)
+                : p.ik_correction_clean_cutoff_hz;
+      }
+      return filter;
+    };
     const auto release_correction = [&](std::size_t r) {
       std::array<OneEuroFilter3, 2>& filters = ctx.ik_correction_filter_[r];
       std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
@@ -762,9 +781,9 @@ bool PartnerSynthesisJob::run() const noexcept {
       const std::array<std::size_t, 2> joints = {static_cast<std::size_t>(roles[arm.shoulder]),
                                                  static_cast<std::size_t>(roles[arm.elbow])};
       const double most = p.ik_correction_max_speed_rad_s * dt;
+      const OneEuroParams filter = correction_filter_of(r);
       for (std::size_t k = 0; k < 2; ++k) {
-        const Vec3 c =
-            step_correction(filters[k], shown[k], Vec3::Zero(), dt, p.ik_correction_filter, most);
+        const Vec3 c = step_correction(filters[k], shown[k], Vec3::Zero(), dt, filter, most);
         out_r[joints[k]] = (out_r[joints[k]] * exp_map(c)).normalized();
       }
     };
@@ -806,7 +825,6 @@ bool PartnerSynthesisJob::run() const noexcept {
       }
       const auto t = static_cast<std::size_t>(ts);
       Vec3 raw_target = user->wrist_positions_ws[t];
-      const bool steady = p.smooth && p.ik_target_jitter_reference_m > 0.0;
       const bool target_restarts = jumped || ctx.ik_pair_[r] != previous_pair;
       if (p.ik_target == IkTarget::kCapturedOffset) {
         const double at = has_position ? frame_position : static_cast<double>(frame);
@@ -886,22 +904,8 @@ bool PartnerSynthesisJob::run() const noexcept {
         // The correction (captured -> IK, in the joint's own frame) through the 1-euro filter,
         // then put back on the captured rotation; the wrist lands where that arm reaches.
         // At most ik_correction_max_speed_rad_s: the IK adds at most that to a joint's speed.
-        // The filter's cutoff falls as the target's measured jitter grows (a steady-state Kalman
-        // filter's gain goes as 1 / noise): ik_correction_clean_cutoff_hz on a clean sensor,
-        // where the 1 Hz filter only lagged the correction (a 1.15x body's hands 1 cm apart),
-        // the filter's own min_cutoff_hz from ik_target_jitter_reference_m up.
         std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
-        OneEuroParams correction_filter = p.ik_correction_filter;
-        if (steady && p.ik_correction_clean_cutoff_hz > correction_filter.min_cutoff_hz) {
-          const double jitter = jitter_rms(ctx.ik_target_jitter_[r]);
-          correction_filter.min_cutoff_hz =
-              jitter * p.ik_correction_clean_cutoff_hz >
-                      correction_filter.min_cutoff_hz * p.ik_target_jitter_reference_m
-                  ? std::max(
-                        correction_filter.min_cutoff_hz,
-                        correction_filter.min_cutoff_hz * p.ik_target_jitter_reference_m / jitter)
-                  : p.ik_correction_clean_cutoff_hz;
-        }
+        const OneEuroParams correction_filter = correction_filter_of(r);
         const auto correct = [&](std::size_t k, const Quat& captured, const Quat& solved) {
           return step_correction(filters[k], shown[k], log_map(captured.conjugate() * solved), dt,
                                  correction_filter, p.ik_correction_max_speed_rad_s * dt);
