@@ -137,7 +137,7 @@ Command register_convert(CLI::App& app) {
   app.add_option("--points", args->points,
                  "Write only the head and both hands as a three-point CSV (the only value: "
                  "head,hands; docs/file-formats.md)")
-      ->check(CLI::IsMember({"head,hands"}));
+      ->check(input_points_choice(false));
   add_device_offsets_option(app, args->device_offsets_cm,
                             "The points are put there: what a headset and controllers would "
                             "record (default: at the joints)");

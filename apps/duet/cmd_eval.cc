@@ -481,7 +481,7 @@ Command register_eval(CLI::App& app) {
                  "controllers, with --point-noise-mm and --point-noise-deg of tracking noise, "
                  "twice that on the noisy cases instead of their per-joint noise) and follow with "
                  "the three-point follower")
-      ->check(CLI::IsMember({"full", "head,hands"}));
+      ->check(input_points_choice(true));
   app.add_option("--point-noise-mm", args->point_noise_mm,
                  "Three points: position noise per axis of each point, mm (default 5)")
       ->check(number_between(0.0, 100.0, "point noise"));

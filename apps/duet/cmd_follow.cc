@@ -284,7 +284,7 @@ Command register_follow(CLI::App& app) {
                  "hands, docs/file-formats.md)")
       ->required();
   app.add_option("--input-points", args->input_points, kInputPointsHelp)
-      ->check(CLI::IsMember({"full", "head,hands"}));
+      ->check(input_points_choice(true));
   add_device_offsets_option(app, args->device_offsets_cm,
                             "Taken out of a three-point recording before following (a recording "
                             "of duet serve --source xr has them out already; default: none)");

@@ -417,7 +417,7 @@ Command register_serve(CLI::App& app) {
                  "from the viewer's VR session); replay also plays a three-point CSV")
       ->capture_default_str();
   app.add_option("--input-points", args->input_points, kInputPointsHelp)
-      ->check(CLI::IsMember({"full", "head,hands"}));
+      ->check(input_points_choice(true));
   add_device_offsets_option(app, args->device_offsets_cm,
                             "Taken out before following: --source xr default 6,6,7 (a typical "
                             "headset user; 0,0,0 leaves the points as sent), a replayed "

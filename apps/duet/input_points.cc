@@ -31,6 +31,17 @@ Result<InputPoints> choose_input_points(const std::string& option, LoadedMotion&
   return InputPoints::kHeadHands;
 }
 
+CLI::Validator input_points_choice(bool with_full) {
+  const std::string choices = with_full ? "full or head,hands" : "head,hands";
+  return CLI::Validator(
+      [with_full, choices](std::string& value) -> std::string {
+        if (value == "head,hands" || (with_full && value == "full")) return {};
+        return "'" + value + "' is not " + choices +
+               " (head,hands is one value: the head and both hands)";
+      },
+      with_full ? "full|head,hands" : "head,hands");
+}
+
 CLI::Option* add_offsets_cm_option(CLI::App& app, const std::string& name, std::vector<double>& cm,
                                    const std::string& help) {
   return app.add_option(name, cm, help)

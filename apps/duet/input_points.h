@@ -19,6 +19,11 @@ inline constexpr const char* kInputPointsHelp =
     "Which points of the input the follower sees: full (the whole body) or head,hands (what a "
     "headset and two controllers give). Default: head,hands for a three-point input, else full";
 
+// The values of --input-points ("full" and "head,hands"; without "full" for duet convert
+// --points), with an error that says "head,hands" is one value: CLI11's IsMember printed the
+// choices as {full,head,hands}, which reads as three.
+CLI::Validator input_points_choice(bool with_full);
+
 // `option` is "", "full" or "head,hands". With head,hands on a full-body motion, `motion` becomes
 // its three points. Errors when the input cannot give what is asked.
 Result<InputPoints> choose_input_points(const std::string& option, LoadedMotion& motion);

@@ -43,8 +43,10 @@ Result<std::vector<std::string>> split_motion_argument(const std::string& word) 
   for (const std::string& part : parts) {
     if (part.empty()) return Error{"'" + word + "': empty file name around '+'"};
     if (!is_regular_file(part)) {
-      return Error{parts.size() == 1 ? "no such file: " + part
-                                     : "'" + word + "': no such file: " + part};
+      std::error_code ec;
+      const std::string problem =
+          std::filesystem::exists(part, ec) ? "not a regular file: " : "no such file: ";
+      return Error{parts.size() == 1 ? problem + part : "'" + word + "': " + problem + part};
     }
   }
   if (parts.size() == 1) {

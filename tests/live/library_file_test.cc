@@ -225,6 +225,9 @@ TEST(MotionArgument, SplitsSkeletonPlusMotion) {
             std::string::npos);
   EXPECT_FALSE(split_motion_argument(asf + "+" + amc + "+" + amc));
   EXPECT_EQ(join_motion_argument({asf, amc}), asf + "+" + amc);
+  // A path that exists but is no file (a directory, a device) is not called missing.
+  EXPECT_NE(split_motion_argument(kSalsa).error().message.find("not a regular file: " + kSalsa),
+            std::string::npos);
 }
 
 TEST(KnownDatasets, WarnsWhenAHeaderRateDisagrees) {
