@@ -152,8 +152,8 @@ TEST(CliHeadHands, OptionsThatCannotApplySaySo) {
   EXPECT_NE(other.exit_code, 0);
   EXPECT_NE(other.output.find("--points"), std::string::npos) << other.output;
   // "head,hands" is one value; the error says so instead of listing {full,head,hands}.
-  CommandResult head_only = run_duet("follow --library " + kSalsaLibrary + " --input " + csv +
-                                     " --input-points head");
+  CommandResult head_only =
+      run_duet("follow --library " + kSalsaLibrary + " --input " + csv + " --input-points head");
   EXPECT_EQ(head_only.exit_code, 2);
   EXPECT_NE(head_only.output.find("'head' is not full or head,hands (head,hands is one value"),
             std::string::npos)

@@ -13,8 +13,8 @@
 #include "duet/follow/follow_params.h"
 #include "duet/follow/jump_gate.h"
 #include "duet/follow/lost_report.h"
-#include "duet/follow/tempo_band.h"
 #include "duet/follow/template_model.h"
+#include "duet/follow/tempo_band.h"
 #include "duet/follow/tracker.h"
 
 namespace duet {
