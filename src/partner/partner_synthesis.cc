@@ -742,11 +742,6 @@ bool PartnerSynthesisJob::run() const noexcept {
   if (p.contact) {
     const HandContacts& contacts = model->contacts();
     const double step = p.ik_fade_s > 0.0 ? dt / p.ik_fade_s : 1.0;
-    // An arm whose IK stops (its fade ended, the user's hand unknown this frame) lets its filtered
-    // correction go the way it came, through the filter and at most ik_correction_max_speed_rad_s,
-    // instead of in one frame: the correction lags the fading IK, and dropping what was left
-    // swung the forearm of a partner of a user of other proportions at up to 2500 deg/s
-    // (docs/evaluation.md, "The IK's correction let go"). At a blended jump the blend takes it.
     // The correction filter's cutoff falls as the arm's target's measured jitter grows (a
     // steady-state Kalman filter's gain goes as 1 / noise): ik_correction_clean_cutoff_hz on a
     // clean sensor, where the 1 Hz filter only lagged the correction (a 1.15x body's hands 1 cm
@@ -766,6 +761,11 @@ bool PartnerSynthesisJob::run() const noexcept {
       }
       return filter;
     };
+    // An arm whose IK stops (its fade ended, the user's hand unknown this frame) lets its filtered
+    // correction go the way it came, through the filter and at most ik_correction_max_speed_rad_s,
+    // instead of in one frame: the correction lags the fading IK, and dropping what was left
+    // swung the forearm of a partner of a user of other proportions at up to 2500 deg/s
+    // (docs/evaluation.md, "The IK's correction let go"). At a blended jump the blend takes it.
     const auto release_correction = [&](std::size_t r) {
       std::array<OneEuroFilter3, 2>& filters = ctx.ik_correction_filter_[r];
       std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
