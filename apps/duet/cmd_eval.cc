@@ -56,6 +56,7 @@ struct EvalArgs {
   double point_noise_deg = 1.0;
   std::vector<double> device_offsets_cm;  // eyes forward, eyes up, grip; empty: at the joints
   std::vector<double> taken_out_cm;       // what the follower takes out; empty: nothing
+  double tell_head_height = 0.0;  // the performer's head height standing times this; 0: not told
   // Tuning of the "hmm" tracker (FollowParams fields); unset keeps the follower's defaults.
   std::optional<float> jump_hold;
   std::optional<int> jump_tolerance;
@@ -265,6 +266,11 @@ int run_eval(EvalArgs& args) {
                                                                   : "--device-offsets-cm") +
                        ": applies to three points (--input-points head,hands)");
   }
+  if (args.tell_head_height > 0.0 && features.input_points != InputPoints::kHeadHands) {
+    return usage_error(
+        "--tell-head-height: applies to three points (--input-points head,hands); the full body's "
+        "size is its skeleton's");
+  }
 
   std::string gnuplot;
   if (!args.plots_dir.empty()) {
@@ -343,6 +349,7 @@ int run_eval(EvalArgs& args) {
       eval_case.recipe.point_noise.rotation_deg = factor * args.point_noise_deg;
       eval_case.recipe.point_noise.offsets = device_offsets_from_cm(args.device_offsets_cm);
       eval_case.recipe.point_noise.taken_out = device_offsets_from_cm(args.taken_out_cm);
+      eval_case.recipe.told_head_height_factor = args.tell_head_height;
     }
   }
 
@@ -496,6 +503,13 @@ Command register_eval(CLI::App& app) {
                         "after the sensor noise, FORWARD,UP,GRIP in cm as duet follow's and duet "
                         "serve's --device-offsets-cm (default: none). With --device-offsets-cm, "
                         "how a wrong calibration costs");
+  app.add_option("--tell-head-height", args->tell_head_height,
+                 "Three points: tell the follower each performer's head height standing (the "
+                 "highest the head is over the performance) times FACTOR (1: exactly, 1.05: 5 % "
+                 "high), as duet follow's and duet serve's --head-height would (default: not "
+                 "told; the unit is then the highest the head has been so far)")
+      ->option_text("FACTOR")
+      ->check(number_between(0.5, 2.0, "factor"));
   app.add_flag("--beam", args->beam,
                "Run the hmm and hmm-paper trackers in beam mode (docs/follower.md "
                "\"Beam mode\"; the partner metrics keep the exact step)");

@@ -36,6 +36,7 @@ struct FollowArgs {
   std::string truth_path;
   std::string input_points;  // "", "full" or "head,hands" (--input-points)
   std::vector<double> device_offsets_cm;  // taken out of a three-point recording; empty: none
+  double head_height_m = 0.0;  // the headset's height standing (--head-height); 0: learnt
   std::string partner_rig;  // a motion word whose skeleton the partner is written on
   MotionFileOptions partner_rig_motion;
   bool allow_lost = false;
@@ -147,6 +148,10 @@ int run_follow(const FollowArgs& args) {
     fmt::print(stderr, "duet follow: {}\n", points.error().message);
     return kExitUsage;
   }
+  if (Status s = check_head_height_applies(args.head_height_m, points.value()); !s) {
+    fmt::print(stderr, "duet follow: {}\n", s.error().message);
+    return kExitUsage;
+  }
   FeatureSpec features;
   features.input_points = points.value();
   std::optional<DuetLibrary> loaded = load_library(args.library, "follow", features);
@@ -184,8 +189,9 @@ int run_follow(const FollowArgs& args) {
     fmt::print(stderr, "duet follow: {}\n", tracker.error().message);
     return kExitFailure;
   }
-  SourceSkeleton user_skeleton{user.skeleton_ptr(), input.value().roles,
-                               input.value().metres_per_unit, user.frame_rate()};
+  SourceSkeleton user_skeleton{
+      user.skeleton_ptr(), input.value().roles, input.value().metres_per_unit, user.frame_rate(),
+      head_joint_height_m(args.head_height_m, device_offsets_from_cm(args.device_offsets_cm))};
   Result<LiveLoop> loop = LiveLoop::create(library, user_skeleton, std::move(tracker).value(),
                                            make_partner_params(args.partner));
   if (!loop) {
@@ -288,6 +294,7 @@ Command register_follow(CLI::App& app) {
   add_device_offsets_option(app, args->device_offsets_cm,
                             "Taken out of a three-point recording before following (a recording "
                             "of duet serve --source xr has them out already; default: none)");
+  add_head_height_option(app, args->head_height_m);
   add_motion_file_options(app, args->input_motion, "input-");
   add_tracker_options(app, args->tracker);
   add_partner_options(app, args->partner);

@@ -41,6 +41,7 @@ struct ServeArgs {
   std::string source_map;
   std::string input_points;  // "", "full" or "head,hands"
   std::vector<double> device_offsets_cm;  // empty: typical_headset_offsets for xr, else none
+  double head_height_m = 0.0;  // the head point's height standing (--head-height); 0: learnt
   std::string http = "127.0.0.1:8080";
   std::optional<std::string> token;
   std::string web;
@@ -147,6 +148,13 @@ Result<SourceSkeleton> load_source_skeleton(const std::string& path, const Serve
   return skeleton;
 }
 
+// The device offsets taken out of the source's points: the typical headset's for --source xr
+// unless --device-offsets-cm says otherwise; a replayed recording's only when given.
+DevicePointOffsets taken_out_offsets(SourceKind kind, const ServeArgs& args) {
+  if (kind == SourceKind::kXr && args.device_offsets_cm.empty()) return typical_headset_offsets();
+  return device_offsets_from_cm(args.device_offsets_cm);
+}
+
 Result<std::unique_ptr<FrameSource>> make_source(const SourceSpec& spec, const ServeArgs& args,
                                                  const DuetLibrary& library) {
   switch (spec.kind) {
@@ -227,9 +235,7 @@ Result<std::unique_ptr<FrameSource>> make_source(const SourceSpec& spec, const S
       SourceSkeleton skeleton{make_head_hands_skeleton(), head_hands_roles(), 1.0,
                               args.source_fps ? *args.source_fps : 72.0};
       PoseSourceOptions options;
-      options.device_offsets = args.device_offsets_cm.empty()
-                                   ? typical_headset_offsets()
-                                   : device_offsets_from_cm(args.device_offsets_cm);
+      options.device_offsets = taken_out_offsets(SourceKind::kXr, args);
       return std::unique_ptr<FrameSource>(std::make_unique<PoseSource>(
           std::move(skeleton), options,
           "a VR headset and two controllers (xr_pose messages over the WebSocket)"));
@@ -298,6 +304,10 @@ int run_serve(const ServeArgs& args) {
     fail(points.error().message);
     return kExitUsage;
   }
+  if (Status s = check_head_height_applies(args.head_height_m, points.value()); !s) {
+    fail(s.error().message);
+    return kExitUsage;
+  }
   FeatureSpec features;
   features.input_points = points.value();
   std::optional<DuetLibrary> loaded = load_library(args.library, "serve", features);
@@ -309,7 +319,9 @@ int run_serve(const ServeArgs& args) {
     fail(source.error().message);
     return kExitFailure;
   }
-  const SourceSkeleton user = source.value()->source_skeleton();
+  SourceSkeleton user = source.value()->source_skeleton();
+  user.head_height_m =
+      head_joint_height_m(args.head_height_m, taken_out_offsets(spec.value().kind, args));
 
   const PartnerParams params = make_partner_params(args.partner);
   Result<std::unique_ptr<LiveLoop>> loop = make_loop(library, args.tracker, user, params);
@@ -418,6 +430,7 @@ Command register_serve(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--input-points", args->input_points, kInputPointsHelp)
       ->check(input_points_choice(true));
+  add_head_height_option(app, args->head_height_m);
   add_device_offsets_option(app, args->device_offsets_cm,
                             "Taken out before following: --source xr default 6,6,7 (a typical "
                             "headset user; 0,0,0 leaves the points as sent), a replayed "

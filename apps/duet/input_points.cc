@@ -65,6 +65,32 @@ DevicePointOffsets device_offsets_from_cm(const std::vector<double>& cm) {
   return DevicePointOffsets::from_cm(cm[0], cm[1], cm[2]);
 }
 
+CLI::Option* add_head_height_option(CLI::App& app, double& metres) {
+  return app
+      .add_option("--head-height", metres,
+                  "Three points: the height above the floor, in metres, of the input's head "
+                  "point with the user standing straight: the headset's for a headset (a height "
+                  "calibration; a headset says nothing of the body's size), the head joint's for "
+                  "a recording at the joints. Device offsets taken out of the points are taken "
+                  "out of it too. Default: learnt as the highest the head has been, which a "
+                  "dance that starts low gets wrong until the dancer stands (docs/features.md, "
+                  "three points' unit)")
+      ->option_text("M")
+      ->check(number_between(0.6, 2.6, "head height"));
+}
+
+double head_joint_height_m(double head_point_height_m, const DevicePointOffsets& offsets) {
+  return head_point_height_m > 0.0 ? head_point_height_m - offsets.eyes_m.y() : 0.0;
+}
+
+Status check_head_height_applies(double metres, InputPoints points) {
+  if (metres > 0.0 && points != InputPoints::kHeadHands) {
+    return Error{"--head-height applies to three points (a headset's recording, --input-points "
+                 "head,hands or --source xr); a full body's size is its skeleton's"};
+  }
+  return Ok{};
+}
+
 Status take_out_device_offsets(const std::vector<double>& cm, LoadedMotion& motion) {
   if (cm.empty()) return Ok{};
   if (!is_head_hands_input(motion.roles) || motion.clip.joint_count() != kHeadHandsJointCount) {

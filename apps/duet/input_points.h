@@ -39,6 +39,15 @@ CLI::Option* add_device_offsets_option(CLI::App& app, std::vector<double>& cm,
                                        const std::string& what);
 // The option's numbers as offsets; empty: none.
 DevicePointOffsets device_offsets_from_cm(const std::vector<double>& cm);
+// --head-height M: the height of the input's head point (the headset's, for a headset) with the
+// user standing straight: a height calibration, FollowSession::set_head_height's unit for three
+// points; 0 when not given.
+CLI::Option* add_head_height_option(CLI::App& app, double& metres);
+// The head joint's height standing from the head point's (--head-height): less the eyes' height
+// above the head joint that `offsets` (the ones taken out of the input) say; 0 stays 0.
+double head_joint_height_m(double head_point_height_m, const DevicePointOffsets& offsets);
+// Errors when --head-height is given (metres > 0) for a follower that does not see three points.
+Status check_head_height_applies(double metres, InputPoints points);
 // Takes the offsets `cm` out of `motion`, a recording of three points as the devices reported
 // them (its units from metres_per_unit). Errors when the motion is not three points (a full body,
 // or three points made from one, are at the joints already).

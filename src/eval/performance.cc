@@ -539,6 +539,7 @@ Performance with_frame_loss(Performance performance, const FrameLossOptions& opt
   Performance out;
   out.roles = performance.roles;
   out.template_rate_hz = performance.template_rate_hz;
+  out.told_head_height_m = performance.told_head_height_m;
   const Clip& motion = performance.motion;
   out.motion = Clip(motion.skeleton_ptr(), motion.frame_rate(), static_cast<int>(kept.size()));
   bool carry_jump = false;
@@ -712,6 +713,10 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
   }
   if (!recipe.head_hands) level_as_loaded(performance);
   if (recipe.head_hands) {
+    if (recipe.told_head_height_factor > 0.0) {
+      performance.told_head_height_m =
+          recipe.told_head_height_factor * highest_head_m(performance.motion, performance.roles);
+    }
     PointNoiseOptions options = recipe.point_noise;
     options.seed = derive_seed(seed, 14);
     Result<Performance> points = with_head_hands(std::move(performance), options);

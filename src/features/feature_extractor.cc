@@ -164,11 +164,14 @@ FeatureExtractor::Context::Sample FeatureExtractor::extract_head_hands(
   now.yaw = heading_yaw(head_canonical);
   now.effectors[0] = context.positions_ws_[at(Role::kLeftWrist)];
   now.effectors[1] = context.positions_ws_[at(Role::kRightWrist)];
-  // Lengths in head heights: the highest the head has been, which a dancer reaches standing in
-  // the first moments (a floor keeps a first frame on the ground from dividing by ~0).
+  // Lengths in head heights: the one a calibration gave, else the highest the head has been,
+  // which a dancer reaches standing in the first moments (a floor keeps a first frame on the
+  // ground from dividing by ~0).
   constexpr double kLowestHeadHeightM = 0.5;
   context.head_height_max_m_ = std::max({context.head_height_max_m_, head.y(), kLowestHeadHeightM});
-  const double per_height = 1.0 / context.head_height_max_m_;
+  const double per_height = 1.0 / (context.head_height_known_m_ > 0.0
+                                       ? context.head_height_known_m_
+                                       : context.head_height_max_m_);
   const Quat to_heading = yaw_rotation(-now.yaw);
 
   std::size_t d = 0;

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <limits>
 
+#include <fmt/format.h>
+
 namespace duet {
 
 Result<FollowSession> FollowSession::create(const DuetLibrary& library,
@@ -90,6 +92,17 @@ void FollowSession::report_captured_place(FollowResult& result) noexcept {
   result.take = place.take;
   result.frame_in_take = place.frame;
   previous_place_ = place;
+}
+
+Status FollowSession::set_head_height(double head_height_m) {
+  if (head_height_m != 0.0 &&
+      !(head_height_m >= kHeadHeightRangeM[0] && head_height_m <= kHeadHeightRangeM[1])) {
+    return Error{fmt::format(
+        "head height {:g} m: give the head's height standing in metres, {:g} to {:g}",
+        head_height_m, kHeadHeightRangeM[0], kHeadHeightRangeM[1])};
+  }
+  context_.set_head_height(head_height_m);
+  return Ok{};
 }
 
 void FollowSession::reset() noexcept {

@@ -76,6 +76,7 @@ Result<LiveLoop> LiveLoop::create(std::shared_ptr<const DuetLibrary> library,
   Result<FollowSession> session =
       FollowSession::create(*library, user.skeleton, user.roles, std::move(tracker));
   if (!session) return session.error();
+  if (Status s = session.value().set_head_height(user.head_height_m); !s) return s.error();
   std::vector<HeadHandsBody> head_hands_bodies;
   if (is_head_hands_input(user.roles)) {
     for (const DuetTake& take : library->takes()) {
@@ -99,8 +100,11 @@ void LiveLoop::place_head_hands_user(int take, int frame) noexcept {
   head_height_max_m_ = std::max(head_height_max_m_, head_position.y());
   const HeadHandsBody& body = head_hands_bodies_[static_cast<std::size_t>(take)];
   const PartnerModel& model = models_[static_cast<std::size_t>(take)];
+  // The user's size against the template dancer's: the head's height standing, given by a
+  // calibration or learnt as the highest it has been.
+  const double head_height_m = user_.head_height_m > 0.0 ? user_.head_height_m : head_height_max_m_;
   const double size_ratio = body.template_head_height_m() > 0.0
-                                ? head_height_max_m_ / body.template_head_height_m()
+                                ? head_height_m / body.template_head_height_m()
                                 : 1.0;
   const Transform head_frame =
       head_heading_frame(head_position, out_.user_rotations_ws[head] * device_correction_);

@@ -161,5 +161,40 @@ TEST(CliHeadHands, OptionsThatCannotApplySaySo) {
   std::filesystem::remove(csv);
 }
 
+TEST(CliHeadHands, AHeadHeightIsForThreePoints) {
+  const std::string csv = temp("height.csv"), trace = temp("height_trace.csv");
+  ASSERT_EQ(run_duet("convert " + kTake + " --input-fps 60 --points head,hands -o " + csv).exit_code,
+            0);
+  // The recording's head point is the head joint (1.49 m standing in this take).
+  CommandResult told = run_duet("follow --library " + kSalsaLibrary + " --input " + csv +
+                                " --head-height 1.49 --trace " + trace);
+  ASSERT_EQ(told.exit_code, 0) << told.output;
+  int right = 0;
+  const auto places = traced_places(trace);
+  for (std::size_t f = 0; f < places.size(); ++f) {
+    right += (places[f].first == 6 && std::abs(places[f].second - static_cast<int>(f)) <= 6) ? 1
+                                                                                             : 0;
+  }
+  ASSERT_GT(places.size(), 2000u);
+  EXPECT_GE(right, static_cast<int>(places.size() * 99 / 100));
+
+  CommandResult body = run_duet("follow --library " + kSalsaLibrary + " --input " + kTake +
+                                " --input-fps 60 --head-height 1.5");
+  EXPECT_EQ(body.exit_code, 2);
+  EXPECT_NE(body.output.find("--head-height applies to three points"), std::string::npos)
+      << body.output;
+  CommandResult giant =
+      run_duet("follow --library " + kSalsaLibrary + " --input " + csv + " --head-height 150");
+  EXPECT_EQ(giant.exit_code, 2);
+  EXPECT_NE(giant.output.find("--head-height"), std::string::npos) << giant.output;
+  CommandResult serve = run_duet("serve --library " + kSalsaLibrary +
+                                 " --source ws --head-height 1.6 --no-record");
+  EXPECT_EQ(serve.exit_code, 2);
+  EXPECT_NE(serve.output.find("--head-height applies to three points"), std::string::npos)
+      << serve.output;
+  std::filesystem::remove(csv);
+  std::filesystem::remove(trace);
+}
+
 }  // namespace
 }  // namespace duet::testing

@@ -701,6 +701,27 @@ TEST(MakePerformance, RecordsTheRealWristsBeforeTheNoise) {
   EXPECT_GT(moved_on, 0);
 }
 
+TEST(MakePerformance, ThreePointsCarryTheToldHeadHeightThroughLostFrames) {
+  // --tell-head-height: the follower is told the performer's head height standing (the highest
+  // the head is over the performance), a calibration; dropped frames keep it.
+  const Fixture f = make_fixture(600);
+  const SourceTake source = f.source();
+  PerformanceRecipe recipe;
+  recipe.head_hands = true;
+  recipe.loss.drop_fraction = 0.1;
+  Result<Performance> untold = make_performance(std::span(&source, 1), recipe, 5);
+  ASSERT_TRUE(untold) << untold.error().message;
+  EXPECT_EQ(untold.value().told_head_height_m, 0.0);
+
+  recipe.told_head_height_factor = 1.05;
+  recipe.body_scale = 0.9;
+  Result<Performance> told = make_performance(std::span(&source, 1), recipe, 5);
+  ASSERT_TRUE(told) << told.error().message;
+  const double highest = highest_head_m(f.clip, f.roles);
+  ASSERT_GT(highest, 0.5);
+  EXPECT_NEAR(told.value().told_head_height_m, 1.05 * 0.9 * highest, 1e-6 * highest);
+}
+
 TEST(Improvise, RealTakeKeepsTheRootPathContinuous) {
   MotionLoadOptions load;
   load.frame_rate = 60.0;

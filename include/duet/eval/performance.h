@@ -56,6 +56,9 @@ struct Performance {
   // The real body's heading frame (body_heading_frame), one per frame, for a performance reduced
   // to three points (with_head_hands), whose roles name no hips to take it from; else empty.
   std::vector<Transform> true_headings_ws;
+  // The head height standing the follower is told (SourceSkeleton::head_height_m), metres; 0:
+  // none.
+  double told_head_height_m = 0.0;
 
   int frame_count() const { return motion.frame_count(); }
 };
@@ -242,6 +245,10 @@ struct PerformanceRecipe {
   // Delivered as three points (head and hands) with point_noise (seed ignored).
   bool head_hands = false;
   PointNoiseOptions point_noise;
+  // Three points: the follower is told the performer's head height standing (highest_head_m of
+  // the performance before it is reduced to points: a height calibration) times this (1.05: one
+  // 5 % off), Performance::told_head_height_m; 0: not told.
+  double told_head_height_factor = 0.0;
   FrameLossOptions loss;  // seed ignored
 };
 

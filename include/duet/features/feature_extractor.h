@@ -30,6 +30,10 @@ class FeatureExtractor {
   class Context {
    public:
     void reset() noexcept;
+    // Head and hands: the user's head height standing (metres), known from a calibration, as the
+    // unit of lengths; 0 (the default) learns it, as the highest the head has been. Kept across
+    // reset().
+    void set_head_height(double head_height_m) noexcept { head_height_known_m_ = head_height_m; }
 
    private:
     friend class FeatureExtractor;
@@ -46,6 +50,7 @@ class FeatureExtractor {
     // Head and hands: the highest the head has been (metres), the unit of lengths there, since a
     // headset says nothing of the body's size.
     double head_height_max_m_ = 0.0;
+    double head_height_known_m_ = 0.0;  // set_head_height; 0: learnt
     std::vector<Vec3> positions_ws_;
     std::vector<Quat> rotations_ws_;
   };

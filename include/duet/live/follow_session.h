@@ -33,6 +33,15 @@ class FollowSession {
                     double time_s) noexcept;
   void reset() noexcept;
 
+  // Three points: the head joint's height standing straight (metres, from a height
+  // calibration) as the unit of lengths a headset cannot measure
+  // (FeatureExtractor::Context::set_head_height). 0, the default, learns it as the highest the
+  // head has been, which a dance that starts low gets wrong until the dancer stands. The full-body
+  // follower takes the body's size from the skeleton and ignores it. Errors outside
+  // kHeadHeightRangeM.
+  Status set_head_height(double head_height_m);
+  static constexpr double kHeadHeightRangeM[2] = {0.5, 2.5};
+
   // The standardised features of the last frame, after the rig's posture offset was removed.
   std::span<const float> last_features() const { return features_; }
   const PostureBias& posture_bias() const { return bias_; }

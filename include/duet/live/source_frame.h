@@ -26,6 +26,10 @@ struct SourceSkeleton {
   JointRoles roles;
   double metres_per_unit = 1.0;
   double frame_rate = 60.0;
+  // Three points: the head joint's height (metres above the floor) with the user standing
+  // straight, when a height calibration gave it (a headset says nothing of the body's size); 0:
+  // learnt from the input (FollowSession::set_head_height).
+  double head_height_m = 0.0;
 
   int joint_count() const { return skeleton ? skeleton->joint_count() : 0; }
 };

@@ -67,4 +67,8 @@ Result<std::array<Quat, 2>> rest_grip_frames(const Skeleton& skeleton, const Joi
 Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles,
                              const DevicePointOffsets& offsets = {});
 
+// The highest the head joint is over a full-body clip (metres above the floor, y up): a
+// standing calibration of the performer's head height (0 when no frame has a finite head).
+double highest_head_m(const Clip& full_body, const JointRoles& roles);
+
 }  // namespace duet
