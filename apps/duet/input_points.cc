@@ -85,8 +85,9 @@ double head_joint_height_m(double head_point_height_m, const DevicePointOffsets&
 
 Status check_head_height_applies(double metres, InputPoints points) {
   if (metres > 0.0 && points != InputPoints::kHeadHands) {
-    return Error{"--head-height applies to three points (a headset's recording, --input-points "
-                 "head,hands or --source xr); a full body's size is its skeleton's"};
+    return Error{
+        "--head-height applies to three points (a headset's recording, --input-points "
+        "head,hands or --source xr); a full body's size is its skeleton's"};
   }
   return Ok{};
 }

@@ -1,11 +1,11 @@
 #include "duet/live/follow_session.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
-
-#include <fmt/format.h>
 
 namespace duet {
 
@@ -97,9 +97,9 @@ void FollowSession::report_captured_place(FollowResult& result) noexcept {
 Status FollowSession::set_head_height(double head_height_m) {
   if (head_height_m != 0.0 &&
       !(head_height_m >= kHeadHeightRangeM[0] && head_height_m <= kHeadHeightRangeM[1])) {
-    return Error{fmt::format(
-        "head height {:g} m: give the head's height standing in metres, {:g} to {:g}",
-        head_height_m, kHeadHeightRangeM[0], kHeadHeightRangeM[1])};
+    return Error{
+        fmt::format("head height {:g} m: give the head's height standing in metres, {:g} to {:g}",
+                    head_height_m, kHeadHeightRangeM[0], kHeadHeightRangeM[1])};
   }
   context_.set_head_height(head_height_m);
   return Ok{};

@@ -103,9 +103,8 @@ void LiveLoop::place_head_hands_user(int take, int frame) noexcept {
   // The user's size against the template dancer's: the head's height standing, given by a
   // calibration or learnt as the highest it has been.
   const double head_height_m = user_.head_height_m > 0.0 ? user_.head_height_m : head_height_max_m_;
-  const double size_ratio = body.template_head_height_m() > 0.0
-                                ? head_height_m / body.template_head_height_m()
-                                : 1.0;
+  const double size_ratio =
+      body.template_head_height_m() > 0.0 ? head_height_m / body.template_head_height_m() : 1.0;
   const Transform head_frame =
       head_heading_frame(head_position, out_.user_rotations_ws[head] * device_correction_);
   user_pose_.body_heading = body.body_heading(head_frame, frame, size_ratio);

@@ -163,8 +163,8 @@ TEST(CliHeadHands, OptionsThatCannotApplySaySo) {
 
 TEST(CliHeadHands, AHeadHeightIsForThreePoints) {
   const std::string csv = temp("height.csv"), trace = temp("height_trace.csv");
-  ASSERT_EQ(run_duet("convert " + kTake + " --input-fps 60 --points head,hands -o " + csv).exit_code,
-            0);
+  ASSERT_EQ(
+      run_duet("convert " + kTake + " --input-fps 60 --points head,hands -o " + csv).exit_code, 0);
   // The recording's head point is the head joint (1.49 m standing in this take).
   CommandResult told = run_duet("follow --library " + kSalsaLibrary + " --input " + csv +
                                 " --head-height 1.49 --trace " + trace);
@@ -172,8 +172,8 @@ TEST(CliHeadHands, AHeadHeightIsForThreePoints) {
   int right = 0;
   const auto places = traced_places(trace);
   for (std::size_t f = 0; f < places.size(); ++f) {
-    right += (places[f].first == 6 && std::abs(places[f].second - static_cast<int>(f)) <= 6) ? 1
-                                                                                             : 0;
+    right +=
+        (places[f].first == 6 && std::abs(places[f].second - static_cast<int>(f)) <= 6) ? 1 : 0;
   }
   ASSERT_GT(places.size(), 2000u);
   EXPECT_GE(right, static_cast<int>(places.size() * 99 / 100));
@@ -187,8 +187,8 @@ TEST(CliHeadHands, AHeadHeightIsForThreePoints) {
       run_duet("follow --library " + kSalsaLibrary + " --input " + csv + " --head-height 150");
   EXPECT_EQ(giant.exit_code, 2);
   EXPECT_NE(giant.output.find("--head-height"), std::string::npos) << giant.output;
-  CommandResult serve = run_duet("serve --library " + kSalsaLibrary +
-                                 " --source ws --head-height 1.6 --no-record");
+  CommandResult serve =
+      run_duet("serve --library " + kSalsaLibrary + " --source ws --head-height 1.6 --no-record");
   EXPECT_EQ(serve.exit_code, 2);
   EXPECT_NE(serve.output.find("--head-height applies to three points"), std::string::npos)
       << serve.output;

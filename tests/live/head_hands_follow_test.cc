@@ -395,7 +395,8 @@ TEST(HeadHandsFollow, AKnownHeadHeightFollowsADanceThatStartsLow) {
   ASSERT_TRUE(all_points);
   Clip points(all_points.value().skeleton_ptr(), 60.0, frames);
   for (int f = 0; f < frames; ++f) {
-    std::ranges::copy(all_points.value().translations_ls(first + f), points.translations_ls(f).begin());
+    std::ranges::copy(all_points.value().translations_ls(first + f),
+                      points.translations_ls(f).begin());
     std::ranges::copy(all_points.value().rotations_ls(first + f), points.rotations_ls(f).begin());
   }
   const DuetLibrary& library = head_hands_library();
