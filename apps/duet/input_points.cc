@@ -76,11 +76,7 @@ CLI::Option* add_head_height_option(CLI::App& app, double& metres) {
                   "dance that starts low gets wrong until the dancer stands (docs/features.md, "
                   "three points' unit)")
       ->option_text("M")
-      ->check(number_between(0.6, 2.6, "head height"));
-}
-
-double head_joint_height_m(double head_point_height_m, const DevicePointOffsets& offsets) {
-  return head_point_height_m > 0.0 ? head_point_height_m - offsets.eyes_m.y() : 0.0;
+      ->check(number_between(kHeadPointHeightRangeM[0], kHeadPointHeightRangeM[1], "m"));
 }
 
 Status check_head_height_applies(double metres, InputPoints points) {

@@ -43,9 +43,6 @@ DevicePointOffsets device_offsets_from_cm(const std::vector<double>& cm);
 // user standing straight: a height calibration, FollowSession::set_head_height's unit for three
 // points; 0 when not given.
 CLI::Option* add_head_height_option(CLI::App& app, double& metres);
-// The head joint's height standing from the head point's (--head-height): less the eyes' height
-// above the head joint that `offsets` (the ones taken out of the input) say; 0 stays 0.
-double head_joint_height_m(double head_point_height_m, const DevicePointOffsets& offsets);
 // Errors when --head-height is given (metres > 0) for a follower that does not see three points.
 Status check_head_height_applies(double metres, InputPoints points);
 // Takes the offsets `cm` out of `motion`, a recording of three points as the devices reported

@@ -154,6 +154,12 @@ std::shared_ptr<const Skeleton> LiveLoop::partner_skeleton() const noexcept {
   return models_[0].response_skeleton_ptr();
 }
 
+Status LiveLoop::set_head_height(double head_height_m) {
+  if (Status s = session_.set_head_height(head_height_m); !s) return s;
+  user_.head_height_m = head_height_m;
+  return Ok{};
+}
+
 bool LiveLoop::set_correction(std::string_view name, bool enabled) noexcept {
   return duet::set_correction(params_, name, enabled);
 }

@@ -35,4 +35,8 @@ void device_points_to_joints(const DevicePointOffsets& offsets, Clip& points) {
   }
 }
 
+double head_joint_height_m(double head_point_height_m, const DevicePointOffsets& offsets) {
+  return head_point_height_m > 0.0 ? head_point_height_m - offsets.eyes_m.y() : 0.0;
+}
+
 }  // namespace duet

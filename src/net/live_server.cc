@@ -358,7 +358,29 @@ struct LiveServer::Impl {
       case ClientMessage::Type::kReplay:
         control_replay(id);
         return;
+      case ClientMessage::Type::kHeadHeight:
+        set_head_height(id);
+        return;
     }
+  }
+
+  // A height calibration from the headset (the viewer: both grips held while standing straight):
+  // the eyes' offset taken off as from every pose. Kept across a role switch.
+  void set_head_height(ClientId id) {
+    const DevicePointOffsets* offsets = device_offsets_or_null();
+    if (offsets == nullptr) {
+      reject(id, "head_height messages are for the headset source (duet serve --source xr)");
+      return;
+    }
+    if (Status s = loop->set_head_height(head_joint_height_m(message.head_height_m, *offsets));
+        !s) {
+      reject(id, "head_height: " + s.error().message);
+      return;
+    }
+    log(message.head_height_m > 0.0
+            ? fmt::format("the headset's height standing: {:.2f} m (the user's size from it)",
+                          message.head_height_m)
+            : std::string("the user's size is learnt again from the highest the head has been"));
   }
 
   // Pause, seek, speed of a file replay; every client sees the new state.
@@ -481,6 +503,8 @@ struct LiveServer::Impl {
 
   void activate_other() {
     other_loop->set_params(loop->params());
+    // In range: this loop took it.
+    (void)other_loop->set_head_height(loop->head_height_m());
     other_loop->reset();
     std::swap(loop, other_loop);
     std::swap(hello, other_hello);

@@ -371,6 +371,21 @@ std::optional<std::string> parse_client_message(std::string_view text, ClientMes
     message.type = ClientMessage::Type::kReset;
     return std::nullopt;
   }
+  if (type == "head_height") {
+    // The range of duet serve --head-height; 0 goes back to learning it.
+    const auto metres = doc.find("metres");
+    double value = 0.0;
+    if (metres == doc.end() || !get_number(*metres, value) ||
+        (value != 0.0 && !(value >= kHeadPointHeightRangeM[0] && value <= kHeadPointHeightRangeM[1]))) {
+      return fmt::format(
+          "head_height: needs \"metres\": the headset's height standing, {:g} to {:g} (0: learn "
+          "it)",
+          kHeadPointHeightRangeM[0], kHeadPointHeightRangeM[1]);
+    }
+    message.type = ClientMessage::Type::kHeadHeight;
+    message.head_height_m = value;
+    return std::nullopt;
+  }
   if (type == "pose") {
     message.type = ClientMessage::Type::kPose;
     message.time_s = std::nan("");

@@ -189,6 +189,16 @@ TEST(LiveLoop, SwitchesAndReset) {
   EXPECT_EQ(out.seq, 30);  // seq counts every processed frame, across resets
   EXPECT_FALSE(out.follow.jumped);
   EXPECT_TRUE(all_finite(out));
+
+  // A height calibration is the user's body, not the session's: a reset keeps it; one out of a
+  // person's range is refused and changes nothing.
+  EXPECT_EQ(loop.head_height_m(), 0.0);
+  EXPECT_TRUE(loop.set_head_height(1.52));
+  EXPECT_FALSE(loop.set_head_height(152.0));
+  EXPECT_FALSE(loop.set_head_height(std::nan("")));
+  loop.reset();
+  EXPECT_EQ(loop.head_height_m(), 1.52);
+  EXPECT_TRUE(all_finite(loop.step(frame_of(user, 1))));
 }
 
 TEST(LiveLoop, RefusesASkeletonWithoutRoles) {

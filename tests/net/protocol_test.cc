@@ -25,6 +25,11 @@ TEST(Protocol, ParsesControlMessages) {
   EXPECT_EQ(m.role, DancerRole::kPartner);
   EXPECT_FALSE(parse(R"({"type": "reset", "extra": [1, 2]})", m));
   EXPECT_EQ(m.type, ClientMessage::Type::kReset);
+  EXPECT_FALSE(parse(R"({"type": "head_height", "metres": 1.62})", m));
+  EXPECT_EQ(m.type, ClientMessage::Type::kHeadHeight);
+  EXPECT_DOUBLE_EQ(m.head_height_m, 1.62);
+  EXPECT_FALSE(parse(R"({"type": "head_height", "metres": 0})", m));  // learn it again
+  EXPECT_EQ(m.head_height_m, 0.0);
 }
 
 TEST(Protocol, ParsesPoses) {
@@ -64,6 +69,11 @@ TEST(Protocol, RejectsWithAReason) {
       R"({"type": "pose", "root": [0, 1, 0], "rotations": [[1, 0, 0, null]]})",
       R"({"type": "pose", "root": [0, 1, 0], "rotations": {"a": 1}})",
       R"({"type": "pose", "time_s": "now", "root": [0, 1, 0], "rotations": []})",
+      R"({"type": "head_height"})",
+      R"({"type": "head_height", "metres": "tall"})",
+      R"({"type": "head_height", "metres": 162})",  // centimetres
+      R"({"type": "head_height", "metres": -1.6})",
+      R"({"type": "head_height", "metres": 0.3})",
   };
   for (const char* text : bad) {
     const std::optional<std::string> reason = parse(text, m);

@@ -4,6 +4,8 @@
 // the devices where a headset user's sit (the eyes, the grips).
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -103,6 +105,23 @@ TEST(ServeXr, AHeadsetIsFollowedAndThePartnerStandsInFront) {
   std::printf("xr_pose -> frame latency: p50 %lld us, p99 %lld us\n",
               latencies[latencies.size() / 2], latencies[latencies.size() * 99 / 100]);
 
+  // A height calibration: the headset's height standing (the highest the eyes are in the take)
+  // is taken, a height in centimetres is refused with a reason.
+  double eyes_m = 0.0;
+  for (int f = 0; f < clip.frame_count(); ++f) {
+    eyes_m = std::max(eyes_m, clip.translations_ls(f)[kPointsHead].y());
+  }
+  ASSERT_TRUE(dancer.write(Json{{"type", "head_height"}, {"metres", eyes_m}}.dump()));
+  ASSERT_TRUE(dancer.write(R"({"type": "head_height", "metres": 162})"));
+  const std::optional<Json> refused = dancer.read_type("error");
+  ASSERT_TRUE(refused);
+  EXPECT_NE((*refused)["reason"].get<std::string>().find("head_height: needs \"metres\""),
+            std::string::npos)
+      << *refused;
+  EXPECT_NE(server.log().find(fmt::format("the headset's height standing: {:.2f} m", eyes_m)),
+            std::string::npos)
+      << server.log();
+
   // A full-body pose is refused by the headset source, and the next xr_pose is accepted.
   ASSERT_TRUE(dancer.write(R"({"type": "pose", "root": [0, 1, 0], "rotations": []})"));
   ASSERT_TRUE(dancer.read_type("error"));
@@ -137,6 +156,13 @@ TEST(ServeXr, ReplaysAThreePointRecording) {
   WsClient viewer;
   ASSERT_TRUE(viewer.connect(server.port()));
   ASSERT_TRUE(viewer.read_type("hello"));
+  // A height calibration comes from a headset; a replay has none to send it.
+  ASSERT_TRUE(viewer.write(R"({"type": "head_height", "metres": 1.6})"));
+  const std::optional<Json> refused = viewer.read_type("error");
+  ASSERT_TRUE(refused) << server.log();
+  EXPECT_NE((*refused)["reason"].get<std::string>().find("for the headset source"),
+            std::string::npos)
+      << *refused;
   std::optional<Json> last;
   for (std::optional<Json> frame; (frame = viewer.read_type("frame"));) last = frame;
   ASSERT_TRUE(last) << server.log();

@@ -10,6 +10,7 @@ import { StickFigure, kRoleColors } from './dancers.js';
 import { Timeline } from './timeline.js';
 import { VRSession, installXREmulator, placeRigAtHead } from './xr.js';
 import { XRPoseSender } from './xr_pose.js';
+import { HeightCalibration } from './height_calibration.js';
 
 const kCorrections = ['align', 'contact', 'smooth', 'footlock', 'blend'];
 const kPendingToggle_s = 1.5; // how long a clicked switch waits for the server to confirm it
@@ -306,6 +307,8 @@ async function main() {
   });
   // In VR on a headset-source server, the headset and controllers are the user's input.
   const xr_sender = new XRPoseSender(connection);
+  // Standing straight, both grips held for a second: the headset's height (head_height).
+  const height_calibration = new HeightCalibration(connection);
   let xr_frame_hook = null; // test hook: (time_ms, message sent or null) after each XR frame
   const headsetIsSource = () => state.hello?.source_kind === 'xr';
 
@@ -531,6 +534,7 @@ async function main() {
   renderer.setAnimationLoop((time_ms, xr_frame) => {
     if (xr_frame && headsetIsSource() && renderer.xr.isPresenting) {
       const sent = xr_sender.send(time_ms, xr_frame, renderer.xr.getReferenceSpace());
+      if (sent) height_calibration.update(time_ms, sent.head.position[1], xr_frame.session);
       xr_frame_hook?.(time_ms, sent);
     }
     const now = performance.now();
@@ -585,6 +589,8 @@ async function main() {
     get xrDevice() { return xr_device; },
     /** xr_pose messages sent and skipped (socket behind) in VR on a headset source. */
     get xrPoses() { return { sent: xr_sender.sent, skipped: xr_sender.skipped }; },
+    /** The last height calibration sent (head_height, metres), null before any. */
+    get headHeightSent() { return height_calibration.sent_m; },
     /** Calls `fn(time_ms, sent)` after each XR frame on a headset source (null: stop). */
     setXRFrameHook(fn) { xr_frame_hook = typeof fn === 'function' ? fn : null; },
     /** In VR, the partner as the headset's left eye sees it: its hips in normalized device

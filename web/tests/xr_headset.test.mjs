@@ -187,6 +187,20 @@ test('a headset playing a three-point recording is followed, the partner in fron
     await new Promise((r) => setTimeout(r, 300)); // the last frames on their way back
     const drive = await page.evaluate(() => window.duetXRDrive);
     const poses_info = await page.evaluate(() => window.duetViewer.xrPoses);
+    // A height calibration: standing, both grips held for over a second send the headset's
+    // height (head_height), which the server takes: no error comes back.
+    await page.evaluate(() => {
+      const d = window.duetViewer.xrDevice;
+      d.controllers.left.updateButtonValue('squeeze', 1);
+      d.controllers.right.updateButtonValue('squeeze', 1);
+    });
+    await page.waitForFunction(() => window.duetViewer.headHeightSent !== null, null, { timeout: 5000 });
+    const head_height_m = await page.evaluate(() => window.duetViewer.headHeightSent);
+    // The headset stands where the driver last put it (it skips frames at a low frame rate).
+    const last_head_y = poses[await page.evaluate(() => window.duetXRDrive.current)][1];
+    assert.ok(Math.abs(head_height_m - last_head_y) < 0.01,
+      `the calibration sent ${head_height_m} m, the headset stands at ${last_head_y} m`);
+    await new Promise((r) => setTimeout(r, 300)); // an error reply would be back by now
     const errors = await page.evaluate(() => window.duetViewer.errors);
     assert.deepEqual(errors, [], 'the server rejected messages');
 

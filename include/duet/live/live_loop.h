@@ -71,6 +71,11 @@ class LiveLoop {
 
   // Restart the follower and the corrections' state (the next frame starts fresh).
   void reset() noexcept;
+  // Three points: the head joint's height standing, from a height calibration
+  // (SourceSkeleton::head_height_m); 0 learns it again. Errors, and nothing changes, outside
+  // FollowSession::kHeadHeightRangeM. Call between steps, as the other setters.
+  Status set_head_height(double head_height_m);
+  double head_height_m() const noexcept { return user_.head_height_m; }
   // Switch a correction (protocol name); false for an unknown name.
   bool set_correction(std::string_view name, bool enabled) noexcept;
   void set_params(const PartnerParams& params) noexcept { params_ = params; }

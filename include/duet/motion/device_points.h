@@ -40,4 +40,11 @@ void device_points_to_joints(const DevicePointOffsets& offsets, std::span<Vec3> 
 // The same for every frame of a three-point clip.
 void device_points_to_joints(const DevicePointOffsets& offsets, Clip& points);
 
+// The head joint's height standing from the head point's (a height calibration of the headset,
+// duet follow/serve --head-height): less the eyes' height above the head joint that `offsets` say
+// (the user stands straight, so the head's up is the world's). 0 (not given) stays 0.
+double head_joint_height_m(double head_point_height_m, const DevicePointOffsets& offsets);
+// The head point's heights standing a calibration may give (metres): a child to a tall adult.
+inline constexpr double kHeadPointHeightRangeM[2] = {0.6, 2.6};
+
 }  // namespace duet

@@ -69,7 +69,7 @@ std::string make_replay_state(const ReplayState& state);
 
 // What a client asked for.
 struct ClientMessage {
-  enum class Type { kSet, kRole, kReset, kPose, kXrPose, kReplay };
+  enum class Type { kSet, kRole, kReset, kPose, kXrPose, kReplay, kHeadHeight };
   Type type = Type::kReset;
   // set
   std::string correction;
@@ -83,6 +83,8 @@ struct ClientMessage {
   // xr_pose: head, left hand, right hand; positions in metres, orientations w, x, y, z
   std::array<Vec3, 3> point_positions{};
   std::array<double, 12> point_orientations{};
+  // head_height: the headset's height standing, metres; 0 learns it again
+  double head_height_m = 0.0;
   // replay: each absent field leaves that setting alone (at least one is present)
   std::optional<bool> replay_paused;
   std::optional<double> replay_seek_s;

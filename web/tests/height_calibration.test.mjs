@@ -1,0 +1,66 @@
+// HeightCalibration: a `head_height` (docs/protocol.md) goes out once per hold of both grips, only
+// after the hold has lasted a second, and only with a height the server takes. Plain objects stand
+// in for the XRSession and the Connection.
+import assert from 'node:assert/strict';
+import { test } from 'node:test';
+
+import { HeightCalibration, bothGripsSqueezed, kCalibrationHold_ms } from '../src/height_calibration.js';
+
+/** A session whose left and right grips are pressed as given; pulses are counted. */
+function fakeSession(left, right, pulses = []) {
+  const source = (handedness, pressed) => ({
+    handedness,
+    gamepad: {
+      buttons: [{ pressed: false }, { pressed }],
+      hapticActuators: [{ pulse: (strength, ms) => pulses.push([handedness, strength, ms]) }],
+    },
+  });
+  return { inputSources: [source('left', left), source('right', right)] };
+}
+
+function fakeConnection() {
+  return { messages: [], send(msg) { this.messages.push(JSON.parse(JSON.stringify(msg))); return true; } };
+}
+
+test('both grips, not one, count as a calibration hold', () => {
+  assert.equal(bothGripsSqueezed(fakeSession(true, true)), true);
+  assert.equal(bothGripsSqueezed(fakeSession(true, false)), false);
+  assert.equal(bothGripsSqueezed(fakeSession(false, true)), false);
+  assert.equal(bothGripsSqueezed({ inputSources: [{ handedness: 'left' }, { handedness: 'right' }] }), false);
+  assert.equal(bothGripsSqueezed(undefined), false);
+});
+
+test('a hold of a second sends the headset height once, with a buzz', () => {
+  const connection = fakeConnection();
+  const pulses = [];
+  const calibration = new HeightCalibration(connection);
+  const held = fakeSession(true, true, pulses);
+  assert.equal(calibration.update(0, 1.62, held), null);
+  assert.equal(calibration.update(kCalibrationHold_ms - 10, 1.62, held), null); // not yet
+  assert.equal(calibration.update(kCalibrationHold_ms + 5, 1.63, held), 1.63);
+  assert.deepEqual(connection.messages, [{ type: 'head_height', metres: 1.63 }]);
+  assert.equal(pulses.length, 2); // both controllers
+  assert.equal(calibration.update(kCalibrationHold_ms + 500, 1.63, held), null); // once per hold
+  assert.equal(connection.messages.length, 1);
+  assert.equal(calibration.sent_m, 1.63);
+
+  // Let go and hold again: another calibration.
+  assert.equal(calibration.update(3000, 1.6, fakeSession(false, true)), null);
+  assert.equal(calibration.update(3100, 1.6, held), null);
+  assert.equal(calibration.update(3100 + kCalibrationHold_ms, 1.6, held), 1.6);
+  assert.equal(connection.messages.length, 2);
+});
+
+test('a hold broken before the second sends nothing; a height out of range is not sent', () => {
+  const connection = fakeConnection();
+  const calibration = new HeightCalibration(connection);
+  calibration.update(0, 1.6, fakeSession(true, true));
+  calibration.update(600, 1.6, fakeSession(true, false)); // one grip let go
+  assert.equal(calibration.update(1200, 1.6, fakeSession(true, true)), null); // the hold restarts
+  assert.equal(connection.messages.length, 0);
+  const sitting = new HeightCalibration(connection);
+  sitting.update(0, 0.4, fakeSession(true, true));
+  assert.equal(sitting.update(kCalibrationHold_ms, 0.4, fakeSession(true, true)), null);
+  assert.equal(connection.messages.length, 0);
+  assert.equal(sitting.sent_m, null);
+});
