@@ -376,7 +376,8 @@ std::optional<std::string> parse_client_message(std::string_view text, ClientMes
     const auto metres = doc.find("metres");
     double value = 0.0;
     if (metres == doc.end() || !get_number(*metres, value) ||
-        (value != 0.0 && !(value >= kHeadPointHeightRangeM[0] && value <= kHeadPointHeightRangeM[1]))) {
+        (value != 0.0 &&
+         !(value >= kHeadPointHeightRangeM[0] && value <= kHeadPointHeightRangeM[1]))) {
       return fmt::format(
           "head_height: needs \"metres\": the headset's height standing, {:g} to {:g} (0: learn "
           "it)",

@@ -2,9 +2,8 @@
 // `xr_pose` messages, the three-point follower follows them and the partner stands in front of
 // the user at life size. The performance is take 60_07 as three points with a headset's noise,
 // the devices where a headset user's sit (the eyes, the grips).
-#include <gtest/gtest.h>
-
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
