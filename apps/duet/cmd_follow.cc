@@ -251,6 +251,12 @@ int run_follow(const FollowArgs& args) {
       corrections_string(loop.value().params()),
       loop.value().params().foot_hold.enabled ? ", foot hold" : "");
   if (truth) print_accuracy_summary(*truth, results, library->frame_rate());
+  if (points.value() == InputPoints::kHeadHands && args.head_height_m == 0.0) {
+    if (std::optional<std::string> note = head_height_note(
+            user, input.value().roles, device_offsets_from_cm(args.device_offsets_cm))) {
+      fmt::print(stderr, "duet follow: note: {}\n", *note);
+    }
+  }
   const float median_tempo = median_followed_tempo(results);
   if (summary.lost_fraction() <= kMostlyLostFraction) {
     // Followed, but perhaps in slow or fast motion: the rate is the one cause worth a warning.

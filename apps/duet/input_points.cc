@@ -1,5 +1,9 @@
 #include "input_points.h"
 
+#include <fmt/format.h>
+
+#include <cmath>
+
 #include "duet/motion/head_hands.h"
 #include "number_checks.h"
 
@@ -77,6 +81,24 @@ CLI::Option* add_head_height_option(CLI::App& app, double& metres) {
                   "three points' unit)")
       ->option_text("M")
       ->check(number_between(kHeadPointHeightRangeM[0], kHeadPointHeightRangeM[1], "m"));
+}
+
+std::optional<std::string> head_height_note(const Clip& points, const JointRoles& roles,
+                                            const DevicePointOffsets& offsets) {
+  // Within 5 % the learnt size does no harm (docs/evaluation.md, "A head height from a
+  // calibration": 3 % off costs nothing measurable).
+  constexpr double kRiseFraction = 0.05;
+  const int first_second = static_cast<int>(std::ceil(points.frame_rate()));
+  const double first = highest_head_m(points, roles, first_second);
+  const double highest = highest_head_m(points, roles);
+  if (!(first > 0.0) || highest <= (1.0 + kRiseFraction) * first) return std::nullopt;
+  const double head_point = highest + offsets.eyes_m.y();
+  return fmt::format(
+      "the head was at most {:.2f} m high in the first second and {:.2f} m later: the follower "
+      "learns the body's size from the highest the head has been, so it took the dancer as "
+      "{:.0f} % smaller until they stood. --head-height {:.2f} (the head's height standing) "
+      "gives the size from the first frame",
+      first + offsets.eyes_m.y(), head_point, 100.0 * (1.0 - first / highest), head_point);
 }
 
 Status check_head_height_applies(double metres, InputPoints points) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,13 @@ DevicePointOffsets device_offsets_from_cm(const std::vector<double>& cm);
 // user standing straight: a height calibration, FollowSession::set_head_height's unit for three
 // points; 0 when not given.
 CLI::Option* add_head_height_option(CLI::App& app, double& metres);
+// Three points followed without --head-height: when the head stood clearly higher later than in
+// the recording's first second, the body's size learnt at the start was too small (a dance that
+// starts low) and the first seconds were followed at the wrong size. Then a note saying so and
+// which --head-height to give (the input's head point: the eyes when `offsets` were taken out);
+// else nullopt.
+std::optional<std::string> head_height_note(const Clip& points, const JointRoles& roles,
+                                            const DevicePointOffsets& offsets);
 // Errors when --head-height is given (metres > 0) for a follower that does not see three points.
 Status check_head_height_applies(double metres, InputPoints points);
 // Takes the offsets `cm` out of `motion`, a recording of three points as the devices reported

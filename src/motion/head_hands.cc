@@ -217,16 +217,16 @@ Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles,
   return points;
 }
 
-double highest_head_m(const Clip& full_body, const JointRoles& roles) {
+double highest_head_m(const Clip& clip, const JointRoles& roles, int frames) {
   const int head = roles[Role::kHead];
-  if (head < 0 || head >= full_body.joint_count()) return 0.0;
-  const auto n = static_cast<std::size_t>(full_body.joint_count());
+  if (head < 0 || head >= clip.joint_count()) return 0.0;
+  const auto n = static_cast<std::size_t>(clip.joint_count());
   std::vector<Vec3> positions(n);
   std::vector<Quat> rotations(n);
   double highest = 0.0;
-  for (int f = 0; f < full_body.frame_count(); ++f) {
-    forward_kinematics(full_body.skeleton(), full_body.translations_ls(f),
-                       full_body.rotations_ls(f), positions, rotations);
+  for (int f = 0; f < std::min(frames, clip.frame_count()); ++f) {
+    forward_kinematics(clip.skeleton(), clip.translations_ls(f), clip.rotations_ls(f), positions,
+                       rotations);
     const double y = positions[static_cast<std::size_t>(head)].y();
     if (std::isfinite(y)) highest = std::max(highest, y);
   }

@@ -9,7 +9,12 @@
 #include <utility>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "apps/run_command.h"
+#include "duet/io/motion_file.h"
+#include "duet/io/points_csv.h"
+#include "duet/motion/head_hands.h"
 
 namespace duet::testing {
 namespace {
@@ -158,6 +163,51 @@ TEST(CliHeadHands, OptionsThatCannotApplySaySo) {
   EXPECT_NE(head_only.output.find("'head' is not full or head,hands (head,hands is one value"),
             std::string::npos)
       << head_only.output;
+  std::filesystem::remove(csv);
+}
+
+TEST(CliHeadHands, ADanceThatStartsLowIsToldItsHeadHeight) {
+  // Take 60_01's three points from its deepest dip (head 0.87 m of 1.49) on: the follower learns
+  // the body's size as the head rises, and says which --head-height would have known it.
+  MotionLoadOptions options;
+  options.frame_rate = 60.0;
+  Result<LoadedMotion> take = load_motion({data_path("cmu-salsa/bvh/60/60_01_scaled.bvh")}, options);
+  ASSERT_TRUE(take) << take.error().message;
+  Result<Clip> points = head_hands_clip(take.value().clip, take.value().roles);
+  ASSERT_TRUE(points);
+  int lowest = 0;
+  for (int f = 0; f < points.value().frame_count(); ++f) {
+    if (points.value().translations_ls(f)[kPointsHead].y() <
+        points.value().translations_ls(lowest)[kPointsHead].y()) {
+      lowest = f;
+    }
+  }
+  const int frames = std::min(600, points.value().frame_count() - lowest);
+  Clip dip(points.value().skeleton_ptr(), 60.0, frames);
+  for (int f = 0; f < frames; ++f) {
+    std::ranges::copy(points.value().translations_ls(lowest + f), dip.translations_ls(f).begin());
+    std::ranges::copy(points.value().rotations_ls(lowest + f), dip.rotations_ls(f).begin());
+  }
+  const double standing = highest_head_m(dip, head_hands_roles());
+  const std::string csv = temp("dip.csv");
+  {
+    std::ofstream out(csv);
+    out << format_points_csv(dip);
+  }
+  CommandResult learnt = run_duet("follow --library " + kSalsaLibrary + " --input " + csv);
+  ASSERT_EQ(learnt.exit_code, 0) << learnt.output;
+  EXPECT_NE(learnt.output.find(fmt::format("--head-height {:.2f}", standing)), std::string::npos)
+      << learnt.output;
+  CommandResult told = run_duet("follow --library " + kSalsaLibrary + " --input " + csv +
+                                fmt::format(" --head-height {:.2f}", standing));
+  ASSERT_EQ(told.exit_code, 0) << told.output;
+  EXPECT_EQ(told.output.find("note:"), std::string::npos) << told.output;
+  // A take that starts standing gets no note.
+  CommandResult standing_start = run_duet("follow --library " + kSalsaLibrary + " --input " +
+                                          kTake + " --input-fps 60 --input-points head,hands");
+  ASSERT_EQ(standing_start.exit_code, 0) << standing_start.output;
+  EXPECT_EQ(standing_start.output.find("--head-height"), std::string::npos)
+      << standing_start.output;
   std::filesystem::remove(csv);
 }
 

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <memory>
 
 #include "duet/base/result.h"
@@ -67,8 +68,10 @@ Result<std::array<Quat, 2>> rest_grip_frames(const Skeleton& skeleton, const Joi
 Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles,
                              const DevicePointOffsets& offsets = {});
 
-// The highest the head joint is over a full-body clip (metres above the floor, y up): a
-// standing calibration of the performer's head height (0 when no frame has a finite head).
-double highest_head_m(const Clip& full_body, const JointRoles& roles);
+// The highest the head joint is over a clip's first `frames` frames (all by default), metres above
+// the floor, y up: over a whole dance, a standing calibration of the performer's head height (0
+// when no frame has a finite head). Any rig with a head role, three points included.
+double highest_head_m(const Clip& clip, const JointRoles& roles,
+                      int frames = std::numeric_limits<int>::max());
 
 }  // namespace duet
