@@ -1,6 +1,7 @@
 // End to end with three points (issue 12): `duet convert --points head,hands` makes a headset
 // recording of a take, `duet follow` follows it with the three-point follower, and the options
 // that cannot apply say so.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -8,8 +9,6 @@
 #include <sstream>
 #include <utility>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "apps/run_command.h"
 #include "duet/io/motion_file.h"
@@ -171,7 +170,8 @@ TEST(CliHeadHands, ADanceThatStartsLowIsToldItsHeadHeight) {
   // the body's size as the head rises, and says which --head-height would have known it.
   MotionLoadOptions options;
   options.frame_rate = 60.0;
-  Result<LoadedMotion> take = load_motion({data_path("cmu-salsa/bvh/60/60_01_scaled.bvh")}, options);
+  Result<LoadedMotion> take =
+      load_motion({data_path("cmu-salsa/bvh/60/60_01_scaled.bvh")}, options);
   ASSERT_TRUE(take) << take.error().message;
   Result<Clip> points = head_hands_clip(take.value().clip, take.value().roles);
   ASSERT_TRUE(points);
