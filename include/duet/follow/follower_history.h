@@ -4,10 +4,10 @@
 // residual). One struct, so both followers configure and reset the same state.
 #pragma once
 
+#include "duet/follow/ceiling_lost_report.h"
 #include "duet/follow/explained_residual.h"
 #include "duet/follow/follow_params.h"
 #include "duet/follow/jump_gate.h"
-#include "duet/follow/ceiling_lost_report.h"
 #include "duet/follow/noise_filter.h"
 #include "duet/follow/sensor_noise.h"
 #include "duet/follow/template_model.h"
