@@ -169,8 +169,7 @@ FeatureExtractor::Context::Sample FeatureExtractor::extract_head_hands(
   // ground from dividing by ~0).
   constexpr double kLowestHeadHeightM = 0.5;
   context.head_height_max_m_ = std::max({context.head_height_max_m_, head.y(), kLowestHeadHeightM});
-  const double per_height = 1.0 / (context.head_height_known_m_ > 0.0 ? context.head_height_known_m_
-                                                                      : context.head_height_max_m_);
+  const double per_height = 1.0 / context.head_height_m();
   const Quat to_heading = yaw_rotation(-now.yaw);
 
   std::size_t d = 0;

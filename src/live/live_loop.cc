@@ -97,14 +97,13 @@ void LiveLoop::place_head_hands_user(int take, int frame) noexcept {
   const auto head = static_cast<std::size_t>(user_.roles[Role::kHead]);
   const Vec3& head_position = out_.user_positions_ws[head];
   if (!head_position.allFinite()) return;
-  head_height_max_m_ = std::max(head_height_max_m_, head_position.y());
   const HeadHandsBody& body = head_hands_bodies_[static_cast<std::size_t>(take)];
   const PartnerModel& model = models_[static_cast<std::size_t>(take)];
-  // The user's size against the template dancer's: the head's height standing, given by a
-  // calibration or learnt as the highest it has been.
-  const double head_height_m = user_.head_height_m > 0.0 ? user_.head_height_m : head_height_max_m_;
-  const double size_ratio =
-      body.template_head_height_m() > 0.0 ? head_height_m / body.template_head_height_m() : 1.0;
+  // The user's size against the template dancer's, in the follower's own unit: the head's height
+  // standing, given by a calibration or learnt as the highest it has been.
+  const double size_ratio = body.template_head_height_m() > 0.0
+                                ? session_.head_height_m() / body.template_head_height_m()
+                                : 1.0;
   const Transform head_frame =
       head_heading_frame(head_position, out_.user_rotations_ws[head] * device_correction_);
   user_pose_.body_heading = body.body_heading(head_frame, frame, size_ratio);
@@ -155,9 +154,7 @@ std::shared_ptr<const Skeleton> LiveLoop::partner_skeleton() const noexcept {
 }
 
 Status LiveLoop::set_head_height(double head_height_m) {
-  if (Status s = session_.set_head_height(head_height_m); !s) return s;
-  user_.head_height_m = head_height_m;
-  return Ok{};
+  return session_.set_head_height(head_height_m);
 }
 
 bool LiveLoop::set_correction(std::string_view name, bool enabled) noexcept {
@@ -170,7 +167,6 @@ void LiveLoop::reset() noexcept {
   playhead_.reset();
   place_.reset();
   has_previous_ = false;
-  head_height_max_m_ = 0.0;
 }
 
 const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {

@@ -34,6 +34,12 @@ class FeatureExtractor {
     // unit of lengths; 0 (the default) learns it, as the highest the head has been. Kept across
     // reset().
     void set_head_height(double head_height_m) noexcept { head_height_known_m_ = head_height_m; }
+    // The calibration's height (0: none) and the unit of lengths in use: the calibration's, else
+    // the highest the head has been (0 before the first frame).
+    double known_head_height_m() const noexcept { return head_height_known_m_; }
+    double head_height_m() const noexcept {
+      return head_height_known_m_ > 0.0 ? head_height_known_m_ : head_height_max_m_;
+    }
 
    private:
     friend class FeatureExtractor;

@@ -75,7 +75,7 @@ class LiveLoop {
   // (SourceSkeleton::head_height_m); 0 learns it again. Errors, and nothing changes, outside
   // FollowSession::kHeadHeightRangeM. Call between steps, as the other setters.
   Status set_head_height(double head_height_m);
-  double head_height_m() const noexcept { return user_.head_height_m; }
+  double head_height_m() const noexcept { return session_.known_head_height_m(); }
   // Switch a correction (protocol name); false for an unknown name.
   bool set_correction(std::string_view name, bool enabled) noexcept;
   void set_params(const PartnerParams& params) noexcept { params_ = params; }
@@ -110,7 +110,6 @@ class LiveLoop {
   // Three-point users (head and hands only): one HeadHandsBody per take; empty for a full body.
   std::vector<HeadHandsBody> head_hands_bodies_;
   Quat device_correction_ = Quat::Identity();  // a point's device rotation -> canonical
-  double head_height_max_m_ = 0.0;           // the highest the user's head has been
   ResponsePlayhead playhead_;
   Pose shown_pose_;  // the response sampled at the playhead
   PartnerPlace place_;  // where in the library the partner dances
