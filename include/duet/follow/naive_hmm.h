@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "duet/base/result.h"
+#include "duet/follow/ceiling_lost_report.h"
 #include "duet/follow/follow_params.h"
 #include "duet/follow/jump_gate.h"
-#include "duet/follow/ceiling_lost_report.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tempo_band.h"
 #include "duet/follow/tracker.h"
