@@ -57,6 +57,8 @@ struct EvalArgs {
   std::vector<double> device_offsets_cm;  // eyes forward, eyes up, grip; empty: at the joints
   std::vector<double> taken_out_cm;       // what the follower takes out; empty: nothing
   double tell_head_height = 0.0;  // the performer's head height standing times this; 0: not told
+  bool tell_arms_forward = false;             // the performer's wrists with arms held forward
+  std::vector<double> arms_forward_error_cm;  // OUT,UP,FORWARD added to each wrist; empty: none
   // Tuning of the "hmm" tracker (FollowParams fields); unset keeps the follower's defaults.
   std::optional<float> jump_hold;
   std::optional<int> jump_tolerance;
@@ -271,6 +273,15 @@ int run_eval(EvalArgs& args) {
         "--tell-head-height: applies to three points (--input-points head,hands); the full body's "
         "size is its skeleton's");
   }
+  if ((args.tell_arms_forward || !args.arms_forward_error_cm.empty()) &&
+      features.input_points != InputPoints::kHeadHands) {
+    return usage_error(
+        "--tell-arms-forward: applies to three points (--input-points head,hands); the full "
+        "body's features are directions between its joints");
+  }
+  if (!args.arms_forward_error_cm.empty() && !args.tell_arms_forward) {
+    return usage_error("--arms-forward-error-cm: needs --tell-arms-forward");
+  }
 
   std::string gnuplot;
   if (!args.plots_dir.empty()) {
@@ -350,6 +361,15 @@ int run_eval(EvalArgs& args) {
       eval_case.recipe.point_noise.offsets = device_offsets_from_cm(args.device_offsets_cm);
       eval_case.recipe.point_noise.taken_out = device_offsets_from_cm(args.taken_out_cm);
       eval_case.recipe.told_head_height_factor = args.tell_head_height;
+      eval_case.recipe.tell_arms_forward = args.tell_arms_forward;
+      if (!args.arms_forward_error_cm.empty()) {
+        // Centimetres of a 1.7 m body's head height (1.58 m) in head heights.
+        constexpr double kCmPerHeadHeight = 158.0;
+        eval_case.recipe.told_arms_forward_error =
+            Vec3(args.arms_forward_error_cm[0], args.arms_forward_error_cm[1],
+                 args.arms_forward_error_cm[2]) /
+            kCmPerHeadHeight;
+      }
     }
   }
 
@@ -510,6 +530,18 @@ Command register_eval(CLI::App& app) {
                  "told; the unit is then the highest the head has been so far)")
       ->option_text("FACTOR")
       ->check(number_between(0.5, 2.0, "factor"));
+  app.add_flag("--tell-arms-forward", args->tell_arms_forward,
+               "Three points: tell the follower where each performer's wrists are with both arms "
+               "held straight forward (from its rig: shoulders plus the arm's length), as duet "
+               "follow's and duet serve's --calibration would (default: not told; the hands are "
+               "then taken where they come)");
+  app.add_option("--arms-forward-error-cm", args->arms_forward_error_cm,
+                 "With --tell-arms-forward: move each told wrist OUT,UP,FORWARD centimetres (of a "
+                 "1.58 m head height), a calibration pose held wider, higher or further")
+      ->delimiter(',')
+      ->expected(3)
+      ->option_text("OUT,UP,FORWARD")
+      ->check(CLI::Range(-30.0, 30.0));
   app.add_flag("--beam", args->beam,
                "Run the hmm and hmm-paper trackers in beam mode (docs/follower.md "
                "\"Beam mode\"; the partner metrics keep the exact step)");

@@ -37,6 +37,7 @@ struct FollowArgs {
   std::string input_points;  // "", "full" or "head,hands" (--input-points)
   std::vector<double> device_offsets_cm;  // taken out of a three-point recording; empty: none
   double head_height_m = 0.0;  // the headset's height standing (--head-height); 0: learnt
+  std::string calibration_path;  // --calibration: standing with both arms held forward
   std::string partner_rig;  // a motion word whose skeleton the partner is written on
   MotionFileOptions partner_rig_motion;
   bool allow_lost = false;
@@ -152,6 +153,27 @@ int run_follow(const FollowArgs& args) {
     fmt::print(stderr, "duet follow: {}\n", s.error().message);
     return kExitUsage;
   }
+  if (Status s = check_calibration_applies(args.calibration_path, points.value()); !s) {
+    fmt::print(stderr, "duet follow: {}\n", s.error().message);
+    return kExitUsage;
+  }
+  std::optional<BodyCalibration> calibration;
+  if (!args.calibration_path.empty()) {
+    Result<BodyCalibration> read =
+        read_body_calibration(args.calibration_path, args.device_offsets_cm);
+    if (!read) {
+      fmt::print(stderr, "duet follow: {}\n", read.error().message);
+      return kExitFailure;
+    }
+    calibration = read.value();
+    const ArmsForward& arms = calibration->arms_forward;
+    const double head_m = calibration->head_height_m;
+    fmt::print(stderr,
+               "duet follow: calibration {}: head {:.2f} m high standing, wrists held {:.2f} m "
+               "apart and {:.2f} m in front of the head\n",
+               args.calibration_path, head_m, (arms.wrists[0].x() - arms.wrists[1].x()) * head_m,
+               0.5 * (arms.wrists[0].z() + arms.wrists[1].z()) * head_m);
+  }
   FeatureSpec features;
   features.input_points = points.value();
   std::optional<DuetLibrary> loaded = load_library(args.library, "follow", features);
@@ -192,6 +214,10 @@ int run_follow(const FollowArgs& args) {
   SourceSkeleton user_skeleton{
       user.skeleton_ptr(), input.value().roles, input.value().metres_per_unit, user.frame_rate(),
       head_joint_height_m(args.head_height_m, device_offsets_from_cm(args.device_offsets_cm))};
+  if (calibration) {
+    if (args.head_height_m == 0.0) user_skeleton.head_height_m = calibration->head_height_m;
+    user_skeleton.arms_forward = calibration->arms_forward;
+  }
   Result<LiveLoop> loop = LiveLoop::create(library, user_skeleton, std::move(tracker).value(),
                                            make_partner_params(args.partner));
   if (!loop) {
@@ -251,7 +277,7 @@ int run_follow(const FollowArgs& args) {
       corrections_string(loop.value().params()),
       loop.value().params().foot_hold.enabled ? ", foot hold" : "");
   if (truth) print_accuracy_summary(*truth, results, library->frame_rate());
-  if (points.value() == InputPoints::kHeadHands && args.head_height_m == 0.0) {
+  if (points.value() == InputPoints::kHeadHands && args.head_height_m == 0.0 && !calibration) {
     if (std::optional<std::string> note = head_height_note(
             user, input.value().roles, device_offsets_from_cm(args.device_offsets_cm))) {
       fmt::print(stderr, "duet follow: note: {}\n", *note);
@@ -301,6 +327,7 @@ Command register_follow(CLI::App& app) {
                             "Taken out of a three-point recording before following (a recording "
                             "of duet serve --source xr has them out already; default: none)");
   add_head_height_option(app, args->head_height_m);
+  add_calibration_option(app, args->calibration_path);
   add_motion_file_options(app, args->input_motion, "input-");
   add_tracker_options(app, args->tracker);
   add_partner_options(app, args->partner);

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "duet/io/motion_argument.h"
 #include "duet/motion/head_hands.h"
 #include "number_checks.h"
 
@@ -106,6 +107,49 @@ Status check_head_height_applies(double metres, InputPoints points) {
     return Error{
         "--head-height applies to three points (a headset's recording, --input-points "
         "head,hands or --source xr); a full body's size is its skeleton's"};
+  }
+  return Ok{};
+}
+
+CLI::Option* add_calibration_option(CLI::App& app, std::string& path) {
+  return app
+      .add_option("--calibration", path,
+                  "Three points: a recording of the user standing straight with both arms held "
+                  "straight forward, level with the shoulders, for a second (a three-point CSV "
+                  "taken like the input, or any motion file). Gives the body's size (the head's "
+                  "height, unless --head-height says) and where the body holds its hands, so "
+                  "that another body, or another rig, is followed as well as the library's own "
+                  "(docs/features.md, \"A body calibration\")")
+      ->option_text("FILE");
+}
+
+Result<BodyCalibration> read_body_calibration(const std::string& path,
+                                              const std::vector<double>& device_offsets_cm) {
+  Result<std::vector<std::string>> files = split_motion_argument(path);
+  if (!files) return Error{"--calibration: " + files.error().message};
+  Result<LoadedMotion> motion = load_motion(files.value(), MotionLoadOptions{});
+  if (!motion) return Error{"--calibration: " + motion.error().message};
+  LoadedMotion& pose = motion.value();
+  if (is_head_hands_input(pose.roles)) {
+    if (Status s = take_out_device_offsets(device_offsets_cm, pose); !s) return s.error();
+  } else {
+    Result<Clip> points = head_hands_clip(pose.clip, pose.roles);
+    if (!points) return Error{"--calibration: " + path + ": " + points.error().message};
+    pose.clip = std::move(points).value();
+  }
+  BodyCalibration calibration;
+  Result<ArmsForward> arms = arms_forward_of_points(pose.clip);
+  if (!arms) return Error{"--calibration: " + path + ": " + arms.error().message};
+  calibration.arms_forward = arms.value();
+  calibration.head_height_m = median_head_height(pose.clip);  // the clip is in metres
+  return calibration;
+}
+
+Status check_calibration_applies(const std::string& path, InputPoints points) {
+  if (!path.empty() && points != InputPoints::kHeadHands) {
+    return Error{
+        "--calibration applies to three points (a headset's recording, --input-points "
+        "head,hands or --source xr); a full body's proportions are its skeleton's"};
   }
   return Ok{};
 }

@@ -12,6 +12,7 @@
 #include "duet/base/result.h"
 #include "duet/features/feature_spec.h"
 #include "duet/io/motion_file.h"
+#include "duet/motion/arms_forward.h"
 #include "duet/motion/device_points.h"
 
 namespace duet::app {
@@ -53,6 +54,20 @@ std::optional<std::string> head_height_note(const Clip& points, const JointRoles
                                             const DevicePointOffsets& offsets);
 // Errors when --head-height is given (metres > 0) for a follower that does not see three points.
 Status check_head_height_applies(double metres, InputPoints points);
+// --calibration FILE: a recording of the user standing straight with both arms held straight
+// forward (arms_forward.h): the body's calibration for three points.
+CLI::Option* add_calibration_option(CLI::App& app, std::string& path);
+struct BodyCalibration {
+  double head_height_m = 0.0;  // the head joint's median height: standing straight
+  ArmsForward arms_forward;
+};
+// Reads it: a three-point recording (the device offsets `cm` taken out, as from the input) or a
+// full-body motion (its head and wrists). Errors name the file and what is wrong with the pose.
+Result<BodyCalibration> read_body_calibration(const std::string& path,
+                                              const std::vector<double>& device_offsets_cm);
+// Errors when --calibration is given for a follower that does not see three points.
+Status check_calibration_applies(const std::string& path, InputPoints points);
+
 // Takes the offsets `cm` out of `motion`, a recording of three points as the devices reported
 // them (its units from metres_per_unit). Errors when the motion is not three points (a full body,
 // or three points made from one, are at the joints already).

@@ -108,8 +108,12 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
   ReplayTracker* replay_ptr = replay.get();  // owned by the loop below
   // LiveLoop shares its library; this one is the caller's and outlives the loop (no owner).
   const std::shared_ptr<const DuetLibrary> shared(std::shared_ptr<const DuetLibrary>(), &library);
-  const SourceSkeleton user{performance.motion.skeleton_ptr(), performance.roles, 1.0,
-                            performance.motion.frame_rate(), performance.told_head_height_m};
+  const SourceSkeleton user{performance.motion.skeleton_ptr(),
+                            performance.roles,
+                            1.0,
+                            performance.motion.frame_rate(),
+                            performance.told_head_height_m,
+                            performance.told_arms_forward};
   Result<LiveLoop> created = LiveLoop::create(shared, user, std::move(replay), configs[0].params);
   if (!created) return Error{"partner metrics: " + created.error().message};
   LiveLoop& loop = created.value();

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "duet/math/rotation.h"
+#include "duet/motion/arms_forward.h"
 #include "duet/motion/forward_kinematics.h"
 #include "duet/motion/head_hands.h"
 #include "duet/motion/limits.h"
@@ -540,6 +541,7 @@ Performance with_frame_loss(Performance performance, const FrameLossOptions& opt
   out.roles = performance.roles;
   out.template_rate_hz = performance.template_rate_hz;
   out.told_head_height_m = performance.told_head_height_m;
+  out.told_arms_forward = performance.told_arms_forward;
   const Clip& motion = performance.motion;
   out.motion = Clip(motion.skeleton_ptr(), motion.frame_rate(), static_cast<int>(kept.size()));
   bool carry_jump = false;
@@ -716,6 +718,16 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     if (recipe.told_head_height_factor > 0.0) {
       performance.told_head_height_m =
           recipe.told_head_height_factor * highest_head_m(performance.motion, performance.roles);
+    }
+    if (recipe.tell_arms_forward) {
+      constexpr int kStride = 10;  // a median over every 10th frame
+      Result<ArmsForward> arms =
+          arms_forward_of_body(performance.motion, performance.roles, kStride);
+      if (!arms) return arms.error();
+      const Vec3& error = recipe.told_arms_forward_error;
+      arms.value().wrists[0] += error;
+      arms.value().wrists[1] += Vec3(-error.x(), error.y(), error.z());
+      performance.told_arms_forward = arms.value();
     }
     PointNoiseOptions options = recipe.point_noise;
     options.seed = derive_seed(seed, 14);

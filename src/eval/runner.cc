@@ -405,6 +405,7 @@ Result<std::vector<FrameEstimate>> follow_performance(const DuetLibrary& library
   if (!created) return created.error();
   FollowSession& session = created.value();
   if (Status s = session.set_head_height(performance.told_head_height_m); !s) return s.error();
+  if (Status s = session.set_arms_forward(performance.told_arms_forward); !s) return s.error();
   std::vector<FrameEstimate> estimates;
   estimates.reserve(static_cast<std::size_t>(performance.frame_count()));
   for (int f = 0; f < performance.frame_count(); ++f) {

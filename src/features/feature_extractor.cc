@@ -176,8 +176,8 @@ FeatureExtractor::Context::Sample FeatureExtractor::extract_head_hands(
   auto put = [&](const Vec3& v) {
     for (int k = 0; k < 3; ++k) out[d++] = static_cast<float>(v[k]);
   };
-  put(to_heading * (now.effectors[0] - head) * per_height);
-  put(to_heading * (now.effectors[1] - head) * per_height);
+  put(to_heading * (now.effectors[0] - head) * per_height - context.hand_offsets_[0]);
+  put(to_heading * (now.effectors[1] - head) * per_height - context.hand_offsets_[1]);
   out[d++] = static_cast<float>(head.y() * per_height);
   if (spec_.head_tilt) put(to_heading * (head_canonical * Vec3::UnitY()));  // nod and roll
 

@@ -68,6 +68,7 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
   DuetLibrary library;
   library.options_ = options;
   std::vector<FeatureMatrix> raw_features;
+  std::vector<ArmsForward> template_arms;  // three points: per take
   int total_frames = 0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const PairFiles& pair = pairs[k];
@@ -108,6 +109,12 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
       Result<Quat> head = head_correction(take.template_motion.clip, take.template_motion.roles);
       if (!head) return Error{what + ": " + head.error().message};
       extractor.value().set_head_correction(head.value());
+      // Every 10th frame: a median of places the collar bones and the head barely move.
+      constexpr int kArmsStride = 10;
+      Result<ArmsForward> arms =
+          arms_forward_of_body(take.template_motion.clip, take.template_motion.roles, kArmsStride);
+      if (!arms) return Error{what + ": " + arms.error().message};
+      template_arms.push_back(arms.value());
     }
     raw_features.push_back(extractor.value().extract_clip(take.template_motion.clip));
     total_frames += take.template_motion.clip.frame_count();
@@ -123,6 +130,7 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
     all.middleRows(first, raw_features[k].rows()) = raw_features[k];
     take_start.push_back(first);
   }
+  if (!template_arms.empty()) library.template_arms_forward_ = median_arms_forward(template_arms);
   library.normalizer_ = FeatureNormalizer::fit(all, options.features);
   library.normalizer_.apply(all);
   // The feature vector ends with its velocity blocks (root velocity, effector speed).

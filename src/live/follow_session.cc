@@ -105,6 +105,23 @@ Status FollowSession::set_head_height(double head_height_m) {
   return Ok{};
 }
 
+Status FollowSession::set_arms_forward(const std::optional<ArmsForward>& arms_forward) {
+  std::array<Vec3, 2> offsets{Vec3::Zero(), Vec3::Zero()};
+  if (arms_forward) {
+    if (std::string problem = arms_forward->check(); !problem.empty()) {
+      return Error{"arms held forward: " + problem};
+    }
+    const ArmsForward& library_pose = library_->template_arms_forward();
+    for (std::size_t side = 0; side < 2; ++side) {
+      offsets[side] = arms_forward->wrists[side] - library_pose.wrists[side];
+    }
+  }
+  // A full-body library's features have no hand places: the offsets stay unused.
+  context_.set_hand_offsets(offsets);
+  arms_forward_ = arms_forward;
+  return Ok{};
+}
+
 void FollowSession::reset() noexcept {
   context_.reset();
   tracker_->reset();

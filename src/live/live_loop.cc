@@ -77,6 +77,7 @@ Result<LiveLoop> LiveLoop::create(std::shared_ptr<const DuetLibrary> library,
       FollowSession::create(*library, user.skeleton, user.roles, std::move(tracker));
   if (!session) return session.error();
   if (Status s = session.value().set_head_height(user.head_height_m); !s) return s.error();
+  if (Status s = session.value().set_arms_forward(user.arms_forward); !s) return s.error();
   std::vector<HeadHandsBody> head_hands_bodies;
   if (is_head_hands_input(user.roles)) {
     for (const DuetTake& take : library->takes()) {
@@ -155,6 +156,10 @@ std::shared_ptr<const Skeleton> LiveLoop::partner_skeleton() const noexcept {
 
 Status LiveLoop::set_head_height(double head_height_m) {
   return session_.set_head_height(head_height_m);
+}
+
+Status LiveLoop::set_arms_forward(const std::optional<ArmsForward>& arms_forward) {
+  return session_.set_arms_forward(arms_forward);
 }
 
 bool LiveLoop::set_correction(std::string_view name, bool enabled) noexcept {

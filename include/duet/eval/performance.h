@@ -20,12 +20,14 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "duet/base/result.h"
 #include "duet/math/types.h"
+#include "duet/motion/arms_forward.h"
 #include "duet/motion/clip.h"
 #include "duet/motion/head_hands.h"
 #include "duet/motion/skeleton_map.h"
@@ -59,6 +61,8 @@ struct Performance {
   // The head height standing the follower is told (SourceSkeleton::head_height_m), metres; 0:
   // none.
   double told_head_height_m = 0.0;
+  // The body calibration the follower is told (SourceSkeleton::arms_forward); nullopt: none.
+  std::optional<ArmsForward> told_arms_forward = std::nullopt;
 
   int frame_count() const { return motion.frame_count(); }
 };
@@ -249,6 +253,12 @@ struct PerformanceRecipe {
   // the performance before it is reduced to points: a height calibration) times this (1.05: one
   // 5 % off), Performance::told_head_height_m; 0: not told.
   double told_head_height_factor = 0.0;
+  // Three points: the follower is told where the performer's wrists are with both arms held
+  // straight forward (arms_forward_of_body of the performance on its rig: a body calibration),
+  // each wrist moved by told_arms_forward_error (head heights; x outwards, y up, z forward: a
+  // calibration pose held wider, higher or further), Performance::told_arms_forward.
+  bool tell_arms_forward = false;
+  Vec3 told_arms_forward_error = Vec3::Zero();
   FrameLossOptions loss;  // seed ignored
 };
 

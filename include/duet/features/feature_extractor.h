@@ -40,6 +40,12 @@ class FeatureExtractor {
     double head_height_m() const noexcept {
       return head_height_known_m_ > 0.0 ? head_height_known_m_ : head_height_max_m_;
     }
+    // Head and hands: where the user's body holds each hand (left, right) against where the
+    // template dancers' hold it in the same pose, in head heights in the heading frame (x left,
+    // y up, z forward): taken off the hands' places (arms_forward.h). Zero (the default): none.
+    // Kept across reset().
+    void set_hand_offsets(const std::array<Vec3, 2>& offsets) noexcept { hand_offsets_ = offsets; }
+    const std::array<Vec3, 2>& hand_offsets() const noexcept { return hand_offsets_; }
 
    private:
     friend class FeatureExtractor;
@@ -57,6 +63,7 @@ class FeatureExtractor {
     // headset says nothing of the body's size.
     double head_height_max_m_ = 0.0;
     double head_height_known_m_ = 0.0;  // set_head_height; 0: learnt
+    std::array<Vec3, 2> hand_offsets_{Vec3::Zero(), Vec3::Zero()};  // set_hand_offsets
     std::vector<Vec3> positions_ws_;
     std::vector<Quat> rotations_ws_;
   };

@@ -16,6 +16,7 @@
 #include "duet/follow/synthetic_library.h"
 #include "duet/follow/template_model.h"
 #include "duet/io/motion_file.h"
+#include "duet/motion/arms_forward.h"
 
 namespace duet {
 
@@ -96,6 +97,11 @@ class DuetLibrary {
   // then rebuilt.
   const std::string& model_cache_note() const { return model_cache_note_; }
 
+  // Three points: where the template dancers' wrists are with both arms held straight forward
+  // (arms_forward_of_body, per coordinate the median over takes), which a user's calibration is
+  // measured against (FollowSession::set_arms_forward). Zero for full-body features.
+  const ArmsForward& template_arms_forward() const { return template_arms_forward_; }
+
   // An extractor for a user whose motion uses `skeleton` (any convention with the needed
   // roles); its raw output is standardised with normalizer().
   Result<FeatureExtractor> make_extractor(std::shared_ptr<const Skeleton> skeleton,
@@ -116,6 +122,7 @@ class DuetLibrary {
   std::vector<SyntheticTakeSource> copy_sources_;
   std::shared_ptr<const JumpCandidateIndex> candidate_index_;
   std::string model_cache_note_;
+  ArmsForward template_arms_forward_;
 };
 
 }  // namespace duet

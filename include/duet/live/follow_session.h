@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -46,6 +47,16 @@ class FollowSession {
   double known_head_height_m() const noexcept { return context_.known_head_height_m(); }
   double head_height_m() const noexcept { return context_.head_height_m(); }
 
+  // Three points: where the user's wrists are with both arms held straight forward (a body
+  // calibration, arms_forward.h). Its difference from the template dancers'
+  // (DuetLibrary::template_arms_forward) is the user's body holding every hand elsewhere (wider
+  // shoulders, a head further forward), taken off the hands' places
+  // (FeatureExtractor::Context::set_hand_offsets); nullopt, the default, takes the hands as they
+  // come. The full-body follower ignores it. Errors, and nothing changes, for a pose that
+  // ArmsForward::check refuses.
+  Status set_arms_forward(const std::optional<ArmsForward>& arms_forward);
+  const std::optional<ArmsForward>& arms_forward() const noexcept { return arms_forward_; }
+
   // The standardised features of the last frame, after the rig's posture offset was removed.
   std::span<const float> last_features() const { return features_; }
   const PostureBias& posture_bias() const { return bias_; }
@@ -63,6 +74,7 @@ class FollowSession {
   std::unique_ptr<Tracker> tracker_;
   std::vector<float> features_;
   PostureBias bias_;  // the user's rig's posture offset, learnt online
+  std::optional<ArmsForward> arms_forward_;  // set_arms_forward
   RepeatedFrameDetector repeats_;
   double previous_time_s_ = 0.0;
   bool has_previous_ = false;

@@ -76,6 +76,13 @@ class LiveLoop {
   // FollowSession::kHeadHeightRangeM. Call between steps, as the other setters.
   Status set_head_height(double head_height_m);
   double head_height_m() const noexcept { return session_.known_head_height_m(); }
+  // Three points: where the user's wrists are with both arms held straight forward
+  // (SourceSkeleton::arms_forward); nullopt forgets it. Errors, and nothing changes, for a pose
+  // FollowSession::set_arms_forward refuses.
+  Status set_arms_forward(const std::optional<ArmsForward>& arms_forward);
+  const std::optional<ArmsForward>& arms_forward() const noexcept {
+    return session_.arms_forward();
+  }
   // Switch a correction (protocol name); false for an unknown name.
   bool set_correction(std::string_view name, bool enabled) noexcept;
   void set_params(const PartnerParams& params) noexcept { params_ = params; }

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "duet/motion/arms_forward.h"
 #include "duet/motion/skeleton.h"
 #include "duet/motion/skeleton_map.h"
 
@@ -30,6 +31,9 @@ struct SourceSkeleton {
   // straight, when a height calibration gave it (a headset says nothing of the body's size); 0:
   // learnt from the input (FollowSession::set_head_height).
   double head_height_m = 0.0;
+  // Three points: where the user's wrists are with both arms held straight forward, when a body
+  // calibration gave it (FollowSession::set_arms_forward); nullopt: the hands as they come.
+  std::optional<ArmsForward> arms_forward = std::nullopt;
 
   int joint_count() const { return skeleton ? skeleton->joint_count() : 0; }
 };
