@@ -42,6 +42,7 @@ struct ServeArgs {
   std::string input_points;  // "", "full" or "head,hands"
   std::vector<double> device_offsets_cm;  // empty: typical_headset_offsets for xr, else none
   double head_height_m = 0.0;  // the head point's height standing (--head-height); 0: learnt
+  std::string calibration_path;  // --calibration: standing with both arms held forward
   std::string http = "127.0.0.1:8080";
   std::optional<std::string> token;
   std::string web;
@@ -308,6 +309,23 @@ int run_serve(const ServeArgs& args) {
     fail(s.error().message);
     return kExitUsage;
   }
+  if (Status s = check_calibration_applies(args.calibration_path, points.value()); !s) {
+    fail(s.error().message);
+    return kExitUsage;
+  }
+  std::optional<BodyCalibration> calibration;
+  if (!args.calibration_path.empty()) {
+    // A replayed recording's offsets come out of it too; a headset's recording (duet serve
+    // --source xr --record) is at the joints already.
+    Result<BodyCalibration> read = read_body_calibration(
+        args.calibration_path,
+        spec.value().kind == SourceKind::kReplay ? args.device_offsets_cm : std::vector<double>{});
+    if (!read) {
+      fail(read.error().message);
+      return kExitFailure;
+    }
+    calibration = read.value();
+  }
   FeatureSpec features;
   features.input_points = points.value();
   std::optional<DuetLibrary> loaded = load_library(args.library, "serve", features);
@@ -322,6 +340,10 @@ int run_serve(const ServeArgs& args) {
   SourceSkeleton user = source.value()->source_skeleton();
   user.head_height_m =
       head_joint_height_m(args.head_height_m, taken_out_offsets(spec.value().kind, args));
+  if (calibration) {
+    if (args.head_height_m == 0.0) user.head_height_m = calibration->head_height_m;
+    user.arms_forward = calibration->arms_forward;
+  }
 
   const PartnerParams params = make_partner_params(args.partner);
   Result<std::unique_ptr<LiveLoop>> loop = make_loop(library, args.tracker, user, params);
@@ -431,6 +453,7 @@ Command register_serve(CLI::App& app) {
   app.add_option("--input-points", args->input_points, kInputPointsHelp)
       ->check(input_points_choice(true));
   add_head_height_option(app, args->head_height_m);
+  add_calibration_option(app, args->calibration_path);
   add_device_offsets_option(app, args->device_offsets_cm,
                             "Taken out before following: --source xr default 6,6,7 (a typical "
                             "headset user; 0,0,0 leaves the points as sent), a replayed "

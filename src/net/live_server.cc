@@ -361,6 +361,9 @@ struct LiveServer::Impl {
       case ClientMessage::Type::kHeadHeight:
         set_head_height(id);
         return;
+      case ClientMessage::Type::kArmsForward:
+        set_arms_forward(id);
+        return;
     }
   }
 
@@ -381,6 +384,43 @@ struct LiveServer::Impl {
             ? fmt::format("the headset's height standing: {:.2f} m (the user's size from it)",
                           message.head_height_m)
             : std::string("the user's size is learnt again from the highest the head has been"));
+  }
+
+  // A body calibration from the headset (the viewer: both grips held while standing straight with
+  // both arms held straight forward): where the latest pose holds the wrists (joints, the device
+  // offsets taken out), in the calibrated head height or else the head's height now. Kept across
+  // a role switch.
+  void set_arms_forward(ClientId id) {
+    if (device_offsets_or_null() == nullptr) {
+      reject(id, "arms_forward messages are for the headset source (duet serve --source xr)");
+      return;
+    }
+    if (message.forget_arms_forward) {
+      (void)loop->set_arms_forward(std::nullopt);
+      log("the body calibration is forgotten: the hands are taken as they come");
+      return;
+    }
+    if (frames == 0) {
+      reject(id, "arms_forward: no pose from the headset yet (send xr_pose first)");
+      return;
+    }
+    Clip latest(source->source_skeleton().skeleton, 1.0, 1);
+    std::ranges::copy(frame.translations_ls, latest.translations_ls(0).begin());
+    std::ranges::copy(frame.rotations_ls, latest.rotations_ls(0).begin());
+    Result<ArmsForward> arms = arms_forward_of_points(latest, loop->head_height_m());
+    if (!arms) {
+      reject(id, arms.error().message);
+      return;
+    }
+    if (Status s = loop->set_arms_forward(arms.value()); !s) {
+      reject(id, s.error().message);
+      return;
+    }
+    const ArmsForward& held = arms.value();
+    log(fmt::format(
+        "arms held forward: the wrists {:.2f} head heights apart, {:.2f} in front of "
+        "the head (the body's calibration)",
+        held.wrists[0].x() - held.wrists[1].x(), 0.5 * (held.wrists[0].z() + held.wrists[1].z())));
   }
 
   // Pause, seek, speed of a file replay; every client sees the new state.
@@ -505,6 +545,7 @@ struct LiveServer::Impl {
     other_loop->set_params(loop->params());
     // In range: this loop took it.
     (void)other_loop->set_head_height(loop->head_height_m());
+    (void)other_loop->set_arms_forward(loop->arms_forward());
     other_loop->reset();
     std::swap(loop, other_loop);
     std::swap(hello, other_hello);

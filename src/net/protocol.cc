@@ -387,6 +387,15 @@ std::optional<std::string> parse_client_message(std::string_view text, ClientMes
     message.head_height_m = value;
     return std::nullopt;
   }
+  if (type == "arms_forward") {
+    message.type = ClientMessage::Type::kArmsForward;
+    message.forget_arms_forward = false;
+    if (const auto forget = doc.find("forget"); forget != doc.end()) {
+      if (!forget->is_boolean()) return "arms_forward: \"forget\" must be true or false";
+      message.forget_arms_forward = forget->get<bool>();
+    }
+    return std::nullopt;
+  }
   if (type == "pose") {
     message.type = ClientMessage::Type::kPose;
     message.time_s = std::nan("");

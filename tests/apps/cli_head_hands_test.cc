@@ -13,6 +13,8 @@
 #include "apps/run_command.h"
 #include "duet/io/motion_file.h"
 #include "duet/io/points_csv.h"
+#include "duet/math/rotation.h"
+#include "duet/motion/arms_forward.h"
 #include "duet/motion/head_hands.h"
 
 namespace duet::testing {
@@ -244,6 +246,87 @@ TEST(CliHeadHands, AHeadHeightIsForThreePoints) {
       << serve.output;
   std::filesystem::remove(csv);
   std::filesystem::remove(trace);
+}
+
+// The share of a trace's frames on take `take` within 6 frames (100 ms) of frame f.
+double share_on_take(const std::string& trace, int take) {
+  const auto places = traced_places(trace);
+  int right = 0;
+  for (std::size_t f = 0; f < places.size(); ++f) {
+    right += places[f].first == take && std::abs(places[f].second - static_cast<int>(f)) <= 6;
+  }
+  return places.empty() ? 0.0 : static_cast<double>(right) / static_cast<double>(places.size());
+}
+
+TEST(CliHeadHands, ACalibrationFollowsAnotherBodyAsTheLibrarysOwn) {
+  // Take 60_10 on the CMU handshake rig of 18_01 (wider shoulders, the head further forward of
+  // the hands), recorded as three points; its calibration file is that body standing with both
+  // arms held straight forward, as a headset would record it (looking along -Z).
+  const std::string rig = temp("rig.bvh"), csv = temp("rig.csv"), pose = temp("pose.csv");
+  const std::string untold_trace = temp("untold.csv"), told_trace = temp("told.csv");
+  ASSERT_EQ(run_duet("retarget " + data_path("cmu-salsa/bvh/60/60_10_scaled.bvh") +
+                     " --fps 60 --rig " + data_path("cmu-handshake/18_01.bvh") + " -o " + rig)
+                .exit_code,
+            0);
+  ASSERT_EQ(run_duet("convert " + rig + " --points head,hands -o " + csv).exit_code, 0);
+  Result<LoadedMotion> body = load_motion({rig}, MotionLoadOptions{});
+  ASSERT_TRUE(body) << body.error().message;
+  Result<ArmsForward> arms = arms_forward_of_body(body.value().clip, body.value().roles, 10);
+  ASSERT_TRUE(arms) << arms.error().message;
+  const double head_m = highest_head_m(body.value().clip, body.value().roles);
+  Clip held(make_head_hands_skeleton(), 60.0, 30);
+  for (int f = 0; f < held.frame_count(); ++f) {
+    held.translations_ls(f)[kPointsHead] = Vec3(0.0, head_m, 0.0);
+    for (int side = 0; side < 2; ++side) {
+      const Vec3& w = arms.value().wrists[static_cast<std::size_t>(side)];
+      // Facing -Z, the body's left is -X and its forward -Z.
+      held.translations_ls(f)[kPointsLeftHand + side] =
+          Vec3(-w.x(), w.y(), -w.z()) * head_m + Vec3(0.0, head_m, 0.0);
+    }
+  }
+  {
+    std::ofstream out(pose);
+    out << format_points_csv(held);
+  }
+  CommandResult untold =
+      run_duet("follow --library " + kSalsaLibrary + " --input " + csv + " --head-height " +
+               fmt::format("{:.3f}", head_m) + " --trace " + untold_trace);
+  ASSERT_EQ(untold.exit_code, 0) << untold.output;
+  CommandResult told = run_duet("follow --library " + kSalsaLibrary + " --input " + csv +
+                                " --calibration " + pose + " --trace " + told_trace);
+  ASSERT_EQ(told.exit_code, 0) << told.output;
+  EXPECT_NE(told.output.find(fmt::format("head {:.2f} m high standing", head_m)), std::string::npos)
+      << told.output;
+  const double untold_share = share_on_take(untold_trace, 8);  // 60_10
+  const double told_share = share_on_take(told_trace, 8);
+  EXPECT_GT(told_share, 0.98) << "untold " << untold_share;
+  EXPECT_LT(untold_share, told_share - 0.03);
+
+  // Arms down is no calibration; a full body is not calibrated this way.
+  Clip down = held;
+  for (int f = 0; f < down.frame_count(); ++f) {
+    for (int side = 0; side < 2; ++side) {
+      Vec3& hand = down.translations_ls(f)[kPointsLeftHand + side];
+      hand = Vec3(hand.x(), 0.55 * head_m, -0.05);
+    }
+  }
+  {
+    std::ofstream out(pose);
+    out << format_points_csv(down);
+  }
+  CommandResult refused =
+      run_duet("follow --library " + kSalsaLibrary + " --input " + csv + " --calibration " + pose);
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.output.find("--calibration: " + pose), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("in front of the head"), std::string::npos) << refused.output;
+  CommandResult full_body =
+      run_duet("follow --library " + kSalsaLibrary + " --input " + rig + " --calibration " + pose);
+  EXPECT_EQ(full_body.exit_code, 2);
+  EXPECT_NE(full_body.output.find("--calibration applies to three points"), std::string::npos)
+      << full_body.output;
+  for (const std::string& path : {rig, csv, pose, untold_trace, told_trace}) {
+    std::filesystem::remove(path);
+  }
 }
 
 }  // namespace

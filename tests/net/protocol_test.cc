@@ -30,6 +30,11 @@ TEST(Protocol, ParsesControlMessages) {
   EXPECT_DOUBLE_EQ(m.head_height_m, 1.62);
   EXPECT_FALSE(parse(R"({"type": "head_height", "metres": 0})", m));  // learn it again
   EXPECT_EQ(m.head_height_m, 0.0);
+  EXPECT_FALSE(parse(R"({"type": "arms_forward"})", m));
+  EXPECT_EQ(m.type, ClientMessage::Type::kArmsForward);
+  EXPECT_FALSE(m.forget_arms_forward);
+  EXPECT_FALSE(parse(R"({"type": "arms_forward", "forget": true})", m));
+  EXPECT_TRUE(m.forget_arms_forward);
 }
 
 TEST(Protocol, ParsesPoses) {
@@ -74,6 +79,7 @@ TEST(Protocol, RejectsWithAReason) {
       R"({"type": "head_height", "metres": 162})",  // centimetres
       R"({"type": "head_height", "metres": -1.6})",
       R"({"type": "head_height", "metres": 0.3})",
+      R"({"type": "arms_forward", "forget": 1})",
   };
   for (const char* text : bad) {
     const std::optional<std::string> reason = parse(text, m);

@@ -121,6 +121,35 @@ TEST(ServeXr, AHeadsetIsFollowedAndThePartnerStandsInFront) {
             std::string::npos)
       << server.log();
 
+  // A body calibration: the latest pose, arms held forward, is taken (logged); arms down, it is
+  // refused with the reason; "forget" drops it.
+  auto still_pose = [&](double hands_y, double hands_z) {
+    const Json identity = {1, 0, 0, 0};
+    return Json{{"type", "xr_pose"},
+                {"head", {{"position", {0.0, 1.6, 0.0}}, {"orientation", identity}}},
+                {"left", {{"position", {-0.18, hands_y, hands_z}}, {"orientation", identity}}},
+                {"right", {{"position", {0.18, hands_y, hands_z}}, {"orientation", identity}}}}
+        .dump();
+  };
+  ASSERT_TRUE(dancer.write(still_pose(1.38, -0.55)));  // the headset looks along -Z
+  ASSERT_TRUE(dancer.read_type("frame"));
+  ASSERT_TRUE(dancer.write(R"({"type": "arms_forward"})"));
+  ASSERT_TRUE(dancer.write(still_pose(0.85, -0.05)));
+  ASSERT_TRUE(dancer.read_type("frame"));
+  ASSERT_TRUE(dancer.write(R"({"type": "arms_forward"})"));
+  const std::optional<Json> arms_down = dancer.read_type("error");
+  ASSERT_TRUE(arms_down) << server.log();
+  EXPECT_NE((*arms_down)["reason"].get<std::string>().find("in front of the head"),
+            std::string::npos)
+      << *arms_down;
+  EXPECT_NE(server.log().find("arms held forward: the wrists 0.2"), std::string::npos)
+      << server.log();  // 0.36 m apart in a head height of about 1.5 m
+  ASSERT_TRUE(dancer.write(R"({"type": "arms_forward", "forget": true})"));
+  ASSERT_TRUE(dancer.write(R"({"type": "arms_forward", "forget": "yes"})"));
+  ASSERT_TRUE(dancer.read_type("error"));
+  EXPECT_NE(server.log().find("the body calibration is forgotten"), std::string::npos)
+      << server.log();
+
   // A full-body pose is refused by the headset source, and the next xr_pose is accepted.
   ASSERT_TRUE(dancer.write(R"({"type": "pose", "root": [0, 1, 0], "rotations": []})"));
   ASSERT_TRUE(dancer.read_type("error"));
@@ -162,6 +191,13 @@ TEST(ServeXr, ReplaysAThreePointRecording) {
   EXPECT_NE((*refused)["reason"].get<std::string>().find("for the headset source"),
             std::string::npos)
       << *refused;
+  ASSERT_TRUE(viewer.write(R"({"type": "arms_forward"})"));
+  const std::optional<Json> no_arms = viewer.read_type("error");
+  ASSERT_TRUE(no_arms) << server.log();
+  EXPECT_NE((*no_arms)["reason"].get<std::string>().find("arms_forward messages are for the "
+                                                         "headset source"),
+            std::string::npos)
+      << *no_arms;
   std::optional<Json> last;
   for (std::optional<Json> frame; (frame = viewer.read_type("frame"));) last = frame;
   ASSERT_TRUE(last) << server.log();

@@ -1,7 +1,9 @@
 // A height calibration in VR (docs/protocol.md, `head_height`): standing straight, the user
 // holds both controllers' grip buttons for a second, and the headset's height goes to the server,
 // which then knows the user's size from the first step instead of learning it from the highest
-// the head has been (a dance that starts low fools that for its first seconds).
+// the head has been (a dance that starts low fools that for its first seconds). Held with both
+// arms straight forward, the same hold also calibrates the body (`arms_forward`): where this body
+// holds its hands, which another body's shoulders and head place differently.
 
 /** How long both grips must be held, so a grab in the dance does not calibrate. */
 export const kCalibrationHold_ms = 1000;
@@ -23,6 +25,32 @@ export function bothGripsSqueezed(session) {
   return left && right;
 }
 
+/**
+ * Whether an `xr_pose` message (docs/protocol.md) shows both arms held forward: each grip at
+ * least 0.3 m in front of the headset along where it looks, between 0.6 m below and 0.15 m above
+ * it. The server checks the pose again (in head heights); this keeps a height-only calibration,
+ * arms down, from asking for one.
+ */
+export function armsHeldForward(pose) {
+  const [w, x, y, z] = pose?.head?.orientation ?? [];
+  const head = pose?.head?.position;
+  if (![w, x, y, z].every(Number.isFinite) || !head) return false;
+  // The headset looks along -Z of its orientation: that axis in the room, made level.
+  let fx = -2 * (x * z + w * y);
+  let fz = -(1 - 2 * (x * x + y * y));
+  const length = Math.hypot(fx, fz);
+  if (!(length > 1e-6)) return false;
+  fx /= length;
+  fz /= length;
+  for (const hand of [pose.left?.position, pose.right?.position]) {
+    if (!hand || !hand.every(Number.isFinite)) return false;
+    const ahead = (hand[0] - head[0]) * fx + (hand[2] - head[2]) * fz;
+    const rise = hand[1] - head[1];
+    if (!(ahead >= 0.3 && rise >= -0.6 && rise <= 0.15)) return false;
+  }
+  return true;
+}
+
 /** A short buzz in both controllers: the calibration was sent. Headsets without haptics: none. */
 function buzz(session) {
   for (const source of session?.inputSources ?? []) {
@@ -38,14 +66,16 @@ export class HeightCalibration {
     this.heldSince_ms = null; // when both grips went down, null while not both held
     this.doneThisHold = false; // one calibration per hold
     this.sent_m = null; // the last height sent, for the status line
+    this.armsSent = false; // an arms_forward went with the last height
   }
 
   /**
    * One XR frame: `time_ms` the frame's time, `headHeight_m` the viewer pose's height above the
-   * floor (local-floor space), `session` the XRSession (for the grips and the buzz). Returns the
-   * height sent this frame, or null.
+   * floor (local-floor space), `session` the XRSession (for the grips and the buzz), `pose` the
+   * `xr_pose` just sent (optional: with arms held forward in it, an `arms_forward` follows the
+   * height). Returns the height sent this frame, or null.
    */
-  update(time_ms, headHeight_m, session) {
+  update(time_ms, headHeight_m, session, pose = null) {
     if (!bothGripsSqueezed(session)) {
       this.heldSince_ms = null;
       this.doneThisHold = false;
@@ -59,6 +89,8 @@ export class HeightCalibration {
     if (!(headHeight_m >= low && headHeight_m <= high)) return null;
     if (!this.connection.send({ type: 'head_height', metres: headHeight_m })) return null;
     this.sent_m = headHeight_m;
+    // After the height: the server measures the arms in it.
+    this.armsSent = armsHeldForward(pose) && this.connection.send({ type: 'arms_forward' });
     buzz(session);
     return headHeight_m;
   }

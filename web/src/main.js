@@ -534,7 +534,7 @@ async function main() {
   renderer.setAnimationLoop((time_ms, xr_frame) => {
     if (xr_frame && headsetIsSource() && renderer.xr.isPresenting) {
       const sent = xr_sender.send(time_ms, xr_frame, renderer.xr.getReferenceSpace());
-      if (sent) height_calibration.update(time_ms, sent.head.position[1], xr_frame.session);
+      if (sent) height_calibration.update(time_ms, sent.head.position[1], xr_frame.session, sent);
       xr_frame_hook?.(time_ms, sent);
     }
     const now = performance.now();
@@ -591,6 +591,7 @@ async function main() {
     get xrPoses() { return { sent: xr_sender.sent, skipped: xr_sender.skipped }; },
     /** The last height calibration sent (head_height, metres), null before any. */
     get headHeightSent() { return height_calibration.sent_m; },
+    get armsForwardSent() { return height_calibration.armsSent; },
     /** Calls `fn(time_ms, sent)` after each XR frame on a headset source (null: stop). */
     setXRFrameHook(fn) { xr_frame_hook = typeof fn === 'function' ? fn : null; },
     /** In VR, the partner as the headset's left eye sees it: its hips in normalized device

@@ -4,7 +4,7 @@
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
-import { HeightCalibration, bothGripsSqueezed, kCalibrationHold_ms } from '../src/height_calibration.js';
+import { HeightCalibration, armsHeldForward, bothGripsSqueezed, kCalibrationHold_ms } from '../src/height_calibration.js';
 
 /** A session whose left and right grips are pressed as given; pulses are counted. */
 function fakeSession(left, right, pulses = []) {
@@ -63,4 +63,45 @@ test('a hold broken before the second sends nothing; a height out of range is no
   assert.equal(sitting.update(kCalibrationHold_ms, 0.4, fakeSession(true, true)), null);
   assert.equal(connection.messages.length, 0);
   assert.equal(sitting.sent_m, null);
+});
+
+/** An xr_pose with the headset at 1.6 m looking along -Z (identity) and the grips where given. */
+function pose(left, right, orientation = [1, 0, 0, 0]) {
+  return {
+    type: 'xr_pose',
+    head: { position: [0, 1.6, 0], orientation },
+    left: { position: left, orientation: [1, 0, 0, 0] },
+    right: { position: right, orientation: [1, 0, 0, 0] },
+  };
+}
+
+test('arms held forward are told from arms down, whichever way the headset looks', () => {
+  assert.equal(armsHeldForward(pose([-0.18, 1.4, -0.55], [0.18, 1.4, -0.55])), true);
+  assert.equal(armsHeldForward(pose([-0.25, 0.85, -0.05], [0.25, 0.85, -0.05])), false); // down
+  assert.equal(armsHeldForward(pose([-0.18, 1.4, -0.55], [0.25, 0.85, -0.05])), false); // one
+  assert.equal(armsHeldForward(pose([-0.18, 1.95, -0.4], [0.18, 1.95, -0.4])), false); // up
+  // Turned a quarter left (about +Y): ahead is -X in the room.
+  const quarter = [Math.SQRT1_2, 0, Math.SQRT1_2, 0];
+  assert.equal(armsHeldForward(pose([-0.55, 1.4, 0.18], [-0.55, 1.4, -0.18], quarter)), true);
+  assert.equal(armsHeldForward(pose([-0.18, 1.4, -0.55], [0.18, 1.4, -0.55], quarter)), false);
+  assert.equal(armsHeldForward(null), false);
+  assert.equal(armsHeldForward(pose([NaN, 1.4, -0.55], [0.18, 1.4, -0.55])), false);
+});
+
+test('a hold with the arms forward sends the height, then arms_forward; arms down only the height', () => {
+  const connection = fakeConnection();
+  const calibration = new HeightCalibration(connection);
+  const held = fakeSession(true, true);
+  const forward = pose([-0.18, 1.4, -0.55], [0.18, 1.4, -0.55]);
+  calibration.update(0, 1.6, held, forward);
+  assert.equal(calibration.update(kCalibrationHold_ms, 1.6, held, forward), 1.6);
+  assert.deepEqual(connection.messages, [{ type: 'head_height', metres: 1.6 }, { type: 'arms_forward' }]);
+  assert.equal(calibration.armsSent, true);
+
+  calibration.update(2000, 1.6, fakeSession(false, false));
+  const down = pose([-0.25, 0.85, -0.05], [0.25, 0.85, -0.05]);
+  calibration.update(2100, 1.6, held, down);
+  assert.equal(calibration.update(2100 + kCalibrationHold_ms, 1.6, held, down), 1.6);
+  assert.deepEqual(connection.messages.slice(2), [{ type: 'head_height', metres: 1.6 }]);
+  assert.equal(calibration.armsSent, false);
 });

@@ -69,7 +69,7 @@ std::string make_replay_state(const ReplayState& state);
 
 // What a client asked for.
 struct ClientMessage {
-  enum class Type { kSet, kRole, kReset, kPose, kXrPose, kReplay, kHeadHeight };
+  enum class Type { kSet, kRole, kReset, kPose, kXrPose, kReplay, kHeadHeight, kArmsForward };
   Type type = Type::kReset;
   // set
   std::string correction;
@@ -85,6 +85,9 @@ struct ClientMessage {
   std::array<double, 12> point_orientations{};
   // head_height: the headset's height standing, metres; 0 learns it again
   double head_height_m = 0.0;
+  // arms_forward: true ("forget": true) drops the body calibration; false takes it from the
+  // headset's latest pose
+  bool forget_arms_forward = false;
   // replay: each absent field leaves that setting alone (at least one is present)
   std::optional<bool> replay_paused;
   std::optional<double> replay_seek_s;
