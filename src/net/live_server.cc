@@ -12,7 +12,9 @@
 #include <optional>
 #include <thread>
 
+#include "duet/io/atomic_write.h"
 #include "duet/io/motion_file.h"
+#include "duet/io/points_csv.h"
 #include "duet/live/source_neuron.h"
 #include "duet/live/source_pose.h"
 #include "duet/live/source_replay.h"
@@ -404,9 +406,12 @@ struct LiveServer::Impl {
       reject(id, "arms_forward: no pose from the headset yet (send xr_pose first)");
       return;
     }
-    Clip latest(source->source_skeleton().skeleton, 1.0, 1);
-    std::ranges::copy(frame.translations_ls, latest.translations_ls(0).begin());
-    std::ranges::copy(frame.rotations_ls, latest.rotations_ls(0).begin());
+    // Two frames of the one pose: what a three-point CSV holds at least, should it be recorded.
+    Clip latest(source->source_skeleton().skeleton, source->source_skeleton().frame_rate, 2);
+    for (int f = 0; f < latest.frame_count(); ++f) {
+      std::ranges::copy(frame.translations_ls, latest.translations_ls(f).begin());
+      std::ranges::copy(frame.rotations_ls, latest.rotations_ls(f).begin());
+    }
     Result<ArmsForward> arms = arms_forward_of_points(latest, loop->head_height_m());
     if (!arms) {
       reject(id, arms.error().message);
@@ -421,6 +426,22 @@ struct LiveServer::Impl {
         "arms held forward: the wrists {:.2f} head heights apart, {:.2f} in front of "
         "the head (the body's calibration)",
         held.wrists[0].x() - held.wrists[1].x(), 0.5 * (held.wrists[0].z() + held.wrists[1].z())));
+    if (recorder) record_calibration(latest);
+  }
+
+  // The calibration pose beside the recording ("<stem>-calibration.csv", a three-point CSV at the
+  // joints, the latest one of the session), so that `duet follow --input <stem>-user.bvh
+  // --calibration <stem>-calibration.csv` follows the recording as it was followed live.
+  void record_calibration(const Clip& held_pose) {
+    std::string path = recorder->user_path();
+    constexpr std::string_view kUserSuffix = "-user.bvh";
+    if (!path.ends_with(kUserSuffix)) return;
+    path.replace(path.size() - kUserSuffix.size(), kUserSuffix.size(), "-calibration.csv");
+    if (Status s = write_file_atomically(path, format_points_csv(held_pose)); !s) {
+      log("the calibration pose was not recorded: " + s.error().message);
+      return;
+    }
+    log("the calibration pose is recorded in " + path);
   }
 
   // Pause, seek, speed of a file replay; every client sees the new state.

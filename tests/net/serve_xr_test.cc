@@ -12,6 +12,7 @@
 #include "duet/eval/performance.h"
 #include "duet/io/motion_file.h"
 #include "duet/io/points_csv.h"
+#include "duet/motion/arms_forward.h"
 #include "duet/motion/head_hands.h"
 #include "serve_support.h"
 
@@ -33,7 +34,7 @@ TEST(ServeXr, AHeadsetIsFollowedAndThePartnerStandsInFront) {
   TempDir dir("duet-serve-xr-test");
   ServeProcess server;
   std::vector<std::string> args = library_args();
-  args.insert(args.end(), {"--source", "xr", "--no-record"});
+  args.insert(args.end(), {"--source", "xr", "--record", (dir.path / "rec").string()});
   ASSERT_TRUE(server.start(args, dir.path / "serve.log")) << server.log();
 
   MotionLoadOptions load;
@@ -144,6 +145,19 @@ TEST(ServeXr, AHeadsetIsFollowedAndThePartnerStandsInFront) {
       << *arms_down;
   EXPECT_NE(server.log().find("arms held forward: the wrists 0.2"), std::string::npos)
       << server.log();  // 0.36 m apart in a head height of about 1.5 m
+  // The pose is recorded beside the session, as duet follow --calibration reads it.
+  std::vector<fs::path> calibrations;
+  for (const auto& entry : fs::directory_iterator(dir.path / "rec")) {
+    if (entry.path().string().ends_with("-calibration.csv")) calibrations.push_back(entry.path());
+  }
+  ASSERT_EQ(calibrations.size(), 1u) << server.log();
+  Result<LoadedMotion> recorded = load_motion({calibrations[0].string()}, MotionLoadOptions{});
+  ASSERT_TRUE(recorded) << recorded.error().message;
+  Result<ArmsForward> recorded_arms = arms_forward_of_points(recorded.value().clip);
+  ASSERT_TRUE(recorded_arms) << recorded_arms.error().message;
+  EXPECT_NEAR((recorded_arms.value().wrists[0] - recorded_arms.value().wrists[1]).x() *
+                  median_head_height(recorded.value().clip),
+              0.36, 0.01);
   ASSERT_TRUE(dancer.write(R"({"type": "arms_forward", "forget": true})"));
   ASSERT_TRUE(dancer.write(R"({"type": "arms_forward", "forget": "yes"})"));
   ASSERT_TRUE(dancer.read_type("error"));
