@@ -51,11 +51,16 @@ export function armsHeldForward(pose) {
   return true;
 }
 
-/** A short buzz in both controllers: the calibration was sent. Headsets without haptics: none. */
-function buzz(session) {
+/**
+ * A buzz in both controllers: the calibration was sent, short for the height alone, long for the
+ * height and the body (arms held forward). Headsets without haptics: none.
+ */
+export const kBuzzHeight_ms = 120;
+export const kBuzzBody_ms = 400;
+function buzz(session, ms) {
   for (const source of session?.inputSources ?? []) {
     const actuator = source.gamepad?.hapticActuators?.[0];
-    if (typeof actuator?.pulse === 'function') actuator.pulse(0.6, 120);
+    if (typeof actuator?.pulse === 'function') actuator.pulse(0.6, ms);
   }
 }
 
@@ -91,7 +96,7 @@ export class HeightCalibration {
     this.sent_m = headHeight_m;
     // After the height: the server measures the arms in it.
     this.armsSent = armsHeldForward(pose) && this.connection.send({ type: 'arms_forward' });
-    buzz(session);
+    buzz(session, this.armsSent ? kBuzzBody_ms : kBuzzHeight_ms);
     return headHeight_m;
   }
 }

@@ -4,7 +4,9 @@
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
-import { HeightCalibration, armsHeldForward, bothGripsSqueezed, kCalibrationHold_ms } from '../src/height_calibration.js';
+import {
+  HeightCalibration, armsHeldForward, bothGripsSqueezed, kBuzzBody_ms, kBuzzHeight_ms, kCalibrationHold_ms,
+} from '../src/height_calibration.js';
 
 /** A session whose left and right grips are pressed as given; pulses are counted. */
 function fakeSession(left, right, pulses = []) {
@@ -91,12 +93,14 @@ test('arms held forward are told from arms down, whichever way the headset looks
 test('a hold with the arms forward sends the height, then arms_forward; arms down only the height', () => {
   const connection = fakeConnection();
   const calibration = new HeightCalibration(connection);
-  const held = fakeSession(true, true);
+  const pulses = [];
+  const held = fakeSession(true, true, pulses);
   const forward = pose([-0.18, 1.4, -0.55], [0.18, 1.4, -0.55]);
   calibration.update(0, 1.6, held, forward);
   assert.equal(calibration.update(kCalibrationHold_ms, 1.6, held, forward), 1.6);
   assert.deepEqual(connection.messages, [{ type: 'head_height', metres: 1.6 }, { type: 'arms_forward' }]);
   assert.equal(calibration.armsSent, true);
+  assert.deepEqual(pulses.map((p) => p[2]), [kBuzzBody_ms, kBuzzBody_ms]); // a long buzz: the body too
 
   calibration.update(2000, 1.6, fakeSession(false, false));
   const down = pose([-0.25, 0.85, -0.05], [0.25, 0.85, -0.05]);
@@ -104,4 +108,5 @@ test('a hold with the arms forward sends the height, then arms_forward; arms dow
   assert.equal(calibration.update(2100 + kCalibrationHold_ms, 1.6, held, down), 1.6);
   assert.deepEqual(connection.messages.slice(2), [{ type: 'head_height', metres: 1.6 }]);
   assert.equal(calibration.armsSent, false);
+  assert.deepEqual(pulses.slice(2).map((p) => p[2]), [kBuzzHeight_ms, kBuzzHeight_ms]);
 });
