@@ -4,12 +4,14 @@
 #include <algorithm>
 #include <iostream>
 #include <limits>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
-#include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "duet/io/motion_file.h"
+#include "duet/motion/arms_forward.h"
 #include "duet/motion/forward_kinematics.h"
 #include "duet/motion/head_hands.h"
 #include "motion_options.h"
@@ -73,6 +75,13 @@ int run_inspect(const InspectArgs& args) {
     high = high.cwiseMax(to_file_world * p);
   }
   if (positions.empty()) low = high = Vec3::Zero();
+  // Three points: whether the file holds a body calibration's pose (arms_forward.h), as duet
+  // follow --calibration would read it.
+  std::optional<Result<ArmsForward>> calibration;
+  if (is_head_hands_input(motion.roles) && clip.joint_count() == kHeadHandsJointCount) {
+    calibration = arms_forward_of_points(clip);
+  }
+  const double pose_head_m = calibration ? median_head_height(clip) : 0.0;
 
   if (args.json) {
     nlohmann::json doc;
@@ -115,6 +124,18 @@ int run_inspect(const InspectArgs& args) {
     doc["rest_pose_stands"] =
         full_body_roles ? nlohmann::json(rest_pose_stands(skeleton, motion.roles)) : nullptr;
     doc["follower_problems"] = problems;
+    if (calibration && static_cast<bool>(*calibration)) {
+      const ArmsForward& arms = calibration->value();
+      doc["calibration"] = {
+          {"usable", true},
+          {"head_height_m", pose_head_m},
+          {"wrists_apart_m", (arms.wrists[0].x() - arms.wrists[1].x()) * pose_head_m},
+          {"wrists_ahead_m", 0.5 * (arms.wrists[0].z() + arms.wrists[1].z()) * pose_head_m}};
+    } else if (calibration) {
+      doc["calibration"] = {{"usable", false}, {"reason", calibration->error().message}};
+    } else {
+      doc["calibration"] = nullptr;
+    }
     doc["bounding_box_m"] = {{"min", {low.x(), low.y(), low.z()}},
                              {"max", {high.x(), high.y(), high.z()}}};
     nlohmann::json names = nlohmann::json::array();
@@ -175,6 +196,16 @@ int run_inspect(const InspectArgs& args) {
                    : "no standing body: where the head faces (three points, retargeting) is read "
                      "from the motion");
   }
+  if (calibration && static_cast<bool>(*calibration)) {
+    const ArmsForward& arms = calibration->value();
+    fmt::print(
+        "calibration: a body calibration's pose (--calibration): head {:.2f} m high, wrists held "
+        "{:.2f} m apart and {:.2f} m in front of the head\n",
+        pose_head_m, (arms.wrists[0].x() - arms.wrists[1].x()) * pose_head_m,
+        0.5 * (arms.wrists[0].z() + arms.wrists[1].z()) * pose_head_m);
+  } else if (calibration) {
+    fmt::print("calibration: not a body calibration's pose: {}\n", calibration->error().message);
+  }
   if (problems.empty() && is_head_hands_input(motion.roles)) {
     fmt::print("follower:    this file can drive the three-point follower (head and hands)\n");
   } else if (problems.empty()) {
@@ -197,7 +228,8 @@ Command register_inspect(CLI::App& app) {
       "Prints joints, frames, frame rate, units and how they were decided, the estimated body "
       "height, whether the rest pose is a standing body, each role's joint and how it was found "
       "(built-in map, joint names or hierarchy), and "
-      "whether the file can drive the follower (and why not). Exits 0 even when roles are "
+      "whether the file can drive the follower (and why not); for three points, whether it holds a "
+      "body calibration's pose (--calibration). Exits 0 even when roles are "
       "missing.");
   app.add_option("files", args->files, "A .bvh file, or an .asf and an .amc file")
       ->required()

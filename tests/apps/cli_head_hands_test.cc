@@ -288,6 +288,12 @@ TEST(CliHeadHands, ACalibrationFollowsAnotherBodyAsTheLibrarysOwn) {
     std::ofstream out(pose);
     out << format_points_csv(held);
   }
+  CommandResult inspected = run_duet("inspect " + pose);
+  EXPECT_NE(inspected.output.find(fmt::format("calibration: a body calibration's pose "
+                                              "(--calibration): head {:.2f} m high",
+                                              head_m)),
+            std::string::npos)
+      << inspected.output;
   CommandResult untold =
       run_duet("follow --library " + kSalsaLibrary + " --input " + csv + " --head-height " +
                fmt::format("{:.3f}", head_m) + " --trace " + untold_trace);
@@ -314,6 +320,9 @@ TEST(CliHeadHands, ACalibrationFollowsAnotherBodyAsTheLibrarysOwn) {
     std::ofstream out(pose);
     out << format_points_csv(down);
   }
+  CommandResult down_inspected = run_duet("inspect " + pose + " --json");
+  EXPECT_NE(down_inspected.output.find("\"usable\": false"), std::string::npos)
+      << down_inspected.output;
   CommandResult refused =
       run_duet("follow --library " + kSalsaLibrary + " --input " + csv + " --calibration " + pose);
   EXPECT_EQ(refused.exit_code, 1);
