@@ -69,8 +69,8 @@ struct EvalArgs {
   std::optional<float> jump_settle_mass;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
       pause_distance, lost_distance, velocity_cap, pause_noise_factor, lost_residual,
-      lost_noise_factor, lost_residual_factor, lost_confirm, emission_noise_factor,
-      emission_noise_allowance, noise_filter_density, noise_filter_allowance;
+      lost_noise_factor, lost_residual_factor, lost_confirm, lost_velocity_cap,
+      emission_noise_factor, emission_noise_allowance, noise_filter_density, noise_filter_allowance;
   std::optional<double> tempo_time_constant;
   bool fixed_band = false;
   bool no_outlier_gate = false;
@@ -234,6 +234,7 @@ int run_eval(EvalArgs& args) {
   if (args.lost_noise_factor) hmm.lost_noise_factor = *args.lost_noise_factor;
   if (args.lost_residual_factor) hmm.lost_residual_factor = *args.lost_residual_factor;
   if (args.lost_confirm) hmm.lost_confirm_s = *args.lost_confirm;
+  if (args.lost_velocity_cap) hmm.lost_velocity_cap_per_dim = *args.lost_velocity_cap;
   if (args.pause_reported_lost) hmm.pause_reported_lost = true;
   if (args.tempo_time_constant) hmm.tempo_time_constant_s = *args.tempo_time_constant;
   if (args.fixed_band) hmm.tempo_adaptive = false;
@@ -394,7 +395,8 @@ int run_eval(EvalArgs& args) {
       "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s "
       "(mass {}) noisy_jump_hold {} s jump_old_place_mass {} jump_alike_distance {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
-      "lost_residual_factor {} lost_confirm {} s{} emission_noise_factor {} "
+      "lost_residual_factor {} lost_confirm {} s lost_velocity_cap {}/dim{} emission_noise_factor "
+      "{} "
       "emission_noise_allowance {} noise_filter_density {} noise_filter_allowance {}\n\n",
       library->takes().size(), library->model().num_states(), library->frame_rate(),
       args.library.role, takes, options.seed, hmm.self_prob, hmm.next_prob, hmm.skip_prob,
@@ -404,7 +406,7 @@ int run_eval(EvalArgs& args) {
       hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.jump_settle_mass,
       hmm.noisy_jump_hold_s, hmm.jump_old_place_mass, hmm.jump_alike_distance_per_dim,
       hmm.pause_noise_factor, hmm.lost_residual_per_dim, hmm.lost_noise_factor,
-      hmm.lost_residual_factor, hmm.lost_confirm_s,
+      hmm.lost_residual_factor, hmm.lost_confirm_s, hmm.lost_velocity_cap_per_dim,
       hmm.pause_reported_lost ? " pause_reported_lost" : "", hmm.emission_noise_factor,
       hmm.emission_noise_allowance, hmm.noise_filter_density, hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
@@ -634,6 +636,12 @@ Command register_eval(CLI::App& app) {
                    "lost_confirm_s: the input must stay past the HMM's noise-scaled lost distance "
                    "on consecutive frames this long before it is called lost (all HMM variants)")
       ->check(CLI::Range(0.0, 10.0));
+  tuning
+      ->add_option("--lost-velocity-cap-per-dim", args->lost_velocity_cap,
+                   "lost_velocity_cap_per_dim: most the velocity blocks add to the lost test's "
+                   "distance, per dimension of the model (and at most --velocity-cap); all HMM "
+                   "variants")
+      ->check(non_negative_check());
   tuning->add_flag("--pause-reported-lost", args->pause_reported_lost,
                    "pause_reported_lost: report frames whose posterior the pause state holds as "
                    "lost although a template frame explains them (the paper preset's reading; "

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "duet/io/motion_argument.h"
+#include "duet/live/follow_session.h"
 #include "duet/motion/head_hands.h"
 #include "number_checks.h"
 
@@ -142,6 +143,12 @@ Result<BodyCalibration> read_body_calibration(const std::string& path,
   if (!arms) return Error{"--calibration: " + path + ": " + arms.error().message};
   calibration.arms_forward = arms.value();
   calibration.head_height_m = median_head_height(pose.clip);  // the clip is in metres
+  const auto [lowest, highest] = FollowSession::kHeadHeightRangeM;
+  if (!(calibration.head_height_m >= lowest && calibration.head_height_m <= highest)) {
+    return Error{fmt::format(
+        "--calibration: {}: the head is {:.2f} m high, not {:g}-{:g} m: no one standing straight",
+        path, calibration.head_height_m, lowest, highest)};
+  }
   return calibration;
 }
 

@@ -18,31 +18,6 @@ namespace {
 // Below this the kept mass has lost too many bits to be normalised (as forward_common.cc).
 constexpr double kMinNormaliser = 1e-30;
 
-// ||phi - phi_i||^2 with the velocity part capped (as follow_detail::emission_distances). Read
-// from the blocked features, which the full step keeps resident anyway: the row-major ones may be
-// a memory-mapped cache's (TemplateModel::build_shared), whose pages a beam's scattered jump
-// candidates would otherwise bring in one by one (at 1M states, 150 MB in the first seconds).
-float emission_distance(const TemplateModel& model, const float* phi, int i,
-                        float velocity_cap) noexcept {
-  constexpr int kBlock = TemplateModel::kStateBlock;
-  const int dims = model.num_dims();
-  const int posture = dims - model.velocity_dims();
-  const float* lane =
-      model.blocked_features().data() +
-      static_cast<std::size_t>(i / kBlock) * static_cast<std::size_t>(dims) * kBlock +
-      static_cast<std::size_t>(i % kBlock);
-  float posture_d2 = 0.0f, velocity_d2 = 0.0f;
-  for (int d = 0; d < posture; ++d) {
-    const float diff = lane[static_cast<std::size_t>(d) * kBlock] - phi[d];
-    posture_d2 += diff * diff;
-  }
-  for (int d = posture; d < dims; ++d) {
-    const float diff = lane[static_cast<std::size_t>(d) * kBlock] - phi[d];
-    velocity_d2 += diff * diff;
-  }
-  return std::min(posture_d2 + std::min(velocity_d2, velocity_cap), FLT_MAX);
-}
-
 Error left_to_right_error() {
   return make_error("beam follower", 0,
                     "beam mode needs the jump HMM's pause state; the left-to-right HMM runs "
@@ -249,7 +224,8 @@ bool BeamForward::sparse_emission(const float* phi, const CandidateSet& candidat
   float best = FLT_MAX;
   float* d2 = context.distance_sq_.data();
   for (std::size_t k = 0; k < count; ++k) {
-    d2[k] = emission_distance(model, phi, context.next_[k], params.velocity_distance_cap);
+    d2[k] = follow_detail::state_emission_distance(model, phi, context.next_[k],
+                                                   params.velocity_distance_cap);
     best = std::min(best, d2[k]);
   }
   // The bound the states left out would have to be beyond for this frame's decisions to be the
@@ -469,17 +445,17 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   result.sensor_noise_per_dim = context.history_.sensor_noise.variance_per_dim();
   context.frame_noise_ = result.sensor_noise_per_dim;
   if (result.missing) context.history_.noise_filter.miss(dt_s);
+  const float* phi = nullptr;  // the filtered features, while the frame has them
   if (!result.missing) {
-    const std::span<const float> phi =
-        context.history_.noise_filter.apply(features, dt_s, context.frame_noise_);
+    phi = context.history_.noise_filter.apply(features, dt_s, context.frame_noise_).data();
     // Uncertain with the usual candidates: widen the search; still uncertain, the beam may have
     // lost the dancer: finish the frame with the full step.
-    if (!dense && !sparse_step(phi.data(), context, result)) {
+    if (!dense && !sparse_step(phi, context, result)) {
       materialise(context);
       dense = true;
     }
     if (dense) {
-      exact_.emit_all_states(phi.data(), context.frame_noise_, context.history_, context.alpha_,
+      exact_.emit_all_states(phi, context.frame_noise_, context.history_, context.alpha_,
                              context.scratch_, context.distance_sq_.data(), result);
     }
   } else if (dense) {
@@ -503,9 +479,12 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
         follow_detail::is_jump(model, context.history_.previous_state, result.state, result.steps);
   }
   const bool unexplained =
-      !result.missing && result.best_distance_per_dim * static_cast<float>(model.num_dims()) >
-                             exact_.noise_levels_.lost_distance_sq(
-                                 context.frame_noise_, context.history_.explained_residual.level());
+      phi != nullptr &&
+      follow_detail::lost_test_distance(
+          model, params, phi, result.best_distance_per_dim * static_cast<float>(model.num_dims()),
+          result.state) >
+          exact_.noise_levels_.lost_distance_sq(context.frame_noise_,
+                                                context.history_.explained_residual.level());
   context.history_.jump_gate.apply(model, params, alpha, 1.0f, context.history_.previous_state,
                                    context.history_.previous_lost, result, unexplained);
   if (dense && !result.missing) rebuild_beam(context);

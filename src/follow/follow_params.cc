@@ -75,6 +75,10 @@ Status FollowParams::validate(int num_states) const {
     return params_error("velocity_distance_cap must be >= 0, got " +
                         std::to_string(velocity_distance_cap));
   }
+  if (!(lost_velocity_cap_per_dim >= 0.0f)) {  // +inf allowed: the emission's cap
+    return params_error("lost_velocity_cap_per_dim must be >= 0, got " +
+                        std::to_string(lost_velocity_cap_per_dim));
+  }
   if (!(lost_distance_per_dim >= 0.0f)) {  // +inf allowed: never lost by distance
     return params_error("lost_distance_per_dim must be >= 0, got " +
                         std::to_string(lost_distance_per_dim));

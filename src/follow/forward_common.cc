@@ -81,6 +81,38 @@ float emission_distances(const TemplateModel& model, const float* phi, float vel
   return best;
 }
 
+float state_emission_distance(const TemplateModel& model, const float* phi, int i,
+                              float velocity_cap) noexcept {
+  constexpr int kBlock = TemplateModel::kStateBlock;
+  const int dims = model.num_dims();
+  const int posture = dims - model.velocity_dims();
+  const float* lane =
+      model.blocked_features().data() +
+      static_cast<std::size_t>(i / kBlock) * static_cast<std::size_t>(dims) * kBlock +
+      static_cast<std::size_t>(i % kBlock);
+  float posture_d2 = 0.0f, velocity_d2 = 0.0f;
+  for (int d = 0; d < posture; ++d) {
+    const float diff = lane[static_cast<std::size_t>(d) * kBlock] - phi[d];
+    posture_d2 += diff * diff;
+  }
+  for (int d = posture; d < dims; ++d) {
+    const float diff = lane[static_cast<std::size_t>(d) * kBlock] - phi[d];
+    velocity_d2 += diff * diff;
+  }
+  return std::min(posture_d2 + std::min(velocity_d2, velocity_cap), FLT_MAX);
+}
+
+float lost_test_distance(const TemplateModel& model, const FollowParams& params, const float* phi,
+                         float best_emission_sq, int state) noexcept {
+  const float cap =
+      std::min(params.velocity_distance_cap,
+               params.lost_velocity_cap_per_dim * static_cast<float>(model.num_dims()));
+  if (!(cap < params.velocity_distance_cap) || state < 0 || state >= model.num_states()) {
+    return best_emission_sq;
+  }
+  return std::min(best_emission_sq, state_emission_distance(model, phi, state, cap));
+}
+
 double weigh_and_normalise(const float* predicted, const float* distance_sq, float best_distance_sq,
                            float inv_two_sigma_sq, int num_states, float log_b_pause,
                            bool with_pause, float* out) noexcept {

@@ -8,6 +8,7 @@
 #include <xmmintrin.h>
 #endif
 
+#include "duet/follow/follow_params.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tracker.h"
 
@@ -51,6 +52,20 @@ float squared_distances(const FeatureView& features, const float* phi, int begin
 // velocity dimensions or the cap is infinite.
 float emission_distances(const TemplateModel& model, const float* phi, float velocity_cap,
                          float* out) noexcept;
+
+// The same for one template state i: ||phi - phi_i||^2 with the velocity part capped at
+// velocity_cap. Read from the blocked features, which the full step keeps resident anyway: the
+// row-major ones may be a memory-mapped cache's (TemplateModel::build_shared), whose pages a
+// beam's scattered jump candidates would otherwise bring in one by one (at 1M states, 150 MB in
+// the first seconds). O(D).
+float state_emission_distance(const TemplateModel& model, const float* phi, int i,
+                              float velocity_cap) noexcept;
+
+// The squared distance of the lost test (FollowParams::lost_velocity_cap_per_dim): the best
+// emission distance, or at the estimated state with the velocity part capped lower, whichever is
+// smaller. `state` < 0: the best emission distance.
+float lost_test_distance(const TemplateModel& model, const FollowParams& params, const float* phi,
+                         float best_emission_sq, int state) noexcept;
 
 // log b = max(-d^2 * inv_two_sigma_sq, kMinLogEmission) (eq. 7, without its constant).
 inline float log_emission(float distance_sq, float inv_two_sigma_sq) noexcept {

@@ -211,18 +211,13 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
 
   context.history_.sensor_noise.update(features, dt_s, !result.missing);
   result.sensor_noise_per_dim = context.history_.sensor_noise.variance_per_dim();
-  bool unexplained = false;  // past the noise-scaled lost distance
+  const float noise = result.sensor_noise_per_dim;
+  const float* phi = nullptr;  // the filtered features, while the frame has them
+  float best = 0.0f;
   if (!result.missing) {
-    const std::span<const float> phi =
-        context.history_.noise_filter.apply(features, dt_s, result.sensor_noise_per_dim);
-    const float noise = result.sensor_noise_per_dim;
-    const float best = emit_all_states(phi.data(), noise, context.history_, context.alpha_,
-                                       context.scratch_, context.distance_sq_.data(), result);
-    // lost is completed below, once in_pause is known. The band's tempo and the jump gate go on
-    // the fixed ceiling: taught only by frames within the noise-scaled level, the tempo lagged
-    // on clean input at 1.4x (100% -> 98.8% within 100 ms).
-    unexplained =
-        best > noise_levels_.lost_distance_sq(noise, context.history_.explained_residual.level());
+    phi = context.history_.noise_filter.apply(features, dt_s, noise).data();
+    best = emit_all_states(phi, noise, context.history_, context.alpha_, context.scratch_,
+                           context.distance_sq_.data(), result);
   } else {
     context.history_.noise_filter.miss(dt_s);
     // No evidence: the transitions conserve mass; renormalise only to stop float drift.
@@ -233,6 +228,13 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   const float* alpha = context.alpha_.data();
   follow_detail::decide(model, alpha, 1.0f, alpha[num_states], context.history_.previous_state,
                         result.steps, params_.confidence_window_frames, result);
+  // Past the noise-scaled lost distance. lost is completed below, once in_pause is known. The
+  // band's tempo and the jump gate go on the fixed ceiling: taught only by frames within the
+  // noise-scaled level, the tempo lagged on clean input at 1.4x (100% -> 98.8% within 100 ms).
+  const bool unexplained =
+      phi != nullptr &&
+      follow_detail::lost_test_distance(model, params_, phi, best, result.state) >
+          noise_levels_.lost_distance_sq(noise, context.history_.explained_residual.level());
   context.history_.jump_gate.apply(model, params_, alpha, 1.0f, context.history_.previous_state,
                                    context.history_.previous_lost, result, unexplained);
   const bool past_ceiling = result.lost;  // the emission's test (false without features)

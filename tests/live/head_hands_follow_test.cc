@@ -6,12 +6,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <random>
 #include <vector>
 
 #include "duet/eval/non_dance.h"
 #include "duet/eval/performance.h"
+#include "duet/eval/runner.h"
 #include "duet/features/feature_extractor.h"
 #include "duet/follow/hmm_follower.h"
 #include "duet/io/points_csv.h"
@@ -476,6 +478,61 @@ TEST(HeadHandsFollow, ANoisyHeadsetTakeIsFollowed) {
   const Counts flickering = follow(every_frame);
   EXPECT_EQ(flickering.within, followed.within);
   EXPECT_GT(flickering.lost, 3 * followed.lost + 10) << flickering.lost << " of " << frames;
+}
+
+TEST(HeadHandsFollow, ADanceFasterThanItsTakeIsNotLost) {
+  // The evaluation's `tempo-fast` case on take 60_07 as three points with a headset's noise: the
+  // take danced 1.4x faster than captured. Its velocities are 1.4x the take's; over three
+  // points' 13 dimensions the emission's velocity cap alone passed the lost distance, so the
+  // lost test caps them lower (FollowParams::lost_velocity_cap_per_dim).
+  const LoadedMotion take = load_take("60_07");
+  EvalCase tempo_fast;
+  for (const EvalCase& c : standard_cases()) {
+    if (c.name == "tempo-fast") tempo_fast = c;
+  }
+  ASSERT_EQ(tempo_fast.name, "tempo-fast");
+  PerformanceRecipe recipe = tempo_fast.recipe;
+  recipe.head_hands = true;
+  recipe.point_noise.position_m = 0.005;
+  recipe.point_noise.rotation_deg = 1.0;
+  const SourceTake source{6, &take.clip, take.roles};
+  Result<Performance> made = make_performance(std::span(&source, 1), recipe, 1);
+  ASSERT_TRUE(made) << made.error().message;
+  const Performance& performance = made.value();
+  const DuetLibrary& library = head_hands_library();
+  struct Counts {
+    int within = 0, lost_within = 0;
+  };
+  auto follow = [&](const FollowParams& params) {
+    Result<HmmFollower> follower = HmmFollower::create(library.model(), params);
+    EXPECT_TRUE(follower);
+    Result<FollowSession> session =
+        FollowSession::create(library, performance.motion.skeleton_ptr(), performance.roles,
+                              std::make_unique<HmmFollower>(std::move(follower).value()));
+    EXPECT_TRUE(session) << session.error().message;
+    Counts counts;
+    for (int f = 0; f < performance.motion.frame_count(); ++f) {
+      const FollowResult r =
+          session.value().step(performance.motion.translations_ls(f),
+                               performance.motion.rotations_ls(f), performance.times_s[f]);
+      const TruthFrame& truth = performance.truth[static_cast<std::size_t>(f)];
+      const bool within =
+          r.take == truth.take && std::abs(r.frame_in_take - truth.template_frame) <= 6.0;
+      counts.within += within ? 1 : 0;
+      counts.lost_within += within && r.lost ? 1 : 0;
+    }
+    return counts;
+  };
+  const Counts capped = follow(FollowParams{});
+  FollowParams emission_cap;
+  emission_cap.lost_velocity_cap_per_dim = std::numeric_limits<float>::infinity();
+  const Counts uncapped = follow(emission_cap);
+  const int frames = performance.motion.frame_count();
+  EXPECT_GE(capped.within, 0.97 * frames) << capped.within << " of " << frames;
+  EXPECT_LE(capped.lost_within, 0.01 * capped.within)
+      << capped.lost_within << " of " << capped.within;
+  EXPECT_GT(uncapped.lost_within, capped.lost_within + 0.02 * capped.within)
+      << uncapped.lost_within << " against " << capped.lost_within;
 }
 
 TEST(HeadHandsFollow, TakeOneFromTheCmuAsfAmcAsThreePointsIsFollowed) {

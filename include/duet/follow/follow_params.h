@@ -116,6 +116,14 @@ struct FollowParams {
   // noise is an average over the posture dimensions): three points flagged 1.7 % of the frames
   // of a clean take lost, nearly all on their own. 0 calls every such frame lost.
   float lost_confirm_s = 0.05f;
+  // The lost test counts the velocity blocks at most this much per dimension of the model (and
+  // at most velocity_distance_cap), at the estimated state. The emission's cap is one number for
+  // any model: over the full body's 50 dimensions velocities alone can never pass the lost
+  // distance, over three points' 13 they could, and a dance 1.4x faster than its take did
+  // (three points' `tempo-fast`: 3.6 % of its tracked frames lost; docs/evaluation.md "Lost on
+  // three points' velocities"). 0.0019 caps three points' at 0.025, half the emission's, and
+  // leaves the full body's as it was; a walk, whose velocities differ most, stays lost.
+  float lost_velocity_cap_per_dim = 0.0019f;
   // Whether a pause-state majority is reported lost (FollowResult::lost) although a template
   // frame explains the input within the lost distance: the follower between places after a jump,
   // still deciding where the user went. true is the paper preset's reading; by default lost says
