@@ -111,8 +111,8 @@ Result<DuetLibrary> DuetLibrary::load(const std::vector<PairFiles>& pairs,
       extractor.value().set_head_correction(head.value());
       // Every 10th frame: a median of places the collar bones and the head barely move.
       constexpr int kArmsStride = 10;
-      Result<ArmsForward> arms =
-          arms_forward_of_body(take.template_motion.clip, take.template_motion.roles, kArmsStride);
+      Result<ArmsForward> arms = arms_forward_of_body(
+          take.template_motion.clip, take.template_motion.roles, head.value(), kArmsStride);
       if (!arms) return Error{what + ": " + arms.error().message};
       template_arms.push_back(arms.value());
     }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "duet/math/median.h"
 #include "duet/math/rotation.h"
 #include "duet/motion/forward_kinematics.h"
 #include "duet/motion/head_hands.h"
@@ -13,12 +14,6 @@
 namespace duet {
 
 namespace {
-
-double median(std::vector<double>& values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
 
 // Per side and coordinate, the values of the frames seen; the median of each makes the result.
 struct WristSamples {
@@ -34,7 +29,8 @@ struct WristSamples {
     ArmsForward pose;
     for (std::size_t side = 0; side < 2; ++side) {
       for (std::size_t k = 0; k < 3; ++k) {
-        pose.wrists[side][static_cast<int>(k)] = median(coordinates[side][k]) * per_unit;
+        pose.wrists[side][static_cast<int>(k)] =
+            upper_median(std::move(coordinates[side][k])) * per_unit;
       }
     }
     return pose;
@@ -73,6 +69,13 @@ std::string ArmsForward::check() const {
 
 Result<ArmsForward> arms_forward_of_body(const Clip& full_body, const JointRoles& roles,
                                          int stride) {
+  Result<Quat> correction = head_correction(full_body, roles);
+  if (!correction) return correction.error();
+  return arms_forward_of_body(full_body, roles, correction.value(), stride);
+}
+
+Result<ArmsForward> arms_forward_of_body(const Clip& full_body, const JointRoles& roles,
+                                         const Quat& correction, int stride) {
   const int head = roles[Role::kHead];
   const std::array<std::array<Role, 3>, 2> arms = {
       {{Role::kLeftShoulder, Role::kLeftElbow, Role::kLeftWrist},
@@ -84,8 +87,6 @@ Result<ArmsForward> arms_forward_of_body(const Clip& full_body, const JointRoles
       }
     }
   }
-  Result<Quat> correction = head_correction(full_body, roles);
-  if (!correction) return correction.error();
   const auto n = static_cast<std::size_t>(full_body.joint_count());
   std::vector<Vec3> positions(n);
   std::vector<Quat> rotations(n);
@@ -96,7 +97,7 @@ Result<ArmsForward> arms_forward_of_body(const Clip& full_body, const JointRoles
     forward_kinematics(full_body.skeleton(), full_body.translations_ls(f),
                        full_body.rotations_ls(f), positions, rotations);
     const Vec3 head_ws = positions[static_cast<std::size_t>(head)];
-    const Quat head_canonical = rotations[static_cast<std::size_t>(head)] * correction.value();
+    const Quat head_canonical = rotations[static_cast<std::size_t>(head)] * correction;
     if (!head_ws.allFinite() || !head_canonical.coeffs().allFinite()) continue;
     for (std::size_t side = 0; side < 2; ++side) {
       const auto& [shoulder, elbow, wrist] = arms[side];
@@ -110,7 +111,7 @@ Result<ArmsForward> arms_forward_of_body(const Clip& full_body, const JointRoles
   if (!(head_height_m > 0.0)) return Error{"arms held forward: the head is never above the floor"};
   ArmsForward pose = samples.medians(1.0 / head_height_m);
   for (std::size_t side = 0; side < 2; ++side) {
-    pose.wrists[side].z() += median(arm_lengths[side]) / head_height_m;
+    pose.wrists[side].z() += upper_median(std::move(arm_lengths[side])) / head_height_m;
   }
   return pose;
 }
@@ -126,7 +127,7 @@ double median_head_height(const Clip& points) {
                        positions, rotations);
     if (std::isfinite(positions[kPointsHead].y())) heights.push_back(positions[kPointsHead].y());
   }
-  return heights.empty() ? 0.0 : median(heights);
+  return upper_median(std::move(heights));
 }
 
 ArmsForward median_arms_forward(std::span<const ArmsForward> poses) {

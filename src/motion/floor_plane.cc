@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "duet/math/median.h"
 #include "duet/math/rotation.h"
 
 namespace duet {
@@ -16,13 +17,6 @@ constexpr double kLeastHeightSpreadM = 0.01;
 constexpr double kIndependentAfterS = 0.5;
 constexpr int kPasses = 6;
 constexpr double kTrimSpreads = 3.0;
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
 
 }  // namespace
 
@@ -87,7 +81,7 @@ FloorFit fit_floor(std::span<const Vec3> points, const Vec3& prior_up, double sp
     for (std::size_t i = 0; i < residuals.size(); ++i) {
       if (inlier[i]) magnitudes.push_back(std::abs(residuals[i]));
     }
-    spread = 1.4826 * median(std::move(magnitudes));
+    spread = 1.4826 * upper_median(std::move(magnitudes));
     // The lower toe is on the floor or above it: points far above are feet in the air.
     const double limit = kTrimSpreads * std::max(spread, kLeastHeightSpreadM);
     for (std::size_t i = 0; i < local.size(); ++i) {

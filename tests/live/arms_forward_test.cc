@@ -21,11 +21,6 @@
 namespace duet::test {
 namespace {
 
-const DuetLibrary& head_hands_library() {
-  static const DuetLibrary loaded = load_salsa_library(InputPoints::kHeadHands);
-  return loaded;
-}
-
 LoadedMotion load(const std::vector<std::string>& files, double fps = 0.0) {
   MotionLoadOptions options;
   if (fps > 0.0) options.frame_rate = fps;
@@ -142,13 +137,10 @@ TEST(ArmsForward, APoseArmsForwardCannotGiveIsRefusedWithTheReason) {
   not_numbers.wrists[0].x() = std::nan("");
   EXPECT_FALSE(not_numbers.check().empty());
 
-  Result<FollowSession> session = FollowSession::create(
-      head_hands_library(), make_head_hands_skeleton(), head_hands_roles(),
-      std::make_unique<HmmFollower>(
-          HmmFollower::create(head_hands_library().model(), FollowParams{}).value()));
-  ASSERT_TRUE(session);
-  EXPECT_FALSE(session.value().set_arms_forward(crossed));
-  EXPECT_FALSE(session.value().arms_forward().has_value());  // nothing changed
+  FollowSession session =
+      hmm_session(head_hands_library(), make_head_hands_skeleton(), head_hands_roles());
+  EXPECT_FALSE(session.set_arms_forward(crossed));
+  EXPECT_FALSE(session.arms_forward().has_value());  // nothing changed
 }
 
 TEST(ArmsForward, CalibratedHandsOfAnotherRigMatchTheLibrarysRig) {
@@ -210,18 +202,14 @@ TEST(ArmsForward, AnotherRigCalibratedIsFollowedAsWellAsTheLibrarysOwn) {
   ASSERT_TRUE(points);
   const Clip& clip = points.value().motion;
   auto within_100ms = [&](const std::optional<ArmsForward>& told) {
-    Result<FollowSession> session = FollowSession::create(
-        head_hands_library(), clip.skeleton_ptr(), points.value().roles,
-        std::make_unique<HmmFollower>(
-            HmmFollower::create(head_hands_library().model(), FollowParams{}).value()));
-    EXPECT_TRUE(session);
-    EXPECT_TRUE(session.value().set_head_height(head_m));
-    EXPECT_TRUE(session.value().set_arms_forward(told));
+    FollowSession session =
+        hmm_session(head_hands_library(), clip.skeleton_ptr(), points.value().roles);
+    EXPECT_TRUE(session.set_head_height(head_m));
+    EXPECT_TRUE(session.set_arms_forward(told));
     const int take = 8;  // 60_10
     int right = 0;
     for (int f = 0; f < clip.frame_count(); ++f) {
-      const FollowResult r =
-          session.value().step(clip.translations_ls(f), clip.rotations_ls(f), f / 60.0);
+      const FollowResult r = session.step(clip.translations_ls(f), clip.rotations_ls(f), f / 60.0);
       right += r.take == take && std::abs(r.frame_in_take - f) <= 6 ? 1 : 0;
     }
     return static_cast<double>(right) / clip.frame_count();

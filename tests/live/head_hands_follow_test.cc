@@ -30,11 +30,6 @@
 namespace duet::test {
 namespace {
 
-const DuetLibrary& head_hands_library() {
-  static const DuetLibrary loaded = load_salsa_library(InputPoints::kHeadHands);
-  return loaded;
-}
-
 LoadedMotion load_take(const std::string& subject_take) {
   MotionLoadOptions options;
   options.frame_rate = 60.0;
@@ -404,17 +399,12 @@ TEST(HeadHandsFollow, AKnownHeadHeightFollowsADanceThatStartsLow) {
   }
   const DuetLibrary& library = head_hands_library();
   auto within = [&](double head_height_m) {
-    Result<HmmFollower> follower = HmmFollower::create(library.model(), FollowParams{});
-    EXPECT_TRUE(follower);
-    Result<FollowSession> session =
-        FollowSession::create(library, points.skeleton_ptr(), head_hands_roles(),
-                              std::make_unique<HmmFollower>(std::move(follower).value()));
-    EXPECT_TRUE(session) << session.error().message;
-    EXPECT_TRUE(session.value().set_head_height(head_height_m));
+    FollowSession session = hmm_session(library, points.skeleton_ptr(), head_hands_roles());
+    EXPECT_TRUE(session.set_head_height(head_height_m));
     int right = 0;
     for (int f = 0; f < frames; ++f) {
       const FollowResult r =
-          session.value().step(points.translations_ls(f), points.rotations_ls(f), f / 60.0);
+          session.step(points.translations_ls(f), points.rotations_ls(f), f / 60.0);
       right += (r.take == 0 && std::abs(r.frame_in_take - (first + f)) <= 6) ? 1 : 0;
     }
     return right;
@@ -430,19 +420,15 @@ TEST(HeadHandsFollow, AHeadHeightOutsideAPersonsIsRefused) {
   const LoadedMotion take = load_take("60_07");
   Result<Clip> points = head_hands_clip(take.clip, take.roles);
   ASSERT_TRUE(points);
-  Result<HmmFollower> follower = HmmFollower::create(head_hands_library().model(), FollowParams{});
-  ASSERT_TRUE(follower);
-  Result<FollowSession> session =
-      FollowSession::create(head_hands_library(), points.value().skeleton_ptr(), head_hands_roles(),
-                            std::make_unique<HmmFollower>(std::move(follower).value()));
-  ASSERT_TRUE(session);
+  FollowSession session =
+      hmm_session(head_hands_library(), points.value().skeleton_ptr(), head_hands_roles());
   for (const double bad : {-1.0, 0.2, 17.0, std::nan("")}) {
-    Status set = session.value().set_head_height(bad);
+    Status set = session.set_head_height(bad);
     ASSERT_FALSE(set) << bad;
     EXPECT_NE(set.error().message.find("head height"), std::string::npos) << set.error().message;
   }
-  EXPECT_TRUE(session.value().set_head_height(1.5));
-  EXPECT_TRUE(session.value().set_head_height(0.0));  // back to learning it
+  EXPECT_TRUE(session.set_head_height(1.5));
+  EXPECT_TRUE(session.set_head_height(0.0));  // back to learning it
 }
 
 TEST(HeadHandsFollow, ANoisyHeadsetTakeIsFollowed) {
@@ -453,16 +439,12 @@ TEST(HeadHandsFollow, ANoisyHeadsetTakeIsFollowed) {
     int within = 0, lost = 0;
   };
   auto follow = [&](const FollowParams& params) {
-    Result<HmmFollower> follower = HmmFollower::create(library.model(), params);
-    EXPECT_TRUE(follower);
-    Result<FollowSession> session =
-        FollowSession::create(library, performance.motion.skeleton_ptr(), performance.roles,
-                              std::make_unique<HmmFollower>(std::move(follower).value()));
-    EXPECT_TRUE(session) << session.error().message;
+    FollowSession session =
+        hmm_session(library, performance.motion.skeleton_ptr(), performance.roles, params);
     Counts counts;
     for (int f = 0; f < performance.motion.frame_count(); ++f) {
-      const FollowResult r = session.value().step(performance.motion.translations_ls(f),
-                                                  performance.motion.rotations_ls(f), f / 60.0);
+      const FollowResult r = session.step(performance.motion.translations_ls(f),
+                                          performance.motion.rotations_ls(f), f / 60.0);
       counts.within += (r.take == 6 && std::abs(r.frame_in_take - f) <= 6) ? 1 : 0;
       counts.lost += r.lost ? 1 : 0;
     }
@@ -505,17 +487,13 @@ TEST(HeadHandsFollow, ADanceFasterThanItsTakeIsNotLost) {
     int within = 0, lost_within = 0;
   };
   auto follow = [&](const FollowParams& params) {
-    Result<HmmFollower> follower = HmmFollower::create(library.model(), params);
-    EXPECT_TRUE(follower);
-    Result<FollowSession> session =
-        FollowSession::create(library, performance.motion.skeleton_ptr(), performance.roles,
-                              std::make_unique<HmmFollower>(std::move(follower).value()));
-    EXPECT_TRUE(session) << session.error().message;
+    FollowSession session =
+        hmm_session(library, performance.motion.skeleton_ptr(), performance.roles, params);
     Counts counts;
     for (int f = 0; f < performance.motion.frame_count(); ++f) {
       const FollowResult r =
-          session.value().step(performance.motion.translations_ls(f),
-                               performance.motion.rotations_ls(f), performance.times_s[f]);
+          session.step(performance.motion.translations_ls(f), performance.motion.rotations_ls(f),
+                       performance.times_s[f]);
       const TruthFrame& truth = performance.truth[static_cast<std::size_t>(f)];
       const bool within =
           r.take == truth.take && std::abs(r.frame_in_take - truth.template_frame) <= 6.0;
@@ -555,17 +533,12 @@ TEST(HeadHandsFollow, TakeOneFromTheCmuAsfAmcAsThreePointsIsFollowed) {
     int within = 0, lost = 0;
   };
   auto follow = [&](const std::optional<ArmsForward>& calibration) {
-    Result<HmmFollower> follower = HmmFollower::create(library.model(), FollowParams{});
-    EXPECT_TRUE(follower);
-    Result<FollowSession> session =
-        FollowSession::create(library, points.value().skeleton_ptr(), head_hands_roles(),
-                              std::make_unique<HmmFollower>(std::move(follower).value()));
-    EXPECT_TRUE(session) << session.error().message;
-    EXPECT_TRUE(session.value().set_arms_forward(calibration));
+    FollowSession session = hmm_session(library, points.value().skeleton_ptr(), head_hands_roles());
+    EXPECT_TRUE(session.set_arms_forward(calibration));
     Counts counts;
     for (int f = 0; f < points.value().frame_count(); ++f) {
-      const FollowResult r = session.value().step(points.value().translations_ls(f),
-                                                  points.value().rotations_ls(f), f / 60.0);
+      const FollowResult r =
+          session.step(points.value().translations_ls(f), points.value().rotations_ls(f), f / 60.0);
       counts.within += (r.take == 0 && std::abs(r.frame_in_take - f) <= 6) ? 1 : 0;
       counts.lost += r.lost ? 1 : 0;
     }

@@ -39,6 +39,27 @@ inline const DuetLibrary& salsa_library() {
   return loaded;
 }
 
+// The same duets with three points' features (a headset's head and hands), loaded once per test
+// binary.
+inline const DuetLibrary& head_hands_library() {
+  static const DuetLibrary loaded = load_salsa_library(InputPoints::kHeadHands);
+  return loaded;
+}
+
+// A follow session of `library` for a user on `skeleton` with `roles`, followed by the HMM with
+// `params`; throws (failing the test) when either cannot be made.
+inline FollowSession hmm_session(const DuetLibrary& library,
+                                 std::shared_ptr<const Skeleton> skeleton, const JointRoles& roles,
+                                 const FollowParams& params = {}) {
+  Result<HmmFollower> follower = HmmFollower::create(library.model(), params);
+  if (!follower) throw std::runtime_error(follower.error().message);
+  Result<FollowSession> session =
+      FollowSession::create(library, std::move(skeleton), roles,
+                            std::make_unique<HmmFollower>(std::move(follower).value()));
+  if (!session) throw std::runtime_error(session.error().message);
+  return std::move(session).value();
+}
+
 // Every frame of `input` through a FollowSession with `tracker`, one result per frame.
 inline std::vector<FollowResult> follow_clip(const LoadedMotion& input,
                                              std::unique_ptr<Tracker> tracker) {

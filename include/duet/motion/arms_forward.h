@@ -41,6 +41,9 @@ struct ArmsForward {
 // roles, or no frame is finite.
 Result<ArmsForward> arms_forward_of_body(const Clip& full_body, const JointRoles& roles,
                                          int stride = 1);
+// The same with the head's correction given (a caller that has head_correction already).
+Result<ArmsForward> arms_forward_of_body(const Clip& full_body, const JointRoles& roles,
+                                         const Quat& head_correction, int stride);
 
 // Three points (the head-and-hands skeleton, head_hands.h, device offsets taken out) of a user
 // holding the pose: the median over frames of each wrist relative to the head in the head's
