@@ -338,6 +338,7 @@ std::string PartnerParams::validate() const {
       {"ik_fade_s", ik_fade_s},
       {"ik_target_jump_speed_mps", ik_target_jump_speed_mps},
       {"reach_s", reach_s},
+      {"blend_root_catch_up_rad_s", blend_root_catch_up_rad_s},
       {"foot.height_margin_m", foot.height_margin_m},
       {"foot.speed_threshold_mps", foot.speed_threshold_mps},
       {"foot.max_offset_m", foot.max_offset_m},
@@ -977,11 +978,15 @@ bool PartnerSynthesisJob::run() const noexcept {
                                      ctx.inertializer_.max_translation_offset(),
                                      p.blend_max_root_speed_mps));
     }
-    constexpr double kNoLimit = std::numeric_limits<double>::infinity();
+    PoseInertializer::Limits limits;
+    if (p.blend_speed_limited) {
+      limits.max_rotation_speed_rad_s = p.blend_max_speed_rad_s;
+      limits.max_translation_speed_mps = p.blend_max_root_speed_mps;
+      limits.limit_shown_speed = p.blend_no_faster_than_input;
+      limits.root_catch_up_rad_s = p.blend_root_catch_up_rad_s;
+    }
     ctx.inertializer_.update(out_t, out_r, std::max(ctx.blend_half_life_, p.blend_half_life_s), dt,
-                             out_t, out_r,
-                             p.blend_speed_limited ? p.blend_max_speed_rad_s : kNoLimit,
-                             p.blend_speed_limited ? p.blend_max_root_speed_mps : kNoLimit);
+                             out_t, out_r, limits);
     diagnostics.blend_offset_rad = ctx.inertializer_.max_rotation_offset();
     if (!ctx.detour_hs_.isZero(0.0) && ctx.detour_offset_m_ > 0.0) {
       const double progress = std::clamp(

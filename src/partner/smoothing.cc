@@ -80,6 +80,41 @@ struct DecayStep {
   }
 };
 
+// The angle of the rotation from `from` to `to`, radians (the shorter way round).
+double rotation_angle(const Quat& from, const Quat& to) {
+  const double dot = std::abs(from.dot(to));
+  return 2.0 * std::acos(std::min(dot, 1.0));
+}
+
+// Holds a rotation offset's step since `before` back so that the joint shown (offset * input)
+// turns from the pose shown last no faster than the input itself or `max_speed`, whichever is
+// faster, plus `catch_up`. Holding the offset (s = 0) turns it exactly as fast as the input
+// (conjugation keeps the angle), so the largest s in [0, 1] within the limit exists; found by
+// bisection. The shown turn is at most the input's turn plus the offset's step (the exponential map
+// shortens distances), which settles most joints without a search; steps under kNegligibleRad (a
+// decayed offset's tail) are not checked.
+void limit_output_speed(Vec3& x, Vec3& v, const Vec3& before, const Quat& input,
+                        const Quat& previous_input, const Quat& previous_output, double max_speed,
+                        double dt, double catch_up) {
+  constexpr double kNegligibleRad = 1e-6;
+  const double step = (x - before).norm();
+  if (step <= kNegligibleRad) return;
+  const double input_turn = rotation_angle(previous_input, input);
+  const double limit = std::max(input_turn + catch_up * dt, max_speed * dt);
+  if (input_turn + step <= limit) return;
+  const auto shown_turn = [&](double s) {
+    return rotation_angle(previous_output, exp_map(before + s * (x - before)) * input);
+  };
+  if (shown_turn(1.0) <= limit) return;
+  double low = 0.0, high = 1.0;
+  for (int i = 0; i < 8; ++i) {
+    const double mid = 0.5 * (low + high);
+    (shown_turn(mid) <= limit ? low : high) = mid;
+  }
+  x = before + low * (x - before);
+  v *= low;
+}
+
 }  // namespace
 
 void decay_spring_damper(Vec3& x, Vec3& v, double half_life_s, double dt_s) noexcept {
@@ -122,12 +157,16 @@ void PoseInertializer::resize(int joint_count) {
   rotation_v_.assign(n, Vec3::Zero());
   translation_x_.assign(n, Vec3::Zero());
   translation_v_.assign(n, Vec3::Zero());
+  previous_input_.assign(n, Quat::Identity());
+  previous_output_.assign(n, Quat::Identity());
+  has_previous_ = false;
 }
 
 void PoseInertializer::reset() noexcept {
   for (auto* buffer : {&rotation_x_, &rotation_v_, &translation_x_, &translation_v_}) {
     std::fill(buffer->begin(), buffer->end(), Vec3::Zero());
   }
+  has_previous_ = false;
 }
 
 void PoseInertializer::transition(std::span<const Vec3> source_translations_ls,
@@ -142,31 +181,46 @@ void PoseInertializer::transition(std::span<const Vec3> source_translations_ls,
     // off_x = (src_x + off_x) - dst_x with src_x + off_x being the pose shown).
     rotation_x_[j] = log_map(source_rotations_ls[j] * destination_rotations_ls[j].conjugate());
     translation_x_[j] = source_translations_ls[j] - destination_translations_ls[j];
+    // The cut is no motion of the input: its speed counts from the new pose on.
+    previous_input_[j] = destination_rotations_ls[j];
+    previous_output_[j] = source_rotations_ls[j];
   }
+  has_previous_ = true;
 }
 
 void PoseInertializer::update(std::span<const Vec3> translations_ls,
                               std::span<const Quat> rotations_ls, double half_life_s, double dt_s,
                               std::span<Vec3> translations_out, std::span<Quat> rotations_out,
-                              double max_rotation_speed_rad_s,
-                              double max_translation_speed_mps) noexcept {
+                              const Limits& limits) noexcept {
   const std::size_t n = rotation_x_.size();
   assert(translations_ls.size() == n && rotations_ls.size() == n);
   assert(translations_out.size() == n && rotations_out.size() == n);
   const DecayStep decay(half_life_s, dt_s);
   const bool timed = dt_s > 0.0 && std::isfinite(dt_s);
+  const double max_rotation_speed = limits.max_rotation_speed_rad_s;
+  const bool hold_shown = limits.limit_shown_speed && timed && has_previous_ &&
+                          max_rotation_speed > 0.0 && std::isfinite(max_rotation_speed);
   for (std::size_t j = 0; j < n; ++j) {
+    const Quat input = rotations_ls[j];  // out may alias the input
     const Vec3 rotation_before = rotation_x_[j], translation_before = translation_x_[j];
     decay.apply(rotation_x_[j], rotation_v_[j]);
     decay.apply(translation_x_[j], translation_v_[j]);
     if (timed) {
-      limit_speed(rotation_x_[j], rotation_v_[j], rotation_before, max_rotation_speed_rad_s, dt_s);
+      limit_speed(rotation_x_[j], rotation_v_[j], rotation_before, max_rotation_speed, dt_s);
       limit_speed(translation_x_[j], translation_v_[j], translation_before,
-                  max_translation_speed_mps, dt_s);
+                  limits.max_translation_speed_mps, dt_s);
     }
-    rotations_out[j] = (exp_map(rotation_x_[j]) * rotations_ls[j]).normalized();
+    if (hold_shown) {
+      limit_output_speed(rotation_x_[j], rotation_v_[j], rotation_before, input, previous_input_[j],
+                         previous_output_[j], max_rotation_speed, dt_s,
+                         j == 0 ? limits.root_catch_up_rad_s : 0.0);
+    }
+    rotations_out[j] = (exp_map(rotation_x_[j]) * input).normalized();
     translations_out[j] = translations_ls[j] + translation_x_[j];
+    previous_input_[j] = input;
+    previous_output_[j] = rotations_out[j];
   }
+  has_previous_ = true;
 }
 
 double PoseInertializer::max_rotation_offset() const noexcept {

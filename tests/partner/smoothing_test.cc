@@ -114,12 +114,21 @@ struct JumpRun {
   std::vector<double> translation_steps;
 };
 
+// The input turns at w rad/s until stop_s (then holds still).
+struct InputTurn {
+  double w = 1.5;
+  double stop_s = std::numeric_limits<double>::infinity();
+  bool limit_shown_speed = false;
+  double catch_up_rad_s = 0.0;  // the joint is the root
+};
+
 JumpRun run_jump(double jump, double half_life, double fps, double seconds,
                  double max_rotation_speed = std::numeric_limits<double>::infinity(),
-                 double max_translation_speed = std::numeric_limits<double>::infinity()) {
+                 double max_translation_speed = std::numeric_limits<double>::infinity(),
+                 const InputTurn& turn = {}) {
   PoseInertializer inertializer(1);
   const Vec3 axis = Vec3(0.2, 1.0, 0.1).normalized();
-  const double w = 1.5;  // rad/s
+  const double w = turn.w;  // rad/s
   const double dt = 1.0 / fps;
   std::vector<Vec3> t(1, Vec3::Zero()), t_out(1);
   std::vector<Quat> r(1), r_out(1);
@@ -129,16 +138,21 @@ JumpRun run_jump(double jump, double half_life, double fps, double seconds,
   const int frames = static_cast<int>(seconds * fps);
   for (int i = 0; i < frames; ++i) {
     const bool jumped = i == 30;
-    const double angle = w * i * dt + (i >= 30 ? jump : 0.0);
+    const double angle = w * std::min(i * dt, turn.stop_s) + (i >= 30 ? jump : 0.0);
     r[0] = quat_from_axis_angle(axis, angle);
     t[0] = Vec3(i >= 30 ? 0.5 : 0.0, 0, 0);
     if (jumped)
       inertializer.transition(std::vector<Vec3>{previous_t}, std::vector<Quat>{previous_out}, t, r);
-    inertializer.update(t, r, half_life, dt, t_out, r_out, max_rotation_speed,
-                        max_translation_speed);
+    inertializer.update(t, r, half_life, dt, t_out, r_out,
+                        {.max_rotation_speed_rad_s = max_rotation_speed,
+                         .max_translation_speed_mps = max_translation_speed,
+                         .limit_shown_speed = turn.limit_shown_speed,
+                         .root_catch_up_rad_s = turn.catch_up_rad_s});
     if (i > 0) run.output_steps.push_back(r_out[0].angularDistance(previous_out));
     if (i > 0) run.translation_steps.push_back((t_out[0] - previous_t).norm());
-    if (i > 0 && !jumped) run.largest_input_step = std::max(run.largest_input_step, w * dt);
+    if (i > 0 && !jumped && i * dt <= turn.stop_s) {
+      run.largest_input_step = std::max(run.largest_input_step, w * dt);
+    }
     previous_out = r_out[0];
     previous_t = t_out[0];
   }
@@ -182,6 +196,53 @@ TEST(PoseInertializer, SpeedLimitsHoldTheOffsetsAndTheyStillArrive) {
   }
 }
 
+TEST(PoseInertializer, TheShownJointTurnsNoFasterThanItsInputOrTheCap) {
+  // The output has to catch up 1.5 rad with the input turning the same way. The cap alone lets
+  // the offset's 4 rad/s add to the input's: up to 6 rad/s shown for a 2 rad/s input. Limited,
+  // no frame turns faster than max(input, cap), and it still arrives.
+  for (const double fps : {30.0, 60.0, 120.0}) {
+    const double largest_capped = [&] {
+      const JumpRun run = run_jump(1.5, 0.1, fps, 3.0, 4.0, 3.0, {.w = 2.0});
+      return *std::max_element(run.output_steps.begin(), run.output_steps.end());
+    }();
+    EXPECT_GT(largest_capped, 5.0 / fps) << "fps " << fps;  // the test would catch the sum
+    const JumpRun run =
+        run_jump(1.5, 0.1, fps, 3.0, 4.0, 3.0, {.w = 2.0, .limit_shown_speed = true});
+    for (const double step : run.output_steps) ASSERT_LE(step, 4.0 / fps + 1e-9) << "fps " << fps;
+    EXPECT_LT(run.final_error, 1e-6) << "fps " << fps;
+  }
+}
+
+TEST(PoseInertializer, AnOffsetHeldBehindAFastInputArrivesOnceItSlows) {
+  // The input turns at 5 rad/s, faster than the 4 rad/s cap, for 1.5 s: the shown joint turns
+  // no faster than it (the offset waits), then the input stops and the offset decays home.
+  for (const double fps : {30.0, 60.0, 120.0}) {
+    const JumpRun run = run_jump(1.0, 0.1, fps, 3.0, 4.0, 3.0,
+                                 {.w = 5.0, .stop_s = 1.5, .limit_shown_speed = true});
+    for (const double step : run.output_steps) ASSERT_LE(step, 5.0 / fps + 1e-9) << "fps " << fps;
+    EXPECT_LT(run.final_error, 1e-6) << "fps " << fps;
+  }
+}
+
+TEST(PoseInertializer, TheRootCatchesUpThroughASpin) {
+  // The root turns at 8 rad/s for 2 s after a jump that left it 1 rad behind. Held, it stays
+  // 1 rad behind for the whole spin; with 2 rad/s to catch up it arrives within 1 s, and no
+  // frame turns faster than the input plus that.
+  for (const double fps : {30.0, 60.0, 120.0}) {
+    const double spin_end_s = 30.0 / fps + 2.0;
+    const JumpRun held = run_jump(1.0, 0.1, fps, 30.0 / fps + 1.0, 6.0, 3.0,
+                                  {.w = 8.0, .stop_s = spin_end_s, .limit_shown_speed = true});
+    EXPECT_GT(held.final_error, 0.9) << "fps " << fps;
+    const JumpRun run = run_jump(
+        1.0, 0.1, fps, 30.0 / fps + 1.0, 6.0, 3.0,
+        {.w = 8.0, .stop_s = spin_end_s, .limit_shown_speed = true, .catch_up_rad_s = 2.0});
+    for (const double step : run.output_steps) {
+      ASSERT_LE(step, 10.0 / fps + 1e-9) << "fps " << fps;
+    }
+    EXPECT_LT(run.final_error, 0.01) << "fps " << fps;
+  }
+}
+
 TEST(PoseInertializer, RepeatedJumpsStayBoundedAndFinite) {
   PoseInertializer inertializer(3);
   std::mt19937 rng(11);
@@ -194,7 +255,11 @@ TEST(PoseInertializer, RepeatedJumpsStayBoundedAndFinite) {
       t[static_cast<std::size_t>(j)] = Vec3(n(rng), n(rng), n(rng));
     }
     inertializer.transition(shown_t, shown_r, t, r);  // a jump every frame
-    inertializer.update(t, r, 0.1, 1.0 / 60, shown_t, shown_r);
+    inertializer.update(t, r, 0.1, 1.0 / 60, shown_t, shown_r,
+                        {.max_rotation_speed_rad_s = 6.0,
+                         .max_translation_speed_mps = 4.0,
+                         .limit_shown_speed = i % 2 == 0,
+                         .root_catch_up_rad_s = 2.0});
     for (int j = 0; j < 3; ++j) {
       ASSERT_TRUE(shown_r[static_cast<std::size_t>(j)].coeffs().allFinite());
       ASSERT_TRUE(shown_t[static_cast<std::size_t>(j)].allFinite());

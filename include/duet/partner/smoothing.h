@@ -77,16 +77,36 @@ class PoseInertializer {
                   std::span<const Quat> source_rotations_ls,
                   std::span<const Vec3> destination_translations_ls,
                   std::span<const Quat> destination_rotations_ls) noexcept;
-  // Decays the offsets by dt_s and writes input + offset to out (out may alias in). No offset
-  // changes faster than max_rotation_speed_rad_s (each joint's rotation vector) or
-  // max_translation_speed_mps (infinity or <= 0: no limit): a large offset (a jump to a far
-  // place) then crosses at that speed and the short half-life only shapes its end, where a
-  // half-life long enough to keep the whole decay under the speed leaves a long tail.
+  // How fast update() lets the offsets change.
+  struct Limits {
+    // No offset changes faster than these (each joint's rotation vector; each translation;
+    // infinity or <= 0: no limit): a large offset (a jump to a far place) then crosses at that
+    // speed and the short half-life only shapes its end, where a half-life long enough to keep
+    // the whole decay under the speed leaves a long tail.
+    double max_rotation_speed_rad_s = std::numeric_limits<double>::infinity();
+    double max_translation_speed_mps = std::numeric_limits<double>::infinity();
+    // With a finite max_rotation_speed_rad_s: each rotation offset also changes no faster than
+    // keeps the joint shown turning, from the rotation shown last update, at most as fast as its
+    // input turns or max_rotation_speed_rad_s, whichever is faster, so the blend never adds its
+    // speed to a joint the input already turns fast. The offset is held, not dropped: it decays
+    // once the input slows or turns the other way. A transition's cut is not counted as the
+    // input turning.
+    bool limit_shown_speed = false;
+    // ... but the root (joint 0) may turn this much faster than its input: a facing held
+    // through a whole spin would keep the body turned away for as long as the spin lasts.
+    double root_catch_up_rad_s = 0.0;
+  };
+  // Decays the offsets by dt_s within `limits` and writes input + offset to out (out may alias
+  // in).
   void update(std::span<const Vec3> translations_ls, std::span<const Quat> rotations_ls,
               double half_life_s, double dt_s, std::span<Vec3> translations_out,
-              std::span<Quat> rotations_out,
-              double max_rotation_speed_rad_s = std::numeric_limits<double>::infinity(),
-              double max_translation_speed_mps = std::numeric_limits<double>::infinity()) noexcept;
+              std::span<Quat> rotations_out, const Limits& limits) noexcept;
+  void update(std::span<const Vec3> translations_ls, std::span<const Quat> rotations_ls,
+              double half_life_s, double dt_s, std::span<Vec3> translations_out,
+              std::span<Quat> rotations_out) noexcept {
+    update(translations_ls, rotations_ls, half_life_s, dt_s, translations_out, rotations_out,
+           Limits{});
+  }
 
   // Largest remaining rotation offset over all joints, radians (0 after convergence).
   double max_rotation_offset() const noexcept;
@@ -102,6 +122,9 @@ class PoseInertializer {
   std::vector<Vec3> rotation_v_;  // their rates, rad/s
   std::vector<Vec3> translation_x_;
   std::vector<Vec3> translation_v_;
+  std::vector<Quat> previous_input_;   // each joint's input rotation last update
+  std::vector<Quat> previous_output_;  // and the rotation shown
+  bool has_previous_ = false;
 };
 
 }  // namespace duet
