@@ -240,7 +240,7 @@ struct PartnerParams {
   bool blend_speed_limited = true;
   // With blend_speed_limited: an offset also changes no faster than keeps each joint shown
   // turning at most as fast as the captured pose under it turns, or blend_max_speed_rad_s,
-  // whichever is faster (PoseInertializer::update's limit_shown_speed). The caps alone let the
+  // whichever is faster (PoseInertializer::Limits::limit_shown_speed). The caps alone let the
   // blend's 6 rad/s add to a joint the capture already turns fast, and on improvised dances the
   // partner's p99 largest joint speed reached 1.11-1.14x the captured partner's on takes the
   // tuning had not seen (issue 11's 1.1x). Measured in docs/evaluation.md ("A blend no faster
