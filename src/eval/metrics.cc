@@ -6,6 +6,8 @@
 #include <limits>
 #include <utility>
 
+#include "duet/eval/look_alike_frames.h"
+
 namespace duet {
 
 namespace {
@@ -50,7 +52,8 @@ double frame_error_ms(const TruthFrame& truth, const FrameEstimate& estimate,
 }
 
 void MetricsAccumulator::add(std::span<const TruthFrame> truth, std::span<const double> times_s,
-                             std::span<const FrameEstimate> estimates, double template_rate_hz) {
+                             std::span<const FrameEstimate> estimates, double template_rate_hz,
+                             const LookAlikeFrames* look_alikes) {
   assert(truth.size() == times_s.size() && truth.size() == estimates.size());
   const std::size_t n = std::min({truth.size(), times_s.size(), estimates.size()});
   std::vector<double> errors(n, 0.0);
@@ -66,6 +69,10 @@ void MetricsAccumulator::add(std::span<const TruthFrame> truth, std::span<const 
     if (estimates[i].take < 0 || estimates[i].take != truth[i].take) ++misses_;
     if (estimates[i].lost) ++lost_;
     calibration_.add(estimates[i].confidence, errors[i] <= 100.0);
+    if (errors[i] <= 100.0 ||
+        (look_alikes != nullptr && look_alikes->shows_the_same(truth[i], estimates[i]))) {
+      ++within_100ms_alike_;
+    }
     if (errors[i] <= 100.0) {
       ++tracked_;
       if (estimates[i].lost) ++lost_on_tracked_;
@@ -133,6 +140,7 @@ void MetricsAccumulator::merge(const MetricsAccumulator& other) {
   tracked_ += other.tracked_;
   lost_on_tracked_ += other.lost_on_tracked_;
   lost_switches_ += other.lost_switches_;
+  within_100ms_alike_ += other.within_100ms_alike_;
   reported_jumps_ += other.reported_jumps_;
   false_jumps_ += other.false_jumps_;
   duration_s_ += other.duration_s_;
@@ -157,6 +165,7 @@ Metrics MetricsAccumulator::summary() const {
     m.within_50ms = static_cast<double>(w50) / scored;
     m.within_100ms = static_cast<double>(w100) / scored;
     m.within_300ms = static_cast<double>(w300) / scored;
+    m.within_100ms_alike = static_cast<double>(within_100ms_alike_) / scored;
     m.miss_fraction = static_cast<double>(misses_) / scored;
     m.mean_error_ms = sum / scored;
     m.median_error_ms = median(errors_ms_);

@@ -6,7 +6,9 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 
+#include "duet/eval/look_alike_frames.h"
 #include "duet/follow/beam_follower.h"
 #include "duet/follow/hmm_follower.h"
 #include "duet/follow/naive_hmm.h"
@@ -468,8 +470,20 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
   }
   long long done = 0;
 
+  // Which misses show the user what the truth shows (Metrics::within_100ms_alike), per library.
+  Result<LookAlikeFrames> look_alikes = LookAlikeFrames::build(library);
+  if (!look_alikes) return look_alikes.error();
+  std::optional<LookAlikeFrames> partner_look_alikes;
+  if (std::ranges::any_of(options.cases, [](const EvalCase& c) { return c.partner_role; })) {
+    Result<LookAlikeFrames> built = LookAlikeFrames::build(*partner_library);
+    if (!built) return built.error();
+    partner_look_alikes = std::move(built).value();
+  }
+
   for (const EvalCase& eval_case : options.cases) {
     const DuetLibrary& lib = eval_case.partner_role ? *partner_library : library;
+    const LookAlikeFrames& lib_look_alikes =
+        eval_case.partner_role ? *partner_look_alikes : look_alikes.value();
     std::vector<MetricsAccumulator> pooled(trackers.size(), MetricsAccumulator(options.metrics));
     std::vector<std::vector<std::pair<int, Metrics>>> per_take(trackers.size());
     std::vector<std::vector<ScoredFrame>> kept(trackers.size());
@@ -504,7 +518,7 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
             follow_performance(lib, performance, std::move(tracker).value());
         if (!estimates) return Error{label + ": " + estimates.error().message};
         MetricsAccumulator one(options.metrics);
-        one.add(performance, estimates.value());
+        one.add(performance, estimates.value(), &lib_look_alikes);
         if (options.keep_frames) {
           for (std::size_t f = 0; f < estimates.value().size(); ++f) {
             const TruthFrame& truth = performance.truth[f];

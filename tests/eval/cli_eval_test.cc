@@ -88,6 +88,12 @@ TEST(CliEval, RunsCasesAndWritesTableCsvAndPlots) {
   EXPECT_GT(std::stoi(improv.at("jumps")), 3);
   EXPECT_GT(std::stoi(improv.at("pause_frames")), 0);
   EXPECT_GT(std::stod(improv.at("acc_100ms")), 0.6) << r.output;
+  // What the user could see: never below acc@100, which it contains.
+  for (const auto& [key, row] : rows) {
+    EXPECT_GE(std::stod(row.at("acc_100ms_alike")), std::stod(row.at("acc_100ms")))
+        << key.first << " " << key.second;
+  }
+  EXPECT_NE(r.output.find("alike"), std::string::npos) << r.output;
   EXPECT_GT(std::stod(clean.at("mean_step_us")), 0.0);
   // The naive forward agrees with the O(M) one.
   const std::string text = read_text(csv);

@@ -16,6 +16,8 @@
 
 namespace duet {
 
+class LookAlikeFrames;
+
 // What a tracker said about one input frame (a FollowResult reduced to what is scored).
 struct FrameEstimate {
   int take = -1;           // -1: no estimate
@@ -58,6 +60,10 @@ struct Metrics {
   double within_50ms = 0.0;
   double within_100ms = 0.0;
   double within_300ms = 0.0;
+  // Within 100 ms, or showing what the true frame shows (look_alike_frames.h: the dancers
+  // standing at another take's start look alike, and so do their partners); equal to
+  // within_100ms when no judge was given.
+  double within_100ms_alike = 0.0;
   double miss_fraction = 0.0;  // scored frames in the wrong take or without estimate
   double mean_error_ms = 0.0;  // over scored frames, each capped at miss_error_ms
   double median_error_ms = 0.0;
@@ -94,11 +100,15 @@ class MetricsAccumulator {
  public:
   explicit MetricsAccumulator(MetricsOptions options = {}) : options_(options) {}
 
-  // truth, times_s and estimates have one entry per frame.
+  // truth, times_s and estimates have one entry per frame. look_alikes (optional) judges which
+  // estimates more than 100 ms off show what the truth shows (Metrics::within_100ms_alike).
   void add(std::span<const TruthFrame> truth, std::span<const double> times_s,
-           std::span<const FrameEstimate> estimates, double template_rate_hz);
-  void add(const Performance& performance, std::span<const FrameEstimate> estimates) {
-    add(performance.truth, performance.times_s, estimates, performance.template_rate_hz);
+           std::span<const FrameEstimate> estimates, double template_rate_hz,
+           const LookAlikeFrames* look_alikes = nullptr);
+  void add(const Performance& performance, std::span<const FrameEstimate> estimates,
+           const LookAlikeFrames* look_alikes = nullptr) {
+    add(performance.truth, performance.times_s, estimates, performance.template_rate_hz,
+        look_alikes);
   }
   void merge(const MetricsAccumulator& other);
 
@@ -113,6 +123,7 @@ class MetricsAccumulator {
   long long frames_ = 0, pause_frames_ = 0, lost_ = 0, misses_ = 0;
   long long tracked_ = 0, lost_on_tracked_ = 0, reported_jumps_ = 0, false_jumps_ = 0;
   long long lost_switches_ = 0;
+  long long within_100ms_alike_ = 0;
   double duration_s_ = 0.0;
   double step_us_sum_ = 0.0;
 };
