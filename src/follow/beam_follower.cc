@@ -6,7 +6,6 @@
 #include <cmath>
 #include <string>
 
-#include "duet/follow/confidence_calibration.h"
 #include "forward_common.h"
 
 namespace duet {
@@ -489,30 +488,7 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
                                    context.history_.previous_lost, result, unexplained);
   if (dense && !result.missing) rebuild_beam(context);
 
-  const bool past_ceiling = result.lost;  // the emission's test (false without features)
-  result.lost = result.missing ? context.history_.previous_lost : (result.lost || result.in_pause);
-  if (params.calibrate_confidence) {
-    result.confidence =
-        ConfidenceCalibration::apply(result.window_mass, result.sensor_noise_per_dim);
-  }
-  if (params.tempo_adaptive) {
-    const bool band_move = !result.missing && !result.lost && !result.jumped;
-    context.history_.tempo.update(context.history_.previous_state, result.state, result.steps, dt_s,
-                                  band_move, exact_.tempo_limits_);
-  }
-  context.history_.tempo.observe_rate(result.steps, dt_s, model.frame_rate_hz(),
-                                      exact_.tempo_limits_);
-  result.tempo = context.history_.tempo.dancer_tempo();
-  context.history_.total_log_likelihood += result.log_likelihood;
-  ++context.history_.frames;
-  context.history_.previous_state = result.state;
-  context.history_.previous_lost = result.lost;
-  context.history_.previous_outlier = result.outlier;
-  context.history_.explained_residual.update(
-      result.best_distance_per_dim,
-      !result.missing && !result.outlier && !result.in_pause && !result.jumped, dt_s);
-  result.lost = context.history_.report_lost(params, result.lost, past_ceiling, unexplained,
-                                             result.missing, result.steps / model.frame_rate_hz());
+  context.history_.finish_step(model, params, exact_.tempo_limits_, unexplained, dt_s, result);
   return result;
 }
 

@@ -1,5 +1,7 @@
 #include "duet/follow/follower_history.h"
 
+#include "duet/follow/confidence_calibration.h"
+
 namespace duet {
 
 FollowerHistory::FollowerHistory(const TemplateModel& model, const FollowParams& params)
@@ -23,6 +25,33 @@ void FollowerHistory::reset() noexcept {
   sensor_noise.reset();
   noise_filter.reset();
   explained_residual.reset();
+}
+
+void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams& params,
+                                  const TempoLimits& limits, bool unexplained, double dt_s,
+                                  FollowResult& result) noexcept {
+  const bool past_ceiling = result.lost;  // the emission's test (false without features)
+  result.lost = result.missing ? previous_lost : (result.lost || result.in_pause);
+  if (params.calibrate_confidence) {
+    result.confidence =
+        ConfidenceCalibration::apply(result.window_mass, result.sensor_noise_per_dim);
+  }
+  if (params.tempo_adaptive) {
+    const bool band_move = !result.missing && !result.lost && !result.jumped;
+    tempo.update(previous_state, result.state, result.steps, dt_s, band_move, limits);
+  }
+  tempo.observe_rate(result.steps, dt_s, model.frame_rate_hz(), limits);
+  result.tempo = tempo.dancer_tempo();
+  total_log_likelihood += result.log_likelihood;
+  ++frames;
+  previous_state = result.state;
+  previous_lost = result.lost;
+  previous_outlier = result.outlier;
+  explained_residual.update(
+      result.best_distance_per_dim,
+      !result.missing && !result.outlier && !result.in_pause && !result.jumped, dt_s);
+  result.lost = report_lost(params, result.lost, past_ceiling, unexplained, result.missing,
+                            result.steps / model.frame_rate_hz());
 }
 
 }  // namespace duet

@@ -5,7 +5,6 @@
 #include <cassert>
 #include <cmath>
 
-#include "duet/follow/confidence_calibration.h"
 #include "forward_common.h"
 
 namespace duet {
@@ -237,30 +236,7 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
           noise_levels_.lost_distance_sq(noise, context.history_.explained_residual.level());
   context.history_.jump_gate.apply(model, params_, alpha, 1.0f, context.history_.previous_state,
                                    context.history_.previous_lost, result, unexplained);
-  const bool past_ceiling = result.lost;  // the emission's test (false without features)
-  result.lost = result.missing ? context.history_.previous_lost : (result.lost || result.in_pause);
-  if (params_.calibrate_confidence) {
-    result.confidence =
-        ConfidenceCalibration::apply(result.window_mass, result.sensor_noise_per_dim);
-  }
-  if (params_.tempo_adaptive) {
-    const bool band_move = !result.missing && !result.lost && !result.jumped;
-    context.history_.tempo.update(context.history_.previous_state, result.state, result.steps, dt_s,
-                                  band_move, tempo_limits_);
-  }
-  context.history_.tempo.observe_rate(result.steps, dt_s, model.frame_rate_hz(), tempo_limits_);
-  result.tempo = context.history_.tempo.dancer_tempo();
-
-  context.history_.total_log_likelihood += result.log_likelihood;
-  ++context.history_.frames;
-  context.history_.previous_state = result.state;
-  context.history_.previous_lost = result.lost;
-  context.history_.previous_outlier = result.outlier;
-  context.history_.explained_residual.update(
-      result.best_distance_per_dim,
-      !result.missing && !result.outlier && !result.in_pause && !result.jumped, dt_s);
-  result.lost = context.history_.report_lost(params_, result.lost, past_ceiling, unexplained,
-                                             result.missing, result.steps / model.frame_rate_hz());
+  context.history_.finish_step(model, params_, tempo_limits_, unexplained, dt_s, result);
   return result;
 }
 

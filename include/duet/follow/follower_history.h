@@ -12,6 +12,7 @@
 #include "duet/follow/sensor_noise.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tempo_band.h"
+#include "duet/follow/tracker.h"
 
 namespace duet {
 
@@ -64,14 +65,22 @@ struct FollowerHistory {
     return ceiling_lost.report(params, gate_lost, past_ceiling, missing) || by_distance;
   }
 
+  // Completes a step's result once its estimate and jump are decided, the same for the exact
+  // and the beam step: lost (the emission's ceiling `result.lost`, the pause state, or
+  // `unexplained`), the calibrated confidence, the dancer's tempo (taught by moves within the
+  // band, `limits`), and this frame remembered for the next. Allocates nothing.
+  void finish_step(const TemplateModel& model, const FollowParams& params,
+                   const TempoLimits& limits, bool unexplained, double dt_s,
+                   FollowResult& result) noexcept;
+
   double total_log_likelihood = 0.0;  // a sum over the whole performance, hence double
   long long frames = 0;
   int previous_state = -1;
   bool previous_lost = false;
-  bool previous_outlier = false;  // the previous frame's evidence was set aside (outlier gate)
-  bool lost_by_distance = false;  // confirm_unexplained's decision
+  bool previous_outlier = false;   // the previous frame's evidence was set aside (outlier gate)
+  bool lost_by_distance = false;   // confirm_unexplained's decision
   CeilingLostReport ceiling_lost;  // report_lost's ceiling test
-  double against_s = 0.0;         // input time the frames have disagreed with it, consecutively
+  double against_s = 0.0;          // input time the frames have disagreed with it, consecutively
   TempoEstimator tempo;
   JumpGate jump_gate;
   SensorNoiseEstimator sensor_noise;
