@@ -1,52 +1,16 @@
 // Retargeter::retarget_frame allocates nothing after set-up (the per-frame path of a live
 // avatar). This file replaces the global operator new of the motion test program with a counting
-// one; counting is on only inside the measured region.
+// one (counting_new.h); counting is on only inside the measured region.
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
-#include <new>
 #include <vector>
 
+#include "counting_new.h"
 #include "duet/io/motion_file.h"
 #include "duet/motion/retarget.h"
 #include "duet/motion/rig_variants.h"
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-
-void* counted_alloc(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* counted_aligned_alloc(std::size_t size, std::align_val_t align) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-  const auto a = static_cast<std::size_t>(align);
-  if (void* p = std::aligned_alloc(a, (size + a - 1) / a * a)) return p;
-  throw std::bad_alloc();
-}
-}  // namespace
-
-void* operator new(std::size_t size) { return counted_alloc(size); }
-void* operator new[](std::size_t size) { return counted_alloc(size); }
-void* operator new(std::size_t size, std::align_val_t align) {
-  return counted_aligned_alloc(size, align);
-}
-void* operator new[](std::size_t size, std::align_val_t align) {
-  return counted_aligned_alloc(size, align);
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 
 namespace duet {
 namespace {
@@ -67,16 +31,16 @@ TEST(Retargeter, PerFrameCallAllocatesNothing) {
   std::vector<Vec3> translations(n);
   std::vector<Quat> rotations(n);
 
-  g_allocations = 0;
-  g_counting = true;
+  test::g_allocations = 0;
+  test::g_counting = true;
   const auto start = std::chrono::steady_clock::now();
   for (int f = 0; f < source.frame_count(); ++f) {
     retargeter.value().retarget_frame(source.translations_ls(f), source.rotations_ls(f),
                                       translations, rotations);
   }
   const auto stop = std::chrono::steady_clock::now();
-  g_counting = false;
-  EXPECT_EQ(g_allocations.load(), 0);
+  test::g_counting = false;
+  EXPECT_EQ(test::g_allocations.load(), 0);
   std::printf(
       "retarget_frame, salsa (43 joints) -> handshake rig (38 joints): %.2f us per frame\n",
       std::chrono::duration<double, std::micro>(stop - start).count() / source.frame_count());

@@ -1,49 +1,13 @@
 // The per-frame path allocates nothing after set-up (architecture.md: run time). This file
-// replaces the global operator new of the partner test program with a counting one; counting is
-// on only inside the measured region.
+// replaces the global operator new of the partner test program with a counting one
+// (counting_new.h); counting is on only inside the measured region.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
 #include <vector>
 
+#include "counting_new.h"
 #include "duet/partner/partner_synthesis.h"
 #include "partner/synthetic_partner.h"
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-
-void* counted_alloc(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* counted_aligned_alloc(std::size_t size, std::align_val_t align) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-  const auto a = static_cast<std::size_t>(align);
-  if (void* p = std::aligned_alloc(a, (size + a - 1) / a * a)) return p;
-  throw std::bad_alloc();
-}
-}  // namespace
-
-void* operator new(std::size_t size) { return counted_alloc(size); }
-void* operator new[](std::size_t size) { return counted_alloc(size); }
-void* operator new(std::size_t size, std::align_val_t align) {
-  return counted_aligned_alloc(size, align);
-}
-void* operator new[](std::size_t size, std::align_val_t align) {
-  return counted_aligned_alloc(size, align);
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 
 namespace duet {
 namespace {
@@ -75,8 +39,8 @@ TEST(PartnerSynthesis, PerFrameCallAllocatesNothing) {
     users.back().wrist_positions_ws[0].y() += 0.05;
   }
 
-  g_allocations = 0;
-  g_counting = true;
+  test::g_allocations = 0;
+  test::g_counting = true;
   bool ok = true;
   for (int i = 0; i < 1000; ++i) {
     const int frame = (i * 7 / 5) % 200;
@@ -96,9 +60,9 @@ TEST(PartnerSynthesis, PerFrameCallAllocatesNothing) {
     job.info = &info;
     ok = job.run() && ok;
   }
-  g_counting = false;
+  test::g_counting = false;
   EXPECT_TRUE(ok);
-  EXPECT_EQ(g_allocations.load(), 0);
+  EXPECT_EQ(test::g_allocations.load(), 0);
 }
 
 }  // namespace
