@@ -184,7 +184,7 @@ TEST(JumpGate, AdriftFromTheFirstFrameIsASpellWithNoPlaceToJumpFrom) {
   // jump, nor is the first place found; from there on, jumps count as usual.
   const TemplateModel model = two_takes();
   FollowParams params;
-  params.jump_settle_s = 0.0f;  // settled at once, as after a performance's first second
+  params.jump_settle_s = 0.0f;  // settled at once, as after a performance's first 0.3 s
   params.jump_hold_s = 0.0f;
   JumpGate gate;
   int previous = -1;

@@ -187,11 +187,8 @@ struct FollowParams {
   // the new place without reporting a jump. 0: every far move is a jump from the first frame on.
   // 0.3 s (0.1 before session 6): at 4 degrees per axis the first placement can sit on a
   // look-alike for a few frames at a time for seconds (`improv-30hz-noisy` seed 3: 8.4 -> 1.1
-  // false jumps a minute); docs/follower.md, "Jump decisions". 1 s since session 24: an inertial
-  // suit or another rig is found by a first placement that moves between look-alikes for longer
-  // (false jumps over two take sets and every rig, suit and three points: 69 -> 32, 25 -> 14 and
-  // 758 -> 579, accuracy and every true jump's recovery unchanged).
-  float jump_settle_s = 1.0f;
+  // false jumps a minute); docs/follower.md, "Jump decisions".
+  float jump_settle_s = 0.3f;
   // ... counting only frames the follower is sure of (window mass at least jump_settle_mass):
   // under noise the first placement often sits on a look-alike place of another take with a
   // window mass of 0.6-0.97 before the maximum moves on. 0: every frame within reach counts.
