@@ -6,6 +6,7 @@
 
 #include "duet/eval/metrics.h"
 #include "duet/live/duet_library.h"
+#include "duet/math/rotation.h"
 
 namespace duet {
 
@@ -84,8 +85,7 @@ bool LookAlikeFrames::alike(int take_a, int frame_a, int take_b, int frame_b) co
   const RootPlacement& pb = placements_[static_cast<std::size_t>(take_b)].placement(frame_b);
   const double apart =
       std::hypot(pa.position_hs.x() - pb.position_hs.x(), pa.position_hs.z() - pb.position_hs.z());
-  double turn = std::abs(pa.relative_yaw_rad() - pb.relative_yaw_rad());
-  turn = std::min(turn, 2.0 * M_PI - turn);
+  const double turn = std::abs(wrap_angle(pa.relative_yaw_rad() - pb.relative_yaw_rad()));
   return apart <= options_.placement_m && turn <= options_.facing_rad;
 }
 

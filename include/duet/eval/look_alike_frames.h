@@ -18,6 +18,7 @@
 #include "duet/base/result.h"
 #include "duet/eval/performance.h"
 #include "duet/features/feature_extractor.h"
+#include "duet/math/rotation.h"
 #include "duet/partner/alignment.h"
 
 namespace duet {
@@ -34,7 +35,7 @@ struct LookAlikeOptions {
   // How far the partner may stand (horizontally) and face from where it stands and faces at the
   // true frame, relative to the dancer.
   double placement_m = 0.1;
-  double facing_rad = 0.1745;  // 10 degrees
+  double facing_rad = deg_to_rad(10.0);
   // The true frame's window: template frames within this of it (the accuracy's 100 ms).
   double window_ms = 100.0;
 };
