@@ -25,6 +25,24 @@ double median(std::vector<double> values) {
   return std::isinf(a) || std::isinf(b) ? kInf : 0.5 * (a + b);
 }
 
+// The first scored frame from which every scored frame's error stays within tolerance_ms for
+// hold_s (pause frames neither break nor count), or n when there is none.
+std::size_t first_found_frame(std::span<const TruthFrame> truth, std::span<const double> times_s,
+                              const std::vector<double>& errors, double tolerance_ms,
+                              double hold_s, std::size_t n) {
+  std::size_t start = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (truth[i].in_pause) continue;
+    if (errors[i] > tolerance_ms) {
+      start = n;
+      continue;
+    }
+    if (start == n) start = i;
+    if (times_s[i] - times_s[start] >= hold_s) return start;
+  }
+  return n;
+}
+
 }  // namespace
 
 FrameEstimate frame_estimate(const FollowResult& r, double step_us) {
@@ -100,6 +118,19 @@ void MetricsAccumulator::add(std::span<const TruthFrame> truth, std::span<const 
     if (!answers) ++false_jumps_;
   }
 
+  // Finding the dance (Metrics::median_find_s).
+  if (n > 0) {
+    const std::size_t found = first_found_frame(truth, times_s, errors,
+                                                options_.recovery_tolerance_ms,
+                                                options_.find_hold_s, n);
+    find_s_.push_back(found < n ? times_s[found] - times_s[0] : kInf);
+    for (std::size_t i = found; i < n; ++i) {
+      if (truth[i].in_pause) continue;
+      ++found_scored_;
+      if (errors[i] <= 100.0) ++found_within_100ms_;
+    }
+  }
+
   // Jump recovery: first frame after the jump from which the error stays within tolerance for
   // the hold time (and at least 3 frames), before the next pause or jump.
   const double tolerance = options_.recovery_tolerance_ms;
@@ -132,6 +163,9 @@ void MetricsAccumulator::add(std::span<const TruthFrame> truth, std::span<const 
 void MetricsAccumulator::merge(const MetricsAccumulator& other) {
   errors_ms_.insert(errors_ms_.end(), other.errors_ms_.begin(), other.errors_ms_.end());
   recovery_s_.insert(recovery_s_.end(), other.recovery_s_.begin(), other.recovery_s_.end());
+  find_s_.insert(find_s_.end(), other.find_s_.begin(), other.find_s_.end());
+  found_scored_ += other.found_scored_;
+  found_within_100ms_ += other.found_within_100ms_;
   calibration_.merge(other.calibration_);
   frames_ += other.frames_;
   pause_frames_ += other.pause_frames_;
@@ -189,6 +223,11 @@ Metrics MetricsAccumulator::summary() const {
   m.median_recovery_s = median(recovery_s_);
   m.mean_recovery_s =
       m.recovered_jumps > 0 ? recovered_sum / static_cast<double>(m.recovered_jumps) : 0.0;
+  m.median_find_s = median(find_s_);
+  m.worst_find_s = find_s_.empty() ? 0.0 : std::ranges::max(find_s_);
+  m.within_100ms_found = found_scored_ > 0 ? static_cast<double>(found_within_100ms_) /
+                                                 static_cast<double>(found_scored_)
+                                           : 0.0;
   m.mean_step_us = frames_ > 0 ? step_us_sum_ / static_cast<double>(frames_) : 0.0;
   m.confidence_ece = calibration_.expected_calibration_error();
   m.reliability = calibration_.diagram();

@@ -19,6 +19,12 @@ std::string recovery_text(const Metrics& m) {
   return fmt::format("{:.2f}", m.median_recovery_s);
 }
 
+// The median time to find the dance (Metrics::median_find_s).
+std::string find_text(const Metrics& m) {
+  if (std::isinf(m.median_find_s)) return "never";
+  return fmt::format("{:.2f}", m.median_find_s);
+}
+
 std::string number_or_empty(double value, int decimals) {
   if (std::isinf(value)) return "inf";
   return fmt::format("{:.{}f}", value, decimals);
@@ -29,14 +35,15 @@ void append_csv_row(std::string& out, const std::string& case_name, const std::s
   fmt::format_to(
       std::back_inserter(out),
       "{},{},{},{},{},{},{},{:.5f},{:.5f},{:.5f},{:.5f},{:.2f},{:.2f},{},{},{},{},{:.5f},"
-      "{:.2f},{},{},{:.3f},{:.5f},{:.5f},{:.3f},{:.5f}\n",
+      "{:.2f},{},{},{:.3f},{:.5f},{:.5f},{:.3f},{:.5f},{},{},{:.5f}\n",
       case_name, tracker, take, take_name, m.frames, m.scored_frames, m.pause_frames, m.within_50ms,
       m.within_100ms, m.within_300ms, m.miss_fraction, m.mean_error_ms, m.median_error_ms, m.jumps,
       m.recovered_jumps, m.jumps ? number_or_empty(m.median_recovery_s, 4) : "",
       m.recovered_jumps ? number_or_empty(m.mean_recovery_s, 4) : "", m.lost_fraction,
       m.mean_step_us, m.reported_jumps, m.false_jumps, m.false_jumps_per_minute,
       m.lost_on_tracked_fraction, m.confidence_ece, m.lost_switches_per_minute,
-      m.within_100ms_alike);
+      m.within_100ms_alike, number_or_empty(m.median_find_s, 3),
+      number_or_empty(m.worst_find_s, 3), m.within_100ms_found);
 }
 
 std::string take_name(const EvalReport& report, int take) {
@@ -341,10 +348,10 @@ std::string format_partner_csv(const EvalReport& report) {
 std::string format_eval_table(const EvalReport& report) {
   std::string out;
   constexpr const char* kHeader =
-      "{:<18} {:<14} {:>7} {:>7} {:>7} {:>7} {:>7} {:>8} {:>7} {:>7} {:>7} {:>6} {:>6} {:>8} "
-      "{:>6} {:>8}\n";
+      "{:<18} {:<14} {:>7} {:>7} {:>7} {:>7} {:>6} {:>7} {:>8} {:>7} {:>7} {:>7} {:>6} {:>6} "
+      "{:>8} {:>6} {:>8}\n";
   fmt::format_to(std::back_inserter(out), kHeader, "case", "tracker", "frames", "acc@50", "acc@100",
-                 "alike", "acc@300", "mean ms", "med ms", "jumps", "recov s", "fj/min", "lost",
+                 "alike", "find s", "acc@300", "mean ms", "med ms", "jumps", "recov s", "fj/min", "lost",
                  "lost trk", "ECE", "us/frame");
   std::string previous_case;
   for (const EvalRow& row : report.rows) {
@@ -355,7 +362,7 @@ std::string format_eval_table(const EvalReport& report) {
         m.jumps ? fmt::format("{}/{}", m.recovered_jumps, m.jumps) : std::string("-");
     fmt::format_to(std::back_inserter(out), kHeader, row.case_name, row.tracker, m.scored_frames,
                    percent(m.within_50ms), percent(m.within_100ms), percent(m.within_100ms_alike),
-                   percent(m.within_300ms), fmt::format("{:.1f}", m.mean_error_ms),
+                   find_text(m), percent(m.within_300ms), fmt::format("{:.1f}", m.mean_error_ms),
                    fmt::format("{:.1f}", m.median_error_ms), jumps, recovery_text(m),
                    fmt::format("{:.1f}", m.false_jumps_per_minute), percent(m.lost_fraction),
                    percent(m.lost_on_tracked_fraction), percent(m.confidence_ece),
@@ -383,7 +390,7 @@ std::string format_eval_csv(const EvalReport& report) {
       "miss_fraction,mean_error_ms,median_error_ms,jumps,recovered_jumps,median_recovery_s,"
       "mean_recovery_s,lost_fraction,mean_step_us,reported_jumps,false_jumps,"
       "false_jumps_per_minute,lost_on_tracked_fraction,confidence_ece,lost_switches_per_minute,"
-      "acc_100ms_alike\n";
+      "acc_100ms_alike,median_find_s,worst_find_s,acc_100ms_found\n";
   for (const EvalRow& row : report.rows) {
     for (const auto& [take, metrics] : row.per_take) {
       append_csv_row(out, row.case_name, row.tracker, std::to_string(take), take_name(report, take),

@@ -94,6 +94,10 @@ TEST(CliEval, RunsCasesAndWritesTableCsvAndPlots) {
         << key.first << " " << key.second;
   }
   EXPECT_NE(r.output.find("alike"), std::string::npos) << r.output;
+  // The clean take is found at once and followed from there.
+  EXPECT_LT(std::stod(clean.at("median_find_s")), 0.5) << r.output;
+  EXPECT_GE(std::stod(clean.at("acc_100ms_found")), std::stod(clean.at("acc_100ms")));
+  EXPECT_NE(r.output.find("find s"), std::string::npos) << r.output;
   EXPECT_GT(std::stod(clean.at("mean_step_us")), 0.0);
   // The naive forward agrees with the O(M) one.
   const std::string text = read_text(csv);

@@ -195,5 +195,51 @@ TEST(Metrics, PoolsPerformances) {
   EXPECT_DOUBLE_EQ(m.median_error_ms, 1000.0);
 }
 
+TEST(Metrics, TheDanceIsFoundWhereTheEstimateFirstStaysRightForASecond) {
+  Trace t(240);
+  // A standing start guessed in another take for half a second, one frame right in it, then
+  // right with a single slip at frame 50: the hold from 30 breaks there, so the dance is found
+  // at frame 51. The pause frames 100-129 (anything goes) neither break nor count.
+  for (int k = 0; k < 30; ++k) t.estimates[static_cast<std::size_t>(k)].take = 4;
+  t.estimates[12].take = 0;
+  t.estimates[50].frame_in_take += 12;  // 200 ms off
+  for (int k = 100; k < 130; ++k) {
+    t.truth[static_cast<std::size_t>(k)].in_pause = true;
+    t.estimates[static_cast<std::size_t>(k)].take = 4;
+  }
+  t.estimates[200].take = 4;  // a later miss counts against the dance once found
+  const Metrics m = t.metrics();
+  EXPECT_NEAR(m.median_find_s, 51.0 / kFps, 1e-12);
+  EXPECT_NEAR(m.worst_find_s, 51.0 / kFps, 1e-12);
+  EXPECT_NEAR(m.within_100ms_found, (240.0 - 51.0 - 30.0 - 1.0) / (240.0 - 51.0 - 30.0), 1e-12);
+
+  // Held for less than find_hold_s: never found.
+  MetricsOptions strict;
+  strict.find_hold_s = 5.0;
+  const Metrics never = t.metrics(strict);
+  EXPECT_TRUE(std::isinf(never.median_find_s));
+  EXPECT_DOUBLE_EQ(never.within_100ms_found, 0.0);
+}
+
+TEST(Metrics, FindingPoolsAsAMedianOverPerformances) {
+  Trace found_at_once(120), found_late(240), never(240);
+  for (int k = 0; k < 90; ++k) found_late.estimates[static_cast<std::size_t>(k)].take = 1;
+  for (auto& e : never.estimates) e.take = 1;
+  MetricsAccumulator two;
+  two.add(found_at_once.truth, found_at_once.times, found_at_once.estimates, kFps);
+  two.add(found_late.truth, found_late.times, found_late.estimates, kFps);
+  const Metrics m2 = two.summary();
+  EXPECT_NEAR(m2.median_find_s, 0.5 * (90.0 / kFps), 1e-12);
+  EXPECT_NEAR(m2.worst_find_s, 90.0 / kFps, 1e-12);
+  EXPECT_DOUBLE_EQ(m2.within_100ms_found, 1.0);
+  MetricsAccumulator three;
+  three.add(never.truth, never.times, never.estimates, kFps);
+  three.merge(two);
+  const Metrics m3 = three.summary();
+  EXPECT_NEAR(m3.median_find_s, 90.0 / kFps, 1e-12);
+  EXPECT_TRUE(std::isinf(m3.worst_find_s));
+  EXPECT_DOUBLE_EQ(m3.within_100ms_found, 1.0);  // a performance never found adds no frames
+}
+
 }  // namespace
 }  // namespace duet

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <sstream>
 
 namespace duet {
@@ -173,6 +174,9 @@ TEST(EvalReportCsv, HasTheCalibrationErrorAndTheFramesCsvItsRows) {
   EvalReport report = small_report();
   report.rows[0].metrics.confidence_ece = 0.0123;
   report.rows[0].metrics.within_100ms_alike = 0.875;
+  report.rows[0].metrics.median_find_s = 1.5;
+  report.rows[0].metrics.worst_find_s = std::numeric_limits<double>::infinity();
+  report.rows[0].metrics.within_100ms_found = 0.96;
   FrameEstimate e{0, 5, true, true, 0.0};
   e.confidence = 0.5f;
   e.window_mass = 0.75f;
@@ -183,9 +187,13 @@ TEST(EvalReportCsv, HasTheCalibrationErrorAndTheFramesCsvItsRows) {
   truth.jump = true;
   report.rows[0].frames.push_back({0, 33.3, e, truth});
   const std::string csv = format_eval_csv(report);
-  EXPECT_NE(csv.find(",confidence_ece,lost_switches_per_minute,acc_100ms_alike\n"),
+  EXPECT_NE(csv.find(",confidence_ece,lost_switches_per_minute,acc_100ms_alike,median_find_s,"
+                     "worst_find_s,acc_100ms_found\n"),
             std::string::npos);
-  EXPECT_NE(csv.find(",0.01230,0.000,0.87500\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",0.01230,0.000,0.87500,1.500,inf,0.96000\n"), std::string::npos) << csv;
+  const std::string table = format_eval_table(report);
+  EXPECT_NE(table.find("find s"), std::string::npos) << table;
+  EXPECT_NE(table.find(" 1.50 "), std::string::npos) << table;
   EXPECT_EQ(format_frames_csv(report),
             "case,tracker,take,error_ms,confidence,window_mass,best_distance_per_dim,"
             "sensor_noise_per_dim,lost,in_pause,jumped,true_take,true_frame,estimated_take,"

@@ -45,6 +45,9 @@ struct MetricsOptions {
   // jump itself) to this long after the jump; any other reported jump is false.
   double jump_answer_window_s = 1.0;
   double jump_answer_lead_s = 0.1;
+  // A performance is found (Metrics::median_find_s) at the first frame from which the estimate
+  // stays within recovery_tolerance_ms for this long.
+  double find_hold_s = 1.0;
 };
 
 // Error of one frame in ms of template time, capped at options.miss_error_ms (a wrong take or no
@@ -88,6 +91,15 @@ struct Metrics {
   long long reported_jumps = 0;
   long long false_jumps = 0;
   double false_jumps_per_minute = 0.0;
+  // Finding the dance: the time from a performance's first frame to the first frame from which
+  // the estimate stays within recovery_tolerance_ms for find_hold_s (pause frames neither break
+  // nor count), the median and the largest over the performances (+inf for one never found, in
+  // the median when half or more are), and within 100 ms over the scored frames from there on.
+  // Every take starts with both dancers standing, and standing starts look alike across takes:
+  // this tells a start the follower has to guess apart from a dance it loses (issues 10, 11).
+  double median_find_s = 0.0;
+  double worst_find_s = 0.0;
+  double within_100ms_found = 0.0;
   double mean_step_us = 0.0;  // mean wall-clock time per session step (measured)
   // Calibration of the confidence against "within 100 ms" over the scored frames (calibration.h).
   double confidence_ece = 0.0;
@@ -119,11 +131,13 @@ class MetricsAccumulator {
   MetricsOptions options_;
   std::vector<double> errors_ms_;   // scored frames
   std::vector<double> recovery_s_;  // one per jump, +inf when unrecovered
+  std::vector<double> find_s_;      // one per performance, +inf when never found
   CalibrationAccumulator calibration_;
   long long frames_ = 0, pause_frames_ = 0, lost_ = 0, misses_ = 0;
   long long tracked_ = 0, lost_on_tracked_ = 0, reported_jumps_ = 0, false_jumps_ = 0;
   long long lost_switches_ = 0;
   long long within_100ms_alike_ = 0;
+  long long found_scored_ = 0, found_within_100ms_ = 0;
   double duration_s_ = 0.0;
   double step_us_sum_ = 0.0;
 };
