@@ -26,10 +26,11 @@ double median(std::vector<double> values) {
 }
 
 // The first scored frame from which every scored frame's error stays within tolerance_ms for
-// hold_s (pause frames neither break nor count), or n when there is none.
+// hold_s (pause frames neither break nor count), or errors.size() when there is none. truth and
+// times_s have at least as many frames as errors.
 std::size_t first_found_frame(std::span<const TruthFrame> truth, std::span<const double> times_s,
-                              const std::vector<double>& errors, double tolerance_ms,
-                              double hold_s, std::size_t n) {
+                              std::span<const double> errors, double tolerance_ms, double hold_s) {
+  const std::size_t n = errors.size();
   std::size_t start = n;
   for (std::size_t i = 0; i < n; ++i) {
     if (truth[i].in_pause) continue;
@@ -120,9 +121,8 @@ void MetricsAccumulator::add(std::span<const TruthFrame> truth, std::span<const 
 
   // Finding the dance (Metrics::median_find_s).
   if (n > 0) {
-    const std::size_t found = first_found_frame(truth, times_s, errors,
-                                                options_.recovery_tolerance_ms,
-                                                options_.find_hold_s, n);
+    const std::size_t found = first_found_frame(
+        truth, times_s, errors, options_.recovery_tolerance_ms, options_.find_hold_s);
     find_s_.push_back(found < n ? times_s[found] - times_s[0] : kInf);
     for (std::size_t i = found; i < n; ++i) {
       if (truth[i].in_pause) continue;

@@ -42,8 +42,8 @@ void append_csv_row(std::string& out, const std::string& case_name, const std::s
       m.recovered_jumps ? number_or_empty(m.mean_recovery_s, 4) : "", m.lost_fraction,
       m.mean_step_us, m.reported_jumps, m.false_jumps, m.false_jumps_per_minute,
       m.lost_on_tracked_fraction, m.confidence_ece, m.lost_switches_per_minute,
-      m.within_100ms_alike, number_or_empty(m.median_find_s, 3),
-      number_or_empty(m.worst_find_s, 3), m.within_100ms_found);
+      m.within_100ms_alike, number_or_empty(m.median_find_s, 3), number_or_empty(m.worst_find_s, 3),
+      m.within_100ms_found);
 }
 
 std::string take_name(const EvalReport& report, int take) {
@@ -351,8 +351,8 @@ std::string format_eval_table(const EvalReport& report) {
       "{:<18} {:<14} {:>7} {:>7} {:>7} {:>7} {:>6} {:>7} {:>8} {:>7} {:>7} {:>7} {:>6} {:>6} "
       "{:>8} {:>6} {:>8}\n";
   fmt::format_to(std::back_inserter(out), kHeader, "case", "tracker", "frames", "acc@50", "acc@100",
-                 "alike", "find s", "acc@300", "mean ms", "med ms", "jumps", "recov s", "fj/min", "lost",
-                 "lost trk", "ECE", "us/frame");
+                 "alike", "find s", "acc@300", "mean ms", "med ms", "jumps", "recov s", "fj/min",
+                 "lost", "lost trk", "ECE", "us/frame");
   std::string previous_case;
   for (const EvalRow& row : report.rows) {
     if (!previous_case.empty() && row.case_name != previous_case) out += "\n";
