@@ -470,7 +470,8 @@ Command register_eval(CLI::App& app) {
                  "library's), proportioned (our own: other proportions and rest pose), asf "
                  "(cmu-salsa 60.asf), handshake (cmu-handshake 18_01.bvh), bandai (a third-party "
                  "rig), all, or a motion file whose skeleton to use. A case on another rig is "
-                 "reported as CASE@RIG: the same performance, retargeted (docs/retarget.md)")
+                 "reported as CASE@RIG: the same performance, its sensor errors included, "
+                 "retargeted (docs/retarget.md)")
       ->delimiter(',');
   app.add_option("--non-dance", args->non_dance,
                  "Motion no part of the library explains, comma-separated, followed after the "

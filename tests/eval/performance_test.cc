@@ -10,6 +10,7 @@
 #include "duet/io/motion_file.h"
 #include "duet/math/rotation.h"
 #include "duet/motion/forward_kinematics.h"
+#include "duet/motion/rig_variants.h"
 #include "features/synthetic_dancer.h"
 
 namespace duet {
@@ -613,6 +614,67 @@ TEST(MakePerformance, ABodySizeOnAnotherRigIsThatRigsBodyScaled) {
         .norm();
   };
   EXPECT_NEAR(head_to_foot_m(1.15) / head_to_foot_m(1.0), 1.15, 1e-6);
+}
+
+// The angle at the elbow (upper arm against forearm) of the left arm at every frame: a property
+// of the body that retargeting keeps (every role's direction is kept) and a sensor's errors move.
+std::vector<double> left_elbow_angles(const Performance& p) {
+  const std::vector<Vec3> world = world_positions(p.motion);
+  const auto joints = static_cast<std::size_t>(p.motion.joint_count());
+  const auto at = [&](int frame, Role role) {
+    return world[static_cast<std::size_t>(frame) * joints +
+                 static_cast<std::size_t>(p.roles[role])];
+  };
+  std::vector<double> angles;
+  for (int k = 0; k < p.frame_count(); ++k) {
+    const Vec3 upper = at(k, Role::kLeftElbow) - at(k, Role::kLeftShoulder);
+    const Vec3 fore = at(k, Role::kLeftWrist) - at(k, Role::kLeftElbow);
+    angles.push_back(std::atan2(upper.cross(fore).norm(), upper.dot(fore)));
+  }
+  return angles;
+}
+
+TEST(MakePerformance, TheSensorsErrorsAreTheSameOnEveryRig) {
+  // The sensor's errors belong to the dancer's body: the same noisy performance reaches every rig
+  // (noise, then retargeting). Put on the delivered rig's joints instead, the proportioned rig's
+  // elbow bent up to 8.2 degrees differently from the library rig's under the same sensor.
+  const Fixture f = make_fixture(240);
+  const SourceTake source = f.source();
+  PerformanceRecipe native;
+  native.noise.rotation_deg = 4.0;
+  native.noise.position_m = 0.01;
+  native.noise.bias_deg = 5.0;
+  native.noise.drift_deg = 5.0;
+  PerformanceRecipe on_rig = native;
+  on_rig.rig = std::make_shared<const Skeleton>(
+      make_proportioned_rig(f.clip.skeleton(), f.roles, RigProportions::evaluation_variant()));
+  on_rig.rig_roles = f.roles;
+  Result<Performance> a = make_performance(std::span(&source, 1), native, 9);
+  Result<Performance> b = make_performance(std::span(&source, 1), on_rig, 9);
+  ASSERT_TRUE(a) << a.error().message;
+  ASSERT_TRUE(b) << b.error().message;
+  const std::vector<double> native_angles = left_elbow_angles(a.value());
+  const std::vector<double> rig_angles = left_elbow_angles(b.value());
+  ASSERT_EQ(native_angles.size(), rig_angles.size());
+  double largest = 0.0;
+  for (std::size_t k = 0; k < native_angles.size(); ++k) {
+    largest = std::max(largest, std::abs(native_angles[k] - rig_angles[k]));
+  }
+  EXPECT_LT(rad_to_deg(largest), 0.01);
+
+  // The scores' true wrists are the noise-free performance's, on the rig.
+  PerformanceRecipe clean_on_rig = on_rig;
+  clean_on_rig.noise = {};
+  Result<Performance> clean = make_performance(std::span(&source, 1), clean_on_rig, 9);
+  ASSERT_TRUE(clean);
+  const std::vector<Vec3> world = world_positions(clean.value().motion);
+  const auto joints = static_cast<std::size_t>(clean.value().motion.joint_count());
+  ASSERT_EQ(b.value().true_wrists_ws.size(), static_cast<std::size_t>(clean.value().frame_count()));
+  for (int k = 0; k < clean.value().frame_count(); k += 17) {
+    const Vec3 wrist = world[static_cast<std::size_t>(k) * joints +
+                             static_cast<std::size_t>(f.roles[Role::kLeftWrist])];
+    EXPECT_LT((b.value().true_wrists_ws[static_cast<std::size_t>(k)][0] - wrist).norm(), 1e-6) << k;
+  }
 }
 
 TEST(RecordedPerformance, FrameIIsTheTakesMomentIOverTheRecordingsRate) {
