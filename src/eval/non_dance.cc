@@ -1,5 +1,7 @@
 #include "duet/eval/non_dance.h"
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 #include <utility>
 
@@ -7,6 +9,24 @@
 #include "duet/motion/head_hands.h"
 
 namespace duet {
+
+Clip looped_clip(const Clip& clip, double min_duration_s) {
+  const int frames = clip.frame_count();
+  if (frames < 2 || !(clip.frame_rate() > 0.0) || clip.duration() >= min_duration_s) return clip;
+  const int repeats = static_cast<int>(std::ceil(min_duration_s / clip.duration()));
+  Clip looped(clip.skeleton_ptr(), clip.frame_rate(), frames * repeats);
+  Vec3 walked = clip.translations_ls(frames - 1)[0] - clip.translations_ls(0)[0];
+  walked.y() = 0.0;
+  for (int r = 0; r < repeats; ++r) {
+    for (int f = 0; f < frames; ++f) {
+      const int to = r * frames + f;
+      std::ranges::copy(clip.translations_ls(f), looped.translations_ls(to).begin());
+      std::ranges::copy(clip.rotations_ls(f), looped.rotations_ls(to).begin());
+      looped.translations_ls(to)[0] += static_cast<double>(r) * walked;
+    }
+  }
+  return looped;
+}
 
 Result<NonDanceResult> follow_non_dance(const DuetLibrary& library, const LoadedMotion& input,
                                         std::string name, std::unique_ptr<Tracker> tracker) {

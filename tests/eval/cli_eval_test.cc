@@ -217,6 +217,18 @@ TEST(CliEval, ReportsNonDanceInputAsLost) {
     const double lost = std::stod(r.output.substr(at + 2 + std::string(clip).size()));
     EXPECT_GE(lost, 95.0) << clip;
   }
+  // The clips shorter than half a minute are also followed looped to it; the walk stays lost.
+  for (const char* clip : {"walk looped", "byebye looped"}) {
+    const std::size_t at = r.output.find(std::string("  ") + clip + " ", section);
+    ASSERT_NE(at, std::string::npos) << clip << "\n" << r.output;
+    const std::size_t of = r.output.find(" of ", at);
+    ASSERT_NE(of, std::string::npos);
+    EXPECT_GE(std::stoi(r.output.substr(of + 4)), 30 * 30) << clip;  // 30 s of the 30 Hz clip
+    if (std::string(clip) == "walk looped") {
+      EXPECT_GE(std::stod(r.output.substr(at + 2 + std::string(clip).size())), 95.0);
+    }
+  }
+  EXPECT_EQ(r.output.find("dance-short looped"), std::string::npos) << r.output;  // 63 s already
   r = run_duet("eval " + pairs + " --non-dance none");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("non-dance input"), std::string::npos) << r.output;
