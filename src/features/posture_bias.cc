@@ -63,6 +63,22 @@ void PostureBias::reset() noexcept {
   std::ranges::fill(mean_, 0.0f);
   std::ranges::fill(offset_, 0.0f);
   learnt_s_ = 0.0;
+  lost_s_ = 0.0;
+}
+
+void PostureBias::note_lost(bool lost, double dt_s) noexcept {
+  if (!lost) {
+    lost_s_ = 0.0;
+    return;
+  }
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) return;
+  lost_s_ += dt_s;
+  if (!(params_.release_after_lost_s > 0.0) || lost_s_ < params_.release_after_lost_s) return;
+  double sum_squares = 0.0;
+  for (float v : offset_) sum_squares += static_cast<double>(v) * v;
+  const double rms =
+      offset_.empty() ? 0.0 : std::sqrt(sum_squares / static_cast<double>(offset_.size()));
+  if (rms > params_.release_offset_rms) reset();
 }
 
 }  // namespace duet

@@ -75,6 +75,8 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
                                        static_cast<std::size_t>(rows.cols())),
                 dt_s, result.confidence, result.sensor_noise_per_dim);
   }
+  // A frame without evidence neither breaks nor extends a lost run.
+  if (!result.missing) bias_.note_lost(result.lost, dt_s);
   if (library_->grown()) report_captured_place(result);
   return result;
 }

@@ -32,6 +32,33 @@ TEST(PostureBias, LearnsAConstantOffsetAndRemovesIt) {
   EXPECT_EQ(bias.offset()[0], 0.0f);
 }
 
+TEST(PostureBias, AnOffsetHeldThroughFourSecondsLostIsLetGo) {
+  const std::vector<float> matched = {0.0f, 0.0f};
+  const auto learnt = [&](float offset) {
+    PostureBias bias(0, 2, {});
+    for (int f = 0; f < 300; ++f) {
+      std::vector<float> x = {offset, -offset};
+      bias.correct(x);
+      bias.learn(x, matched, 1.0 / 60.0, 1.0f);
+    }
+    return bias;
+  };
+  PostureBias bias = learnt(0.3f);
+  ASSERT_NEAR(bias.offset()[0], 0.3f, 0.01f);
+  for (int f = 0; f < 230; ++f) bias.note_lost(true, 1.0 / 60.0);  // 3.8 s
+  bias.note_lost(false, 1.0 / 60.0);  // a frame followed: the count starts again
+  for (int f = 0; f < 230; ++f) bias.note_lost(true, 1.0 / 60.0);
+  EXPECT_NEAR(bias.offset()[0], 0.3f, 0.01f);
+  for (int f = 0; f < 20; ++f) bias.note_lost(true, 1.0 / 60.0);  // past 4 s in a row
+  EXPECT_EQ(bias.offset()[0], 0.0f);
+  EXPECT_EQ(bias.offset()[1], 0.0f);
+
+  // An offset the size the library's own rig shows is kept however long the input is lost.
+  PostureBias small = learnt(0.005f);
+  for (int f = 0; f < 600; ++f) small.note_lost(true, 1.0 / 60.0);
+  EXPECT_GT(small.offset()[0], 0.004f);
+}
+
 TEST(PostureBias, UnsureFramesCountLessAndBadInputIsIgnored) {
   PostureBias sure(0, 1, {}), unsure(0, 1, {});
   const std::vector<float> matched = {0.0f};

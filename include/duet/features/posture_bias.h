@@ -51,6 +51,15 @@ struct PostureBiasParams {
   // of the running mean given the sensor's noise (James-Stein-like positive-part shrinkage).
   // 2 / 3 / 4 / 6 swept in docs/evaluation.md ("Results", session 8); 0 applies the mean as learnt.
   double shrink_k = 4.0;
+  // An offset held through release_after_lost_s seconds of lost frames in a row is let go
+  // (reset()), to be learnt again. Learnt against another take's standing start, a suit's or a
+  // far rig's offset can leave every later frame too far from the library to teach it, and the
+  // follower lost for the rest of the dance (`suit-drift@asf` of take 60_09, seed 1: 90 % of
+  // frames lost, 41 % within 100 ms; docs/evaluation.md, "Letting a lost offset go"). Offsets
+  // under release_offset_rms (root mean square over the dimensions; the library's own rig stays
+  // under 0.001) are kept. 0: never let go.
+  double release_after_lost_s = 4.0;
+  float release_offset_rms = 0.01f;
 };
 
 class PostureBias {
@@ -68,6 +77,9 @@ class PostureBias {
   void learn(std::span<const float> corrected, std::span<const float> matched, double dt_s,
              float confidence, float sensor_noise = 0.0f) noexcept;
   void reset() noexcept;
+  // One frame's lost flag (FollowResult::lost) dt_s after the previous frame: lets the offset go
+  // after PostureBiasParams::release_after_lost_s lost in a row. Allocates nothing.
+  void note_lost(bool lost, double dt_s) noexcept;
 
   // What correct() subtracts: the running mean, shrunk by its uncertainty.
   std::span<const float> offset() const noexcept { return offset_; }
@@ -81,6 +93,7 @@ class PostureBias {
   std::vector<float> mean_;    // running mean of input - matched template, per dimension
   std::vector<float> offset_;  // mean_ shrunk by its uncertainty (params_.shrink_k)
   double learnt_s_ = 0.0;      // weighted seconds learnt since reset
+  double lost_s_ = 0.0;        // seconds lost in a row (note_lost)
 };
 
 }  // namespace duet
