@@ -7,7 +7,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <iterator>
@@ -416,28 +415,29 @@ int run_eval(EvalArgs& args) {
         "\nnon-dance input (motion no part of the library explains; hmm, exact step): lost\n");
     // Each clip as it is and, when shorter, looped to half a minute: the posture offset has time
     // to learn from a long one (docs/evaluation.md, "Non-dance input for half a minute").
+    const auto report_lost = [&](const LoadedMotion& motion, const std::string& name) {
+      Result<HmmFollower> follower = HmmFollower::create(library->model(), options.hmm);
+      if (!follower) {
+        fmt::print(stderr, "duet eval: {}\n", follower.error().message);
+        return false;
+      }
+      Result<NonDanceResult> result = follow_non_dance(
+          *library, motion, name, std::make_unique<HmmFollower>(std::move(follower).value()));
+      if (!result) {
+        fmt::print(stderr, "duet eval: --non-dance {}\n", result.error().message);
+        return false;
+      }
+      fmt::print("  {:<18} {:6.1f}% of {} frames\n", name, 100.0 * result.value().lost_fraction(),
+                 result.value().frames);
+      return true;
+    };
     constexpr double kLongNonDanceS = 30.0;
     for (const NonDanceClip& clip : non_dance.value()) {
+      if (!report_lost(clip.motion, clip.name)) return kExitFailure;
+      if (clip.motion.clip.duration() >= kLongNonDanceS) continue;
       LoadedMotion looped = clip.motion;
       looped.clip = looped_clip(clip.motion.clip, kLongNonDanceS);
-      const bool loops = looped.clip.frame_count() != clip.motion.clip.frame_count();
-      for (const LoadedMotion* motion : std::array<const LoadedMotion*, 2>{&clip.motion, &looped}) {
-        if (motion == &looped && !loops) continue;
-        const std::string name = motion == &looped ? clip.name + " looped" : clip.name;
-        Result<HmmFollower> follower = HmmFollower::create(library->model(), options.hmm);
-        if (!follower) {
-          fmt::print(stderr, "duet eval: {}\n", follower.error().message);
-          return kExitFailure;
-        }
-        Result<NonDanceResult> result = follow_non_dance(
-            *library, *motion, name, std::make_unique<HmmFollower>(std::move(follower).value()));
-        if (!result) {
-          fmt::print(stderr, "duet eval: --non-dance {}\n", result.error().message);
-          return kExitFailure;
-        }
-        fmt::print("  {:<18} {:6.1f}% of {} frames\n", name, 100.0 * result.value().lost_fraction(),
-                   result.value().frames);
-      }
+      if (!report_lost(looped, clip.name + " looped")) return kExitFailure;
     }
   }
   std::fflush(stdout);

@@ -23,16 +23,16 @@ struct NonDanceResult {
   }
 };
 
-// Every frame of `input` (any rig whose body roles are known) through a follow session of
-// `library` with `tracker`, at the clip's own timing; for a three-point library, the clip's head
-// and hands (head_hands_clip), as a headset would give them. An error when the session cannot be
-// made (the rig lacks roles the features need).
 // The clip played over and over until it lasts at least min_duration_s: a user who waves or walks
 // for half a minute, not the 2-3 s a short clip holds. Each repeat's root is moved on
 // horizontally by the clip's own first-to-last displacement, so a walk walks on; each seam is one
 // step back to the first pose. A clip already that long (or empty) is returned as it is.
 Clip looped_clip(const Clip& clip, double min_duration_s);
 
+// Every frame of `input` (any rig whose body roles are known) through a follow session of
+// `library` with `tracker`, at the clip's own timing; for a three-point library, the clip's head
+// and hands (head_hands_clip), as a headset would give them. An error when the session cannot be
+// made (the rig lacks roles the features need).
 Result<NonDanceResult> follow_non_dance(const DuetLibrary& library, const LoadedMotion& input,
                                         std::string name, std::unique_ptr<Tracker> tracker);
 
