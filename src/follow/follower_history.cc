@@ -44,12 +44,14 @@ void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams
   result.tempo = tempo.dancer_tempo();
   total_log_likelihood += result.log_likelihood;
   ++frames;
+  const int advanced = previous_state >= 0 && result.state >= 0 ? result.state - previous_state : 0;
   previous_state = result.state;
   previous_lost = result.lost;
   previous_outlier = result.outlier;
   explained_residual.update(
       result.best_distance_per_dim,
-      !result.missing && !result.outlier && !result.in_pause && !result.jumped, dt_s);
+      !result.missing && !result.outlier && !result.in_pause && !result.jumped, advanced, dt_s,
+      model.frame_rate_hz());
   result.lost = report_lost(params, result.lost, past_ceiling, unexplained, result.missing,
                             result.steps / model.frame_rate_hz());
 }

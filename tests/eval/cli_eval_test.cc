@@ -224,9 +224,10 @@ TEST(CliEval, ReportsNonDanceInputAsLost) {
     const std::size_t of = r.output.find(" of ", at);
     ASSERT_NE(of, std::string::npos);
     EXPECT_GE(std::stoi(r.output.substr(of + 4)), 30 * 30) << clip;  // 30 s of the 30 Hz clip
-    if (std::string(clip) == "walk looped") {
-      EXPECT_GE(std::stod(r.output.substr(at + 2 + std::string(clip).size())), 95.0);
-    }
+    // The wave held for half a minute was 19 % lost while the lost level learnt from it
+    // (explained_residual.h); the posture offset still makes parts of it look like salsa.
+    const double lost = std::stod(r.output.substr(at + 2 + std::string(clip).size()));
+    EXPECT_GE(lost, std::string(clip) == "walk looped" ? 95.0 : 80.0) << clip;
   }
   EXPECT_EQ(r.output.find("dance-short looped"), std::string::npos) << r.output;  // 63 s already
   r = run_duet("eval " + pairs + " --non-dance none");
