@@ -67,6 +67,7 @@ struct EvalArgs {
   std::optional<float> jump_old_place_mass;
   std::optional<float> jump_alike_distance;
   std::optional<float> jump_settle_mass;
+  std::optional<float> jump_settle_advance;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
       pause_distance, lost_distance, velocity_cap, pause_noise_factor, lost_residual,
       lost_noise_factor, lost_residual_factor, lost_confirm, lost_velocity_cap,
@@ -247,6 +248,7 @@ int run_eval(EvalArgs& args) {
   if (args.jump_old_place_mass) hmm.jump_old_place_mass = *args.jump_old_place_mass;
   if (args.jump_alike_distance) hmm.jump_alike_distance_per_dim = *args.jump_alike_distance;
   if (args.jump_settle_mass) hmm.jump_settle_mass = *args.jump_settle_mass;
+  if (args.jump_settle_advance) hmm.jump_settle_advance_s = *args.jump_settle_advance;
   if (Status s = hmm.validate(1); !s) return usage_error(s.error().message);
   if (args.dtw_back) options.dtw.window_back = *args.dtw_back;
   if (args.dtw_ahead) options.dtw.window_ahead = *args.dtw_ahead;
@@ -393,7 +395,7 @@ int run_eval(EvalArgs& args) {
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
       "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s "
-      "(mass {}) noisy_jump_hold {} s jump_old_place_mass {} jump_alike_distance {}\n"
+      "(mass {}, advance {} s) noisy_jump_hold {} s jump_old_place_mass {} jump_alike_distance {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
       "lost_residual_factor {} lost_confirm {} s lost_velocity_cap {}/dim{} emission_noise_factor "
       "{} "
@@ -404,11 +406,12 @@ int run_eval(EvalArgs& args) {
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
       hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.jump_settle_mass,
-      hmm.noisy_jump_hold_s, hmm.jump_old_place_mass, hmm.jump_alike_distance_per_dim,
-      hmm.pause_noise_factor, hmm.lost_residual_per_dim, hmm.lost_noise_factor,
-      hmm.lost_residual_factor, hmm.lost_confirm_s, hmm.lost_velocity_cap_per_dim,
-      hmm.pause_reported_lost ? " pause_reported_lost" : "", hmm.emission_noise_factor,
-      hmm.emission_noise_allowance, hmm.noise_filter_density, hmm.noise_filter_allowance);
+      hmm.jump_settle_advance_s, hmm.noisy_jump_hold_s, hmm.jump_old_place_mass,
+      hmm.jump_alike_distance_per_dim, hmm.pause_noise_factor, hmm.lost_residual_per_dim,
+      hmm.lost_noise_factor, hmm.lost_residual_factor, hmm.lost_confirm_s,
+      hmm.lost_velocity_cap_per_dim, hmm.pause_reported_lost ? " pause_reported_lost" : "",
+      hmm.emission_noise_factor, hmm.emission_noise_allowance, hmm.noise_filter_density,
+      hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
   if (!non_dance.value().empty()) {
     fmt::print(
@@ -738,6 +741,12 @@ Command register_eval(CLI::App& app) {
                    "jump_settle_mass: only frames with at least this window mass count towards "
                    "settling the first placement (0 for every frame)")
       ->check(number_between(0.0, 1.0));
+  tuning
+      ->add_option("--jump-settle-advance", args->jump_settle_advance,
+                   "jump_settle_advance_s: ... and only once the estimate has also moved forward "
+                   "through its take this far (template seconds; 0 for none): a standing start "
+                   "looks like every take's standing moments")
+      ->check(number_between(0.0, 10.0));
   tuning->add_option("--dtw-back", args->dtw_back, "online DTW window behind the estimate")
       ->check(non_negative_check());
   tuning->add_option("--dtw-ahead", args->dtw_ahead, "online DTW window ahead of the estimate")

@@ -25,6 +25,7 @@ FollowParams FollowParams::paper() {
   params.jump_tolerance_frames = 0;
   params.jump_settle_s = 0.0f;
   params.jump_settle_mass = 0.0f;
+  params.jump_settle_advance_s = 0.0f;
   params.noisy_jump_hold_s = 0.0f;
   params.jump_old_place_mass = 1.0f;
   params.jump_alike_distance_per_dim = 0.0f;
@@ -145,6 +146,10 @@ Status FollowParams::validate(int num_states) const {
   }
   if (!(jump_settle_s >= 0.0f && jump_settle_s <= 10.0f)) {
     return params_error("jump_settle_s must be in [0, 10] s, got " + std::to_string(jump_settle_s));
+  }
+  if (!(jump_settle_advance_s >= 0.0f && jump_settle_advance_s <= 10.0f)) {
+    return params_error("jump_settle_advance_s must be in [0, 10] s, got " +
+                        std::to_string(jump_settle_advance_s));
   }
   if (jump_tolerance_frames < 0 || jump_tolerance_frames > 1000) {
     return params_error("jump_tolerance_frames must be in [0, 1000], got " +

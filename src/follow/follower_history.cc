@@ -1,6 +1,9 @@
 #include "duet/follow/follower_history.h"
 
+#include <algorithm>
+
 #include "duet/follow/confidence_calibration.h"
+#include "forward_common.h"
 
 namespace duet {
 
@@ -45,13 +48,17 @@ void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams
   total_log_likelihood += result.log_likelihood;
   ++frames;
   const int advanced = previous_state >= 0 && result.state >= 0 ? result.state - previous_state : 0;
+  // A move out of the band's reach the follower did not call a jump (before the first placement
+  // settles none is, JumpGate) is the estimate being refined, not a dancer's pace.
+  const bool moved_far = follow_detail::is_jump(
+      model, previous_state, result.state, std::max(result.steps, 1), params.jump_tolerance_frames);
   previous_state = result.state;
   previous_lost = result.lost;
   previous_outlier = result.outlier;
   explained_residual.update(
       result.best_distance_per_dim,
-      !result.missing && !result.outlier && !result.in_pause && !result.jumped, advanced, dt_s,
-      model.frame_rate_hz());
+      !result.missing && !result.outlier && !result.in_pause && !result.jumped,
+      moved_far ? 0 : advanced, dt_s, model.frame_rate_hz());
   result.lost = report_lost(params, result.lost, past_ceiling, unexplained, result.missing,
                             result.steps / model.frame_rate_hz());
 }

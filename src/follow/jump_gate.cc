@@ -78,7 +78,13 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
     result.jumped = false;
     // Settling counts the frames the follower is sure of; once settled, it stays settled.
     const bool sure = settled(params) || result.window_mass >= params.jump_settle_mass;
-    if (previous_state >= 0 && result.state >= 0 && sure) settled_s_ += step_s;
+    if (previous_state >= 0 && result.state >= 0 && sure) {
+      settled_s_ += step_s;
+      // Within reach a move forward stays in the take (is_jump: another take is a jump).
+      if (result.state > previous_state) {
+        advanced_s_ += static_cast<double>(result.state - previous_state) / model.frame_rate_hz();
+      }
+    }
     forget_candidate();
     return;
   }
@@ -86,6 +92,7 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
     // Still finding the first place: take the new one and start settling there.
     result.jumped = false;
     settled_s_ = 0.0;
+    advanced_s_ = 0.0;
     forget_candidate();
     return;
   }

@@ -50,6 +50,7 @@ TEST(JumpGate, SmallStepsBackAreJitterLargerOnesAndOtherTakesAreJumps) {
   params.jump_hold_s = 0.0f;
   params.jump_tolerance_frames = 6;
   params.jump_settle_s = 0.0f;  // a follower that has settled (tested below)
+  params.jump_settle_advance_s = 0.0f;
   JumpGate gate;
   for (const auto& [from, to, jump] : {std::tuple{50, 47, false},
                                        {50, 44, false},
@@ -72,6 +73,7 @@ TEST(JumpGate, AFarPlaceIsReportedOnlyOnceItHolds) {
   FollowParams params;
   params.jump_hold_s = 0.05f;  // 3 template frames
   params.jump_settle_s = 0.0f;
+  params.jump_settle_advance_s = 0.0f;
   JumpGate gate;
   // One frame's excursion to take 1 and back: never reported; the old place goes on.
   std::vector<float> p = posterior(150, 41);
@@ -107,6 +109,7 @@ TEST(JumpGate, AfterALostFrameEveryMovePastTheBandIsAJump) {
   FollowParams params;
   params.jump_tolerance_frames = 6;
   params.jump_settle_s = 0.0f;
+  params.jump_settle_advance_s = 0.0f;
   JumpGate gate;
   const std::vector<float> p = posterior(53);
   FollowResult r = maximum_at(model, p, 53);
@@ -122,6 +125,7 @@ TEST(JumpGate, AfterALostFrameTheNewPlaceIsTakenAtOnce) {
   FollowParams params;
   params.jump_hold_s = 0.5f;
   params.jump_settle_s = 0.0f;
+  params.jump_settle_advance_s = 0.0f;
   JumpGate gate;
   const std::vector<float> p = posterior(150, 41);
   FollowResult r = maximum_at(model, p, 150);
@@ -134,6 +138,7 @@ TEST(JumpGate, WhileLostTheWanderingMaximumIsNoJumpAndBeingFoundAgainElsewhereIs
   const TemplateModel model = two_takes();
   FollowParams params;
   params.jump_settle_s = 0.0f;
+  params.jump_settle_advance_s = 0.0f;
   params.jump_hold_s = 0.0f;
   const auto adrift_at = [&](int state, bool in_pause) {
     FollowResult r = maximum_at(model, {}, state);
@@ -185,6 +190,7 @@ TEST(JumpGate, AdriftFromTheFirstFrameIsASpellWithNoPlaceToJumpFrom) {
   const TemplateModel model = two_takes();
   FollowParams params;
   params.jump_settle_s = 0.0f;  // settled at once, as after a performance's first 0.3 s
+  params.jump_settle_advance_s = 0.0f;
   params.jump_hold_s = 0.0f;
   JumpGate gate;
   int previous = -1;
@@ -221,6 +227,7 @@ TEST(JumpGate, AMoveBetweenPlacesThatLookAlikeIsNoJump) {
       std::move(TemplateModel::build(std::move(f), {0, 100}, 60.0, 0)).value();
   FollowParams params;
   params.jump_settle_s = 0.0f;
+  params.jump_settle_advance_s = 0.0f;
   for (const auto& [to, jump] : {std::pair{105, false}, {150, true}}) {
     JumpGate gate;
     const std::vector<float> p = posterior(to);
@@ -241,6 +248,7 @@ TEST(JumpGate, TheFirstPlacementIsRefinedWithoutJumpsUntilItHasSettled) {
   const TemplateModel model = two_takes();
   FollowParams params;
   params.jump_settle_s = 0.1f;  // 6 template frames
+  params.jump_settle_advance_s = 0.1f;  // the same 6 frames move forward
   JumpGate gate;
   // The first frames move between look-alike places: no jump is reported, the place is taken.
   int previous = -1;
@@ -287,6 +295,45 @@ TEST(JumpGate, TheFirstPlacementIsRefinedWithoutJumpsUntilItHasSettled) {
   EXPECT_FALSE(r.jumped);
 }
 
+TEST(JumpGate, TheFirstPlacementSettlesOnlyOnceTheEstimateMovesForward) {
+  const TemplateModel model = two_takes();
+  FollowParams params;
+  params.jump_settle_s = 0.1f;
+  params.jump_settle_advance_s = 0.1f;  // 6 template frames forward
+  JumpGate gate;
+  // Half a second sure of one standing frame (as a standing start is): time alone does not
+  // settle the placement, so a move to another take's look-alike is no jump.
+  int previous = 60;
+  for (int k = 0; k < 30; ++k) {
+    const std::vector<float> p = posterior(60);
+    FollowResult r = maximum_at(model, p, 60);
+    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+    EXPECT_FALSE(r.jumped);
+    previous = r.state;
+  }
+  EXPECT_FALSE(gate.settled(params));
+  std::vector<float> p = posterior(140);
+  FollowResult r = maximum_at(model, p, 140);
+  gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+  EXPECT_FALSE(r.jumped);
+  EXPECT_EQ(r.state, 140);
+  previous = r.state;
+  // Five frames forward are not yet 0.1 s of the take; the sixth settles it.
+  for (int k = 1; k <= 6; ++k) {
+    EXPECT_FALSE(gate.settled(params)) << k;
+    p = posterior(140 + k);
+    r = maximum_at(model, p, 140 + k);
+    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+    EXPECT_FALSE(r.jumped);
+    previous = r.state;
+  }
+  EXPECT_TRUE(gate.settled(params));
+  p = posterior(20);
+  r = maximum_at(model, p, 20);
+  gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+  EXPECT_TRUE(r.jumped);
+}
+
 TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
   FollowParams params;
   // The hold grows with the estimated sensor noise: none on a clean sensor, all of it from the
@@ -302,6 +349,7 @@ TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
   EXPECT_EQ(JumpGate::hold_s(params, 1.0f), 0.5f);
   params.jump_hold_s = 0.0f;
   params.jump_settle_s = 0.0f;
+  params.jump_settle_advance_s = 0.0f;
 
   const TemplateModel model = two_takes();
   const auto noisy = [&](int state) { return noisy_maximum_at(model, params, state); };
@@ -346,6 +394,7 @@ TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
 TEST(JumpGate, UnderANoisySensorAFarPlaceWaitsUntilTheOldPlaceHasLostItsMass) {
   FollowParams params;
   params.jump_settle_s = 0.0f;
+  params.jump_settle_advance_s = 0.0f;
   const TemplateModel model = two_takes();
   const auto noisy = [&](int state) { return noisy_maximum_at(model, params, state); };
   // The maximum sits at take 1 for six frames while the old place (the band's reach of the
@@ -401,6 +450,13 @@ TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
   params.jump_old_place_mass = 0.05f;
   params.jump_settle_mass = -0.5f;
   EXPECT_FALSE(params.validate(200));
+  params.jump_settle_mass = 0.99f;
+  params.jump_settle_advance_s = -1.0f;
+  EXPECT_FALSE(params.validate(200));
+  params.jump_settle_advance_s = std::nanf("");
+  EXPECT_FALSE(params.validate(200));
+  params.jump_settle_advance_s = 0.5f;
+  EXPECT_TRUE(params.validate(200));
 }
 
 }  // namespace

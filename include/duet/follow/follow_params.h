@@ -193,6 +193,15 @@ struct FollowParams {
   // under noise the first placement often sits on a look-alike place of another take with a
   // window mass of 0.6-0.97 before the maximum moves on. 0: every frame within reach counts.
   float jump_settle_mass = 0.99f;
+  // ... and only once the estimate has also moved forward through its take for
+  // jump_settle_advance_s (template time of forward moves within reach, frames it is sure of): a
+  // dancer found is a dancer followed while moving. Every take begins with its dancers standing,
+  // and a standing start looks like every standing moment of every take: under an inertial
+  // suit's calibration error the estimate sat on another take's standing frame, sure of it, for
+  // seconds, then moved between such places, each move a reported jump (`suit-drift`, takes 2, 4,
+  // 9, 11: 4.3-7.1 false jumps a minute, all but one in the first 10 s; 0.2-1.1 with 0.5 s, as
+  // with 1 or 2 s; docs/evaluation.md, "A placement found while moving"). 0: time alone settles.
+  float jump_settle_advance_s = 0.5f;
   // Outlier gate: a frame whose evidence would hand the pause state the majority right after a
   // frame that was followed (the first placement settled, that frame neither lost nor itself an
   // outlier) is taken for an outlier of the sensor: its evidence is set aside (transitions only,

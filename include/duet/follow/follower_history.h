@@ -34,7 +34,8 @@ struct FollowerHistory {
                   float pause_distance_sq) const noexcept {
     return params.gate_outliers && pause_majority &&
            best_distance_sq > params.outlier_pause_fraction * pause_distance_sq &&
-           previous_state >= 0 && !previous_lost && !previous_outlier && jump_gate.settled(params);
+           previous_state >= 0 && !previous_lost && !previous_outlier &&
+           jump_gate.held_a_place(params);
   }
 
   // Whether the input is lost by distance, with hysteresis: it turns lost once past the

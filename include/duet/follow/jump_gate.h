@@ -15,8 +15,10 @@
 // first frame found again is a jump if it is out of reach of the place reported before the spell,
 // over the time the spell lasted. After a lost frame with no such place the new place is taken at
 // once. Until the estimate has first settled (FollowParams::jump_settle_s of frames within reach
-// with a window mass of at least jump_settle_mass) a far move is the first placement being
-// refined: no jump is reported (half the false jumps left at 4 degrees per axis were those).
+// with a window mass of at least jump_settle_mass, over which it moved forward through its take
+// for jump_settle_advance_s) a far move is the first placement being refined: no jump is
+// reported (half the false jumps left at 4 degrees per axis were those, and nearly all of an
+// inertial suit's, whose standing start sat on other takes' standing frames).
 #pragma once
 
 #include "duet/follow/follow_params.h"
@@ -31,6 +33,7 @@ class JumpGate {
   void reset() noexcept {
     forget_candidate();
     settled_s_ = 0.0;
+    advanced_s_ = 0.0;
     steady_state_ = -1;
     steps_since_steady_ = 0;
     in_spell_ = false;
@@ -45,8 +48,15 @@ class JumpGate {
   void apply(const TemplateModel& model, const FollowParams& params, const float* posterior,
              float total, int previous_state, bool previous_lost, FollowResult& result,
              bool unexplained = false) noexcept;
-  // Whether the first placement has settled (FollowParams::jump_settle_s).
+  // Whether the first placement has settled (FollowParams::jump_settle_s and
+  // jump_settle_advance_s).
   bool settled(const FollowParams& params) const noexcept {
+    return settled_s_ + 1e-6 >= params.jump_settle_s &&
+           advanced_s_ + 1e-6 >= params.jump_settle_advance_s;
+  }
+  // Whether the estimate has held one place for FollowParams::jump_settle_s, moving or not (the
+  // outlier gate's followed place: FollowerHistory::is_outlier).
+  bool held_a_place(const FollowParams& params) const noexcept {
     return settled_s_ + 1e-6 >= params.jump_settle_s;
   }
   // The hold (template seconds) at this sensor noise (FollowResult::sensor_noise_per_dim).
@@ -73,6 +83,7 @@ class JumpGate {
   int steps_since_steady_ = 0;  // template steps since then
   bool in_spell_ = false;       // adrift since steady_state_ (or since the start)
   double settled_s_ = 0.0;    // how long (template time) the estimate has stayed within reach
+  double advanced_s_ = 0.0;   // how far (template time) it has moved forward meanwhile
   int candidate_state_ = -1;  // the far place that currently holds the maximum
   double held_s_ = 0.0;       // how long (template time) it has held it
 };
