@@ -21,8 +21,8 @@ void ExplainedResidual::update(float best_distance_per_dim, bool followed, int a
   const double dt = dt_s > 0.0 && std::isfinite(dt_s) ? std::min(dt_s, 1.0) : 1.0 / 60.0;
   run_s_ += dt;
   // Steps back count against the pace (jitter back and forth is no progress); a move of more
-  // than a few times the input's time (a far move the follower did not call a jump) counts as
-  // that much, so that it cannot stand for a run's pace.
+  // than a few times the input's time counts as that much, so that it cannot stand for a run's
+  // pace (FollowerHistory passes 0 for a far move the follower did not call a jump).
   const double rate = frame_rate_hz > 0.0 && std::isfinite(frame_rate_hz) ? frame_rate_hz : 60.0;
   constexpr double kMaxAdvance = 3.0;
   const double advance =
