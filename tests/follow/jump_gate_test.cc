@@ -17,6 +17,13 @@ TemplateModel two_takes() {
   return std::move(TemplateModel::build(std::move(f), {0, 100}, 60.0, 0)).value();
 }
 
+// A follower whose first placement has settled from the first frame (JumpGate::settled): no
+// settling time, no forward move asked for.
+void settle_at_once(FollowParams& params) {
+  params.jump_settle_s = 0.0f;
+  params.jump_settle_advance_s = 0.0f;
+}
+
 // A posterior with all its mass on `peak` and a little on `also`.
 std::vector<float> posterior(int peak, int also = -1) {
   std::vector<float> p(201, 0.0f);
@@ -49,8 +56,7 @@ TEST(JumpGate, SmallStepsBackAreJitterLargerOnesAndOtherTakesAreJumps) {
   FollowParams params;
   params.jump_hold_s = 0.0f;
   params.jump_tolerance_frames = 6;
-  params.jump_settle_s = 0.0f;  // a follower that has settled (tested below)
-  params.jump_settle_advance_s = 0.0f;
+  settle_at_once(params);  // a follower that has settled (tested below)
   JumpGate gate;
   for (const auto& [from, to, jump] : {std::tuple{50, 47, false},
                                        {50, 44, false},
@@ -72,8 +78,7 @@ TEST(JumpGate, AFarPlaceIsReportedOnlyOnceItHolds) {
   const TemplateModel model = two_takes();
   FollowParams params;
   params.jump_hold_s = 0.05f;  // 3 template frames
-  params.jump_settle_s = 0.0f;
-  params.jump_settle_advance_s = 0.0f;
+  settle_at_once(params);
   JumpGate gate;
   // One frame's excursion to take 1 and back: never reported; the old place goes on.
   std::vector<float> p = posterior(150, 41);
@@ -108,8 +113,7 @@ TEST(JumpGate, AfterALostFrameEveryMovePastTheBandIsAJump) {
   const TemplateModel model = two_takes();
   FollowParams params;
   params.jump_tolerance_frames = 6;
-  params.jump_settle_s = 0.0f;
-  params.jump_settle_advance_s = 0.0f;
+  settle_at_once(params);
   JumpGate gate;
   const std::vector<float> p = posterior(53);
   FollowResult r = maximum_at(model, p, 53);
@@ -124,8 +128,7 @@ TEST(JumpGate, AfterALostFrameTheNewPlaceIsTakenAtOnce) {
   const TemplateModel model = two_takes();
   FollowParams params;
   params.jump_hold_s = 0.5f;
-  params.jump_settle_s = 0.0f;
-  params.jump_settle_advance_s = 0.0f;
+  settle_at_once(params);
   JumpGate gate;
   const std::vector<float> p = posterior(150, 41);
   FollowResult r = maximum_at(model, p, 150);
@@ -137,8 +140,7 @@ TEST(JumpGate, AfterALostFrameTheNewPlaceIsTakenAtOnce) {
 TEST(JumpGate, WhileLostTheWanderingMaximumIsNoJumpAndBeingFoundAgainElsewhereIsOne) {
   const TemplateModel model = two_takes();
   FollowParams params;
-  params.jump_settle_s = 0.0f;
-  params.jump_settle_advance_s = 0.0f;
+  settle_at_once(params);
   params.jump_hold_s = 0.0f;
   const auto adrift_at = [&](int state, bool in_pause) {
     FollowResult r = maximum_at(model, {}, state);
@@ -189,8 +191,7 @@ TEST(JumpGate, AdriftFromTheFirstFrameIsASpellWithNoPlaceToJumpFrom) {
   // jump, nor is the first place found; from there on, jumps count as usual.
   const TemplateModel model = two_takes();
   FollowParams params;
-  params.jump_settle_s = 0.0f;  // settled at once, as after a performance's first 0.3 s
-  params.jump_settle_advance_s = 0.0f;
+  settle_at_once(params);  // settled at once, as after a performance's first 0.3 s
   params.jump_hold_s = 0.0f;
   JumpGate gate;
   int previous = -1;
@@ -226,8 +227,7 @@ TEST(JumpGate, AMoveBetweenPlacesThatLookAlikeIsNoJump) {
   const TemplateModel model =
       std::move(TemplateModel::build(std::move(f), {0, 100}, 60.0, 0)).value();
   FollowParams params;
-  params.jump_settle_s = 0.0f;
-  params.jump_settle_advance_s = 0.0f;
+  settle_at_once(params);
   for (const auto& [to, jump] : {std::pair{105, false}, {150, true}}) {
     JumpGate gate;
     const std::vector<float> p = posterior(to);
@@ -348,8 +348,7 @@ TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
   params.jump_hold_s = 0.5f;
   EXPECT_EQ(JumpGate::hold_s(params, 1.0f), 0.5f);
   params.jump_hold_s = 0.0f;
-  params.jump_settle_s = 0.0f;
-  params.jump_settle_advance_s = 0.0f;
+  settle_at_once(params);
 
   const TemplateModel model = two_takes();
   const auto noisy = [&](int state) { return noisy_maximum_at(model, params, state); };
@@ -393,8 +392,7 @@ TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
 
 TEST(JumpGate, UnderANoisySensorAFarPlaceWaitsUntilTheOldPlaceHasLostItsMass) {
   FollowParams params;
-  params.jump_settle_s = 0.0f;
-  params.jump_settle_advance_s = 0.0f;
+  settle_at_once(params);
   const TemplateModel model = two_takes();
   const auto noisy = [&](int state) { return noisy_maximum_at(model, params, state); };
   // The maximum sits at take 1 for six frames while the old place (the band's reach of the
