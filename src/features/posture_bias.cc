@@ -55,8 +55,12 @@ void PostureBias::learn(std::span<const float> corrected, std::span<const float>
 float PostureBiasParams::learn_distance_limit(float sensor_noise) const noexcept {
   if (!(sensor_noise > 0.0f) || !(noisy_learn_level > 0.0f)) return max_learn_distance_per_dim;
   const float noisy = std::min(sensor_noise / noisy_learn_level, 1.0f);
-  return max_learn_distance_per_dim +
-         noisy * (max_learn_distance_noisy_per_dim - max_learn_distance_per_dim);
+  const float narrowed = max_learn_distance_per_dim +
+                         noisy * (max_learn_distance_noisy_per_dim - max_learn_distance_per_dim);
+  // Never wider than a steady sensor's limit: a noise estimate thrown high by input no take
+  // explains must not open the offset to it.
+  return std::max(narrowed,
+                  std::min(learn_noise_factor * sensor_noise, max_learn_distance_per_dim));
 }
 
 void PostureBias::reset() noexcept {

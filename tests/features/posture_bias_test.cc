@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace duet {
@@ -158,7 +159,8 @@ TEST(PostureBias, FollowsADriftingOffset) {
 }
 
 TEST(PostureBias, TheLearningDistanceNarrowsAsTheSensorsNoiseRises) {
-  const PostureBiasParams params;
+  PostureBiasParams params;
+  params.learn_noise_factor = 0.0f;  // the narrowing alone
   EXPECT_FLOAT_EQ(params.learn_distance_limit(0.0f), params.max_learn_distance_per_dim);
   EXPECT_FLOAT_EQ(params.learn_distance_limit(params.noisy_learn_level),
                   params.max_learn_distance_noisy_per_dim);
@@ -170,6 +172,25 @@ TEST(PostureBias, TheLearningDistanceNarrowsAsTheSensorsNoiseRises) {
   // No estimate of the noise (NaN or negative) is a steady sensor's limit, not NaN.
   EXPECT_FLOAT_EQ(params.learn_distance_limit(std::nanf("")), params.max_learn_distance_per_dim);
   EXPECT_FLOAT_EQ(params.learn_distance_limit(-1.0f), params.max_learn_distance_per_dim);
+}
+
+TEST(PostureBias, ANoisySensorsRightMatchesStillTeach) {
+  const PostureBiasParams params;
+  ASSERT_GT(params.learn_noise_factor, 1.0f);
+  // At the noise where the narrowing ends, a match as far as the noise itself may teach.
+  const float noisy = params.noisy_learn_level;
+  EXPECT_FLOAT_EQ(params.learn_distance_limit(noisy), params.learn_noise_factor * noisy);
+  EXPECT_GT(params.learn_distance_limit(noisy), params.max_learn_distance_noisy_per_dim);
+  // Up to twice that noise the limit is never below the floor nor above a steady sensor's.
+  for (float noise = 0.0f; noise <= 2.0f * noisy; noise += 0.0005f) {
+    const float limit = params.learn_distance_limit(noise);
+    EXPECT_GE(limit, params.learn_noise_factor * noise - 1e-7f) << noise;
+    EXPECT_LE(limit, params.max_learn_distance_per_dim) << noise;
+  }
+  // A noise estimate thrown far up never opens the limit past a steady sensor's.
+  EXPECT_FLOAT_EQ(params.learn_distance_limit(1.0f), params.max_learn_distance_per_dim);
+  EXPECT_FLOAT_EQ(params.learn_distance_limit(std::numeric_limits<float>::infinity()),
+                  params.max_learn_distance_per_dim);
 }
 
 TEST(PostureBias, DisabledChangesNothing) {

@@ -45,6 +45,12 @@ struct PostureBiasParams {
   float max_learn_distance_noisy_per_dim = 0.005f;
   float noisy_learn_level =
       0.004f;  // sensor noise per dimension (FollowResult::sensor_noise_per_dim)
+  // The limit never falls below this many times the sensor's own noise: at 4 degrees per axis a
+  // right match's best distance is about the noise itself (median 0.0066 at a noise of 0.0082 on
+  // `harsh@asf`), so a fixed 0.005 kept most frames of a noisy sensor from teaching a rig's
+  // offset. Only sensors above about 3.3 degrees per axis reach the floor; 1 / 1.5 / 2 / 3 swept
+  // in docs/evaluation.md ("A noisy sensor's frames teach the offset", session 29). 0: no floor.
+  float learn_noise_factor = 2.0f;
   // The limit above for a sensor whose white-noise variance per dimension is sensor_noise.
   float learn_distance_limit(float sensor_noise) const noexcept;
   // Per dimension the applied offset is mean * max(0, 1 - (k se / mean)^2), se^2 the variance
