@@ -726,8 +726,14 @@ bool PartnerSynthesisJob::run() const noexcept {
   if (need_world) {
     forward_kinematics(skeleton, out_t, out_r, ctx.positions_ws_, ctx.rotations_ws_);
   }
+  //    While a blend carries the body to a new place (a jump, from its first frame), no foot is
+  //    locked: a lock held then keeps the root up to FootLockParams::max_offset_m off the place
+  //    the blend is bringing it to (PartnerParams::foot_lock_through_blend).
   Vec3 foot_lock_shift = Vec3::Zero();
-  if (p.foot_lock) {
+  const bool carried_by_blend =
+      p.blend && (jumped || ctx.inertializer_.max_rotation_offset() > kBlendingRad ||
+                  ctx.inertializer_.max_translation_offset() > kBlendingM);
+  if (p.foot_lock && (p.foot_lock_through_blend || !carried_by_blend)) {
     const std::array<Vec3, 2> feet = {ctx.positions_ws_[static_cast<std::size_t>(roles[kToes[0]])],
                                       ctx.positions_ws_[static_cast<std::size_t>(roles[kToes[1]])]};
     foot_lock_shift = ctx.foot_locker_.update(feet, planted, p.foot, dt);

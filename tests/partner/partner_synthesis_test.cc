@@ -997,6 +997,51 @@ TEST(PartnerSynthesis, TheContactTargetTakesTheFootLocksShiftWholeUnderANoisySen
   EXPECT_LT(hand_miss / counted, 0.019);
 }
 
+TEST(PartnerSynthesis, NoFootIsLockedWhileABlendCarriesTheBody) {
+  // The captured follower slides sideways at 0.1 m/s with her feet on the floor, so the foot lock
+  // shifts her root back; from frame 100 on she stands 0.6 m further left, turned by 1 rad. The
+  // follower jumps
+  // from frame 60 to 160: the blend carries the partner across. Held through the blend, the
+  // locks keep the root off the place the blend brings it to; by default they let go until the
+  // blend has arrived, then lock again.
+  Duet duet(240, 0, 0);
+  for (int f = 0; f < 240; ++f) {
+    duet.follower.translations_ls(f)[0] += Vec3(0.1 * f * kDt + (f >= 100 ? 0.6 : 0.0), 0, 0);
+    if (f >= 100) duet.follower.rotations_ls(f)[0] = yaw_rotation(1.0);
+  }
+  duet.rebuild();
+  struct Seen {
+    double largest_shift_while_blending = 0.0;
+    int frames_blending = 0;
+    bool locked_after = false;
+  };
+  Seen seen[2];
+  for (const bool through : {false, true}) {
+    PartnerParams params = only(true, false, false, true, true);
+    params.foot_lock_through_blend = through;
+    Runner run(duet.model, params);
+    Seen& s = seen[through ? 1 : 0];
+    for (int i = 0; i < 120; ++i) {
+      const int frame = i < 60 ? i : 100 + i;
+      run.step(duet.follower, frame, user_from(duet.leader, i, duet.roles), i == 60);
+      if (i < 60) continue;
+      if (i == 60 || run.info.blend_offset_rad > 0.02) {
+        ++s.frames_blending;
+        s.largest_shift_while_blending =
+            std::max(s.largest_shift_while_blending, run.info.foot_lock_offset_ws.norm());
+      } else if (i > 100) {
+        s.locked_after = s.locked_after || run.info.foot_locked[0];
+      }
+      EXPECT_TRUE(run.world().positions[0].allFinite());
+    }
+  }
+  EXPECT_GT(seen[0].frames_blending, 5);
+  EXPECT_EQ(seen[0].largest_shift_while_blending, 0.0);
+  EXPECT_GT(seen[1].largest_shift_while_blending, 0.03);
+  EXPECT_TRUE(seen[0].locked_after);  // the locks start again once the blend has arrived
+  EXPECT_TRUE(seen[1].locked_after);
+}
+
 TEST(PartnerSynthesis, AJumpKeepsPlantedFeetOnTheFloorAndStepsToTheNewPlace) {
   // The captured follower stands still (feet planted) beside the leader; from frame 100 on she
   // stands 0.6 m further left and turned by 1 rad. The follower jumps from frame 50 to 150: the

@@ -286,6 +286,15 @@ struct PartnerParams {
 
   // footlock thresholds and release.
   FootLockParams foot;
+  // footlock with blend: false, the default, locks no foot while a blend carries the body to a
+  // new place (from a jump's frame until the blend's offsets are under 0.02 rad and 1 cm); the
+  // locks start again where the blend has brought the feet. A lock held through the blend pinned
+  // the feet against the user's sensor noise and kept the root up to foot.max_offset_m off the
+  // place the blend was bringing it to: under 4 degrees of noise per axis the spacing 0.3 s after
+  // a jump was 3.2 cm off in the median instead of 1.3, and jumps rejoined within 0.3 s over the
+  // improvised and noisy cases on five rigs rose 350 -> 389 of 938 (docs/evaluation.md, "Feet
+  // free while the blend carries them", session 29). true: the earlier behaviour.
+  bool foot_lock_through_blend = false;
   // footlock with blend: planted feet held by leg IK through a jump's blend, catching up by
   // steps (foot_hold.h). enabled = false: the blend slides them (before issue 11's last target).
   FootHoldParams foot_hold;
