@@ -575,6 +575,7 @@ void PartnerContext::reset() noexcept {
   reach_ramp_ = {1.0, 1.0};
   for (auto& arm : reach_correction_) arm.fill(Vec3::Zero());
   blend_half_life_ = 0.0;
+  blend_carrying_ = false;
 }
 
 std::string_view PartnerSynthesisJob::validate() const noexcept {
@@ -730,9 +731,7 @@ bool PartnerSynthesisJob::run() const noexcept {
   //    locked: a lock held then keeps the root up to FootLockParams::max_offset_m off the place
   //    the blend is bringing it to (PartnerParams::foot_lock_through_blend).
   Vec3 foot_lock_shift = Vec3::Zero();
-  const bool carried_by_blend =
-      p.blend && (jumped || ctx.inertializer_.max_rotation_offset() > kBlendingRad ||
-                  ctx.inertializer_.max_translation_offset() > kBlendingM);
+  const bool carried_by_blend = p.blend && (jumped || ctx.blend_carrying_);
   if (p.foot_lock && (p.foot_lock_through_blend || !carried_by_blend)) {
     const std::array<Vec3, 2> feet = {ctx.positions_ws_[static_cast<std::size_t>(roles[kToes[0]])],
                                       ctx.positions_ws_[static_cast<std::size_t>(roles[kToes[1]])]};
@@ -994,6 +993,8 @@ bool PartnerSynthesisJob::run() const noexcept {
     ctx.inertializer_.update(out_t, out_r, std::max(ctx.blend_half_life_, p.blend_half_life_s), dt,
                              out_t, out_r, limits);
     diagnostics.blend_offset_rad = ctx.inertializer_.max_rotation_offset();
+    ctx.blend_carrying_ = diagnostics.blend_offset_rad > kBlendingRad ||
+                          ctx.inertializer_.max_translation_offset() > kBlendingM;
     if (!ctx.detour_hs_.isZero(0.0) && ctx.detour_offset_m_ > 0.0) {
       const double progress = std::clamp(
           1.0 - ctx.inertializer_.root_translation_offset() / ctx.detour_offset_m_, 0.0, 1.0);
@@ -1002,6 +1003,7 @@ bool PartnerSynthesisJob::run() const noexcept {
     }
   } else {
     ctx.inertializer_.reset();
+    ctx.blend_carrying_ = false;
   }
   std::copy(out_t.begin(), out_t.end(), ctx.blend_translations_.begin());
   std::copy(out_r.begin(), out_r.end(), ctx.blend_rotations_.begin());
@@ -1020,8 +1022,7 @@ bool PartnerSynthesisJob::run() const noexcept {
   //     What it adds to each arm joint changes at most reach_max_speed_rad_s, also when it ends.
   if (p.contact && p.blend && p.reach_s > 0.0) {
     const double rise = dt / p.reach_s;
-    const bool blending = diagnostics.blend_offset_rad > kBlendingRad ||
-                          ctx.inertializer_.max_translation_offset() > kBlendingM;
+    const bool blending = ctx.blend_carrying_;
     bool posed = false;
     for (std::size_t r = 0; r < 2; ++r) {
       std::array<Vec3, 2>& shown = ctx.reach_correction_[r];
@@ -1088,8 +1089,7 @@ bool PartnerSynthesisJob::run() const noexcept {
       leg_lengths[side] = (ctx.positions_ws_[knee] - hips[side]).norm() +
                           (ankles[side] - ctx.positions_ws_[knee]).norm();
     }
-    const bool blending = ctx.inertializer_.max_rotation_offset() > kBlendingRad ||
-                          ctx.inertializer_.max_translation_offset() > kBlendingM;
+    const bool blending = ctx.blend_carrying_;
     ctx.foot_hold_.update(ankles, ankle_rotations, hips, leg_lengths, planted, blending,
                           jumped && blending, p.foot_hold, dt);
     bool any = false;

@@ -404,6 +404,7 @@ class PartnerContext {
   std::array<Vec3, 2> ik_target_offset_velocity_{Vec3::Zero(), Vec3::Zero()};
   std::array<double, 2> ik_target_half_life_{0.0, 0.0};
   double blend_half_life_ = 0.0;  // of the current transition
+  bool blend_carrying_ = false;   // the blend still over 0.02 rad or 1 cm after its last update
   // The current transition's detour round the user (heading frame; zero: none) and the root's
   // translation offset when it started (the detour's progress is measured against it).
   Vec3 detour_hs_ = Vec3::Zero();
