@@ -1000,10 +1000,9 @@ TEST(PartnerSynthesis, TheContactTargetTakesTheFootLocksShiftWholeUnderANoisySen
 TEST(PartnerSynthesis, NoFootIsLockedWhileABlendCarriesTheBody) {
   // The captured follower slides sideways at 0.1 m/s with her feet on the floor, so the foot lock
   // shifts her root back; from frame 100 on she stands 0.6 m further left, turned by 1 rad. The
-  // follower jumps
-  // from frame 60 to 160: the blend carries the partner across. Held through the blend, the
-  // locks keep the root off the place the blend brings it to; by default they let go until the
-  // blend has arrived, then lock again.
+  // follower jumps from frame 60 to 160: the blend carries the partner across. Held through the
+  // blend, the locks keep the root off the place the blend brings it to; by default they let go
+  // until the blend has arrived, then lock again.
   Duet duet(240, 0, 0);
   for (int f = 0; f < 240; ++f) {
     duet.follower.translations_ls(f)[0] += Vec3(0.1 * f * kDt + (f >= 100 ? 0.6 : 0.0), 0, 0);
