@@ -56,6 +56,9 @@ FrameEstimate frame_estimate(const FollowResult& r, double step_us) {
   e.window_mass = r.window_mass;
   e.best_distance_per_dim = r.best_distance_per_dim;
   e.sensor_noise_per_dim = r.sensor_noise_per_dim;
+  e.rig_offset = r.rig_offset;
+  e.rig_offset_learnt_s = r.rig_offset_learnt_s;
+  e.tracker_confidence = r.tracker_confidence;
   e.in_pause = r.in_pause;
   e.outlier = r.outlier;
   e.step_us = step_us;

@@ -40,6 +40,7 @@ void PostureBias::learn(std::span<const float> corrected, std::span<const float>
   const double mean_variance =
       std::max(0.0, static_cast<double>(sensor_noise)) * rate / (2.0 - rate);
   const double k_squared = params_.shrink_k * params_.shrink_k;
+  double sum_squares = 0.0;
   for (std::size_t d = 0; d < offset_.size(); ++d) {
     const std::size_t i = static_cast<std::size_t>(begin_) + d;
     const float residual = corrected[i] + offset_[d] - matched[i];  // input - matched
@@ -49,7 +50,12 @@ void PostureBias::learn(std::span<const float> corrected, std::span<const float>
     const double keep =
         mean_squared > 0.0 ? std::max(0.0, 1.0 - k_squared * mean_variance / mean_squared) : 0.0;
     offset_[d] = static_cast<float>(mean_[d] * keep);
+    sum_squares += static_cast<double>(offset_[d]) * offset_[d];
   }
+  offset_rms_ =
+      offset_.empty()
+          ? 0.0f
+          : static_cast<float>(std::sqrt(sum_squares / static_cast<double>(offset_.size())));
 }
 
 float PostureBiasParams::learn_distance_limit(float sensor_noise) const noexcept {
@@ -66,6 +72,7 @@ float PostureBiasParams::learn_distance_limit(float sensor_noise) const noexcept
 void PostureBias::reset() noexcept {
   std::ranges::fill(mean_, 0.0f);
   std::ranges::fill(offset_, 0.0f);
+  offset_rms_ = 0.0f;
   learnt_s_ = 0.0;
   lost_s_ = 0.0;
 }
@@ -78,11 +85,7 @@ void PostureBias::note_lost(bool lost, double dt_s) noexcept {
   if (!(dt_s > 0.0) || !std::isfinite(dt_s)) return;
   lost_s_ += dt_s;
   if (!(params_.release_after_lost_s > 0.0) || lost_s_ < params_.release_after_lost_s) return;
-  double sum_squares = 0.0;
-  for (float v : offset_) sum_squares += static_cast<double>(v) * v;
-  const double rms =
-      offset_.empty() ? 0.0 : std::sqrt(sum_squares / static_cast<double>(offset_.size()));
-  if (rms > params_.release_offset_rms) reset();
+  if (offset_rms_ > params_.release_offset_rms) reset();
 }
 
 }  // namespace duet

@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <limits>
 
+#include "duet/live/young_offset_confidence.h"
+
 namespace duet {
 
 Result<FollowSession> FollowSession::create(const DuetLibrary& library,
@@ -77,6 +79,14 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
   }
   // A frame without evidence neither breaks nor extends a lost run.
   if (!result.missing) bias_.note_lost(result.lost, dt_s);
+  result.rig_offset = bias_.offset_rms();
+  result.rig_offset_learnt_s = static_cast<float>(bias_.learnt_s());
+  result.tracker_confidence = result.confidence;
+  if (bias_.params().enabled && bias_.params().young_offset_confidence) {
+    result.confidence =
+        YoungOffsetConfidence::apply(result.confidence, result.rig_offset,
+                                     result.rig_offset_learnt_s, extractor_.spec().input_points);
+  }
   if (library_->grown()) report_captured_place(result);
   return result;
 }

@@ -8,6 +8,7 @@
 #include "duet/io/motion_file.h"
 #include "duet/live/duet_library.h"
 #include "duet/live/follow_session.h"
+#include "duet/live/young_offset_confidence.h"
 #include "salsa_library.h"
 
 namespace duet {
@@ -32,6 +33,23 @@ TEST(CrossRigFollow, TakeOneFromTheCmuAsfAmcIsFollowedAgainstTheSalsaLibrary) {
   const double share = static_cast<double>(within) / static_cast<double>(results.size());
   std::printf("ASF take 01: %.1f%% within 100 ms\n", 100.0 * share);
   EXPECT_GE(share, 0.99);
+
+  // The session reports the rig's offset it learns and both confidences: lowered while the offset
+  // is young (young_offset_confidence.h), the tracker's own once it has settled.
+  float learnt = 0.0f;
+  int lowered = 0;
+  for (const FollowResult& r : results) {
+    EXPECT_GE(r.rig_offset_learnt_s, learnt);  // no lost run long enough to let it go
+    learnt = r.rig_offset_learnt_s;
+    if (r.rig_offset_learnt_s >= YoungOffsetConfidence::kSettledS) {
+      EXPECT_EQ(r.confidence, r.tracker_confidence);
+    } else {
+      lowered += r.confidence < r.tracker_confidence ? 1 : 0;
+    }
+  }
+  EXPECT_GE(learnt, YoungOffsetConfidence::kSettledS);
+  EXPECT_GT(results.back().rig_offset, 0.03f);  // the ASF rig's (about 0.05 on the salsa takes)
+  EXPECT_GT(lowered, 60);
 }
 
 TEST(CrossRigFollow, AWalkADanceAndAWaveOnAThirdPartyRigAreLost) {

@@ -30,6 +30,9 @@ struct FrameEstimate {
   float window_mass = 0.0f;
   float best_distance_per_dim = 0.0f;
   float sensor_noise_per_dim = 0.0f;
+  float rig_offset = 0.0f;
+  float rig_offset_learnt_s = 0.0f;
+  float tracker_confidence = 0.0f;
   bool in_pause = false;
   bool outlier = false;  // FollowResult::outlier: the frame's evidence was set aside
 };

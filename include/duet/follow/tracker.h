@@ -39,6 +39,13 @@ struct FollowResult {
   // The dancer's tempo as the tracker sees it (template frames per template frame of input time,
   // 1 = the template's tempo); 1 for trackers that do not estimate one.
   float tempo = 1.0f;
+  // Set by FollowSession (0 from a tracker alone): the user's rig's posture offset it removes
+  // (RMS per posture dimension, standardised units) and the confident seconds it has been learnt
+  // for, and the confidence as the tracker gave it, before the session's account of an offset
+  // still young (young_offset_confidence.h).
+  float rig_offset = 0.0f;
+  float rig_offset_learnt_s = 0.0f;
+  float tracker_confidence = 0.0f;
 };
 
 // A per-frame follower. step() is the live path: it allocates nothing, throws nothing and does no

@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+"""Fit the young-offset confidence table (src/live/young_offset_confidence.cc) offline.
+
+Reads the per-frame CSVs of `duet eval --frames-csv` (columns error_ms, tracker_confidence,
+rig_offset, rig_offset_learnt_s; tracker hmm), groups the frames by the band of the rig's posture
+offset and the band of the seconds it has been learnt, fits in each cell a monotone (isotonic) map
+from the tracker's confidence to the share of frames within 100 ms, and prints the C++ table to
+paste. A cell with fewer than MIN_FRAMES frames keeps the tracker's confidence (the identity).
+
+Whole-body and three-point input have tables of their own:
+  scripts/fit_young_offset_confidence.py --full full_*.csv --head-hands points_*.csv
+Fit on performances other than the ones reported on (other seeds), every rig (`--rigs all`).
+"""
+import argparse
+import bisect
+import csv
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from fit_confidence_calibration import isotonic, sample, TOLERANCE_MS  # noqa: E402
+
+# Must match src/live/young_offset_confidence.cc.
+OFFSET_EDGES = [0.03, 0.06, 0.1]  # RMS per posture dimension, standardised units
+LEARNT_EDGES = [1.0, 2.0, 3.0, 5.0]  # seconds; from SETTLED_S on the identity
+SETTLED_S = 8.0
+KNOTS = [k / 10.0 for k in range(10)] + [0.95, 0.99, 1.0]
+MIN_FRAMES = 300
+
+
+def read(paths):
+    cells = {}
+    for path in paths:
+        with open(path, newline="") as f:
+            for row in csv.DictReader(f):
+                if row["tracker"] != "hmm":
+                    continue
+                learnt = float(row["rig_offset_learnt_s"])
+                if learnt >= SETTLED_S:
+                    continue
+                cell = (bisect.bisect_right(OFFSET_EDGES, float(row["rig_offset"])),
+                        bisect.bisect_right(LEARNT_EDGES, learnt))
+                correct = 1.0 if float(row["error_ms"]) <= TOLERANCE_MS else 0.0
+                cells.setdefault(cell, []).append((float(row["tracker_confidence"]), correct))
+    return cells
+
+
+def table(name, paths):
+    cells = read(paths)
+    print(f"    // {name}: fitted on " + ", ".join(p.rsplit("/", 1)[-1] for p in paths))
+    print("    {")
+    for o in range(len(OFFSET_EDGES) + 1):
+        print("        {")
+        for t in range(len(LEARNT_EDGES) + 1):
+            points = sorted(cells.get((o, t), []))
+            if len(points) < MIN_FRAMES:
+                values = list(KNOTS)
+                note = f"{len(points)} frames: as the tracker says"
+            else:
+                blocks = isotonic(points)
+                values = [min(max(sample(blocks, k), 0.0), 1.0) for k in KNOTS]
+                for i in range(1, len(values)):
+                    values[i] = max(values[i], values[i - 1])
+                right = sum(c for _, c in points) / len(points)
+                claimed = sum(x for x, _ in points) / len(points)
+                note = f"{len(points)} frames, {claimed:.3f} claimed, {right:.3f} right"
+            print(f"            // offset band {o}, learnt band {t}: {note}")
+            print(f"            {{{', '.join(f'{v:.4f}f' for v in values)}}},")
+        print("        },")
+    print("    },")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--full", nargs="+", required=True, help="whole-body frames CSVs")
+    parser.add_argument("--head-hands", nargs="+", required=True, help="three-point frames CSVs")
+    args = parser.parse_args()
+    table("whole body", args.full)
+    table("head and hands", args.head_hands)
+
+
+if __name__ == "__main__":
+    main()
