@@ -68,28 +68,36 @@ def sample(blocks, knot):
     return y0 + t * (y1 - y0)
 
 
-def main(paths):
-    bands = [[] for _ in range(len(NOISE_EDGES) + 1)]
+def hmm_frames(paths):
+    """Every hmm frame of the frames CSVs: (row, 1.0 if within TOLERANCE_MS else 0.0)."""
     for path in paths:
         with open(path, newline="") as f:
             for row in csv.DictReader(f):
-                if row["tracker"] != "hmm":
-                    continue
-                noise = float(row["sensor_noise_per_dim"])
-                band = bisect.bisect_right(NOISE_EDGES, noise)
-                correct = 1.0 if float(row["error_ms"]) <= TOLERANCE_MS else 0.0
-                bands[band].append((coordinate(float(row["window_mass"])), correct))
+                if row["tracker"] == "hmm":
+                    yield row, 1.0 if float(row["error_ms"]) <= TOLERANCE_MS else 0.0
+
+
+def monotone_map(points, knots):
+    """The isotonic fit of (x, correct) points sampled at the knots, clamped to [0, 1] and
+    monotone after sampling too (interpolation keeps it; the clamp guards against rounding)."""
+    blocks = isotonic(sorted(points))
+    values = [min(max(sample(blocks, k), 0.0), 1.0) for k in knots]
+    for i in range(1, len(values)):
+        values[i] = max(values[i], values[i - 1])
+    return values
+
+
+def main(paths):
+    bands = [[] for _ in range(len(NOISE_EDGES) + 1)]
+    for row, correct in hmm_frames(paths):
+        band = bisect.bisect_right(NOISE_EDGES, float(row["sensor_noise_per_dim"]))
+        bands[band].append((coordinate(float(row["window_mass"])), correct))
     print("// Fitted by scripts/fit_confidence_calibration.py on " +
           ", ".join(p.rsplit("/", 1)[-1] for p in paths))
     for b, points in enumerate(bands):
         if not points:
             sys.exit(f"noise band {b} has no frames: add performances at that noise level")
-        points.sort()
-        blocks = isotonic(points)
-        values = [min(max(sample(blocks, k), 0.0), 1.0) for k in KNOTS]
-        # Monotone after sampling too (interpolation keeps it; clamp against rounding).
-        for i in range(1, len(values)):
-            values[i] = max(values[i], values[i - 1])
+        values = monotone_map(points, KNOTS)
         print(f"    // band {b}: {len(points)} frames")
         print(f"    {{{', '.join(f'{v:.4f}f' for v in values)}}},")
 

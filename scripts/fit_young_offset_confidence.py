@@ -13,12 +13,11 @@ Fit on performances other than the ones reported on (other seeds), every rig (`-
 """
 import argparse
 import bisect
-import csv
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from fit_confidence_calibration import isotonic, sample, TOLERANCE_MS  # noqa: E402
+from fit_confidence_calibration import hmm_frames, monotone_map  # noqa: E402
 
 # Must match src/live/young_offset_confidence.cc.
 OFFSET_EDGES = [0.03, 0.06, 0.1]  # RMS per posture dimension, standardised units
@@ -30,18 +29,13 @@ MIN_FRAMES = 300
 
 def read(paths):
     cells = {}
-    for path in paths:
-        with open(path, newline="") as f:
-            for row in csv.DictReader(f):
-                if row["tracker"] != "hmm":
-                    continue
-                learnt = float(row["rig_offset_learnt_s"])
-                if learnt >= SETTLED_S:
-                    continue
-                cell = (bisect.bisect_right(OFFSET_EDGES, float(row["rig_offset"])),
-                        bisect.bisect_right(LEARNT_EDGES, learnt))
-                correct = 1.0 if float(row["error_ms"]) <= TOLERANCE_MS else 0.0
-                cells.setdefault(cell, []).append((float(row["tracker_confidence"]), correct))
+    for row, correct in hmm_frames(paths):
+        learnt = float(row["rig_offset_learnt_s"])
+        if learnt >= SETTLED_S:
+            continue
+        cell = (bisect.bisect_right(OFFSET_EDGES, float(row["rig_offset"])),
+                bisect.bisect_right(LEARNT_EDGES, learnt))
+        cells.setdefault(cell, []).append((float(row["tracker_confidence"]), correct))
     return cells
 
 
@@ -52,15 +46,12 @@ def table(name, paths):
     for o in range(len(OFFSET_EDGES) + 1):
         print("        {")
         for t in range(len(LEARNT_EDGES) + 1):
-            points = sorted(cells.get((o, t), []))
+            points = cells.get((o, t), [])
             if len(points) < MIN_FRAMES:
                 values = list(KNOTS)
                 note = f"{len(points)} frames: as the tracker says"
             else:
-                blocks = isotonic(points)
-                values = [min(max(sample(blocks, k), 0.0), 1.0) for k in KNOTS]
-                for i in range(1, len(values)):
-                    values[i] = max(values[i], values[i - 1])
+                values = monotone_map(points, KNOTS)
                 right = sum(c for _, c in points) / len(points)
                 claimed = sum(x for x, _ in points) / len(points)
                 note = f"{len(points)} frames, {claimed:.3f} claimed, {right:.3f} right"
