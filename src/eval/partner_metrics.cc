@@ -135,7 +135,8 @@ void CapturedDuetSampler::compute(double template_frame, const Vec3& user_root_p
   compute(template_frame, heading_frame(user_root_position_ws, user_root_rotation_ws));
 }
 
-void CapturedDuetSampler::compute(double template_frame, const Transform& user_heading) {
+void CapturedDuetSampler::compute(double template_frame, const Transform& user_heading,
+                                  double spacing_scale) {
   const int last = response_clip_->frame_count() - 1;
   const double frame = std::clamp(template_frame, 0.0, static_cast<double>(last));
   const double time_s = frame / response_clip_->frame_rate();
@@ -151,7 +152,10 @@ void CapturedDuetSampler::compute(double template_frame, const Transform& user_h
                      std::span(rotations_scratch_).first(rn));
 
   const RootPlacement placement = model_->alignment().placement_at(frame);
-  Transform root = user_heading * Transform{placement.rotation_hs, placement.position_hs};
+  Vec3 position_hs = placement.position_hs;
+  position_hs.x() *= spacing_scale;
+  position_hs.z() *= spacing_scale;
+  Transform root = user_heading * Transform{placement.rotation_hs, position_hs};
   root.rotation.normalize();
   placed_pose_.translations_ls = response_pose_.translations_ls;
   placed_pose_.rotations_ls = response_pose_.rotations_ls;

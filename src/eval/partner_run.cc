@@ -182,7 +182,10 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
           performance.true_headings_ws.empty()
               ? body_heading_frame(out.user_positions_ws, performance.roles)
               : performance.true_headings_ws[fs];
-      sampler.compute(truth.template_frame, user_heading);
+      // The true response where the partner would stand for this user: the spacing fitted to the
+      // body the partner was fitted to (a 1.1x body's partner stands 5 % further away).
+      sampler.compute(truth.template_frame, user_heading,
+                      loop.partner_model(truth.take).spacing_scale(loop.user_height_m()));
       r.user_distance_m =
           horizontal_distance(out.partner_positions_ws[0], user_heading.translation);
       r.true_user_distance_m =

@@ -129,6 +129,16 @@ TEST(CapturedDuetSampler, PlacesTheTrueResponseRelativeToTheUser) {
   EXPECT_NEAR((root - expected).norm(), 0.0, 1e-9) << root.transpose();
   EXPECT_NEAR(root.y(), 0.97, 1e-12);
 
+  // For a user whose body the synthesis fits a 5 % wider spacing, the true response stands
+  // there too: the captured offset on the floor scaled, the height kept.
+  sampler.compute(10.5, heading_frame(user_root, yaw_rotation(yaw)), 1.05);
+  const Vec3 scaled = sampler.placed_positions_ws()[0];
+  EXPECT_NEAR((scaled - (user_root + yaw_rotation(yaw) * Vec3(0.105 * 1.05, 0.0, 1.05))).norm(),
+              0.0, 1e-9)
+      << scaled.transpose();
+  EXPECT_NEAR(scaled.y(), 0.97, 1e-12);
+  sampler.compute(10.5, user_root, yaw_rotation(yaw));
+
   // A synthesized partner 5 cm off everywhere has a joint error of exactly 5 cm.
   std::vector<Vec3> shifted(sampler.placed_positions_ws().begin(),
                             sampler.placed_positions_ws().end());

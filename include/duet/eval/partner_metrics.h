@@ -133,8 +133,10 @@ class CapturedDuetSampler {
                const Quat& user_root_rotation_ws);
   // Same, placed in a given heading frame of the user: the body heading frame
   // (body_heading_frame) the synthesis places the partner in, so a user on any rig is scored in
-  // the frame the partner was placed in.
-  void compute(double template_frame, const Transform& user_heading);
+  // the frame the partner was placed in. spacing_scale: the captured spacing fitted to the user's
+  // body as the synthesis fits it (PartnerModel::spacing_scale of the user's height), so a
+  // taller user's partner is scored against the place it is meant to stand at.
+  void compute(double template_frame, const Transform& user_heading, double spacing_scale = 1.0);
 
   // The true response, placed relative to the user (world positions and local rotations).
   std::span<const Vec3> placed_positions_ws() const { return placed_positions_; }

@@ -93,6 +93,9 @@ class LiveLoop {
   const SourceSkeleton& user() const noexcept { return user_; }
   // The partner's skeleton as sent to viewers and recorded (take 0's response skeleton).
   std::shared_ptr<const Skeleton> partner_skeleton() const noexcept;
+  // The user's height the partner's spacing was fitted to on the last step (the skeleton's
+  // standing height; three points: from the head's height, FollowSession::head_height_m).
+  double user_height_m() const noexcept { return user_pose_.height_m; }
   const PartnerModel& partner_model(int take) const noexcept {
     return models_[static_cast<std::size_t>(take)];
   }
