@@ -564,10 +564,12 @@ Command register_eval(CLI::App& app) {
                "\"Beam mode\"; the partner metrics keep the exact step)");
   app.add_option("--seed", args->seed, "Seed of every random choice (same seed, same numbers)");
   app.add_option("--csv", args->csv_path, "Write the metrics per case, tracker and take as CSV");
-  app.add_option("--frames-csv", args->frames_csv_path,
-                 "Write every scored frame (case, tracker, take, error, confidence, window mass, "
-                 "best distance, sensor noise, lost) as CSV, e.g. for "
-                 "scripts/fit_confidence_calibration.py");
+  app.add_option(
+      "--frames-csv", args->frames_csv_path,
+      "Write every scored frame (case, tracker, take, error, confidence, window mass, "
+      "best distance, sensor noise, lost, the tracker's own confidence, the rig's "
+      "posture offset and its seconds learnt) as CSV, e.g. for "
+      "scripts/fit_confidence_calibration.py and scripts/fit_young_offset_confidence.py");
   app.add_option("--plots", args->plots_dir,
                  "Write PNG plots (needs gnuplot) into this directory: accuracy.png, trace.png, "
                  "reliability.png (confidence against the share within 100 ms, per case)");
