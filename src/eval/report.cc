@@ -415,9 +415,8 @@ std::string format_frames_csv(const EvalReport& report) {
     for (const ScoredFrame& f : row.frames) {
       const FrameEstimate& e = f.estimate;
       fmt::format_to(std::back_inserter(out),
-                     "{},{},{},{:.1f},{:.5f},{:.5f},{:.6f},{:.7f},{},{},{},{},{:.1f},{},{},{},{},{:"
-                     ".5f},{:.5f},"
-                     "{:.3f}\n",
+                     "{},{},{},{:.1f},{:.5f},{:.5f},{:.6f},{:.7f},{},{},{},{},{:.1f},{},{},{},{},"
+                     "{:.5f},{:.5f},{:.3f}\n",
                      row.case_name, row.tracker, f.take, f.error_ms, e.confidence, e.window_mass,
                      e.best_distance_per_dim, e.sensor_noise_per_dim, e.lost ? 1 : 0,
                      e.in_pause ? 1 : 0, e.jumped ? 1 : 0, f.truth.take, f.truth.template_frame,
