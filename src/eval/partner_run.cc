@@ -184,8 +184,9 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
               : performance.true_headings_ws[fs];
       // The true response where the partner would stand for this user: the spacing fitted to the
       // body the partner was fitted to (a 1.1x body's partner stands 5 % further away).
+      const PartnerModel& true_model = loop.partner_model(truth.take);
       sampler.compute(truth.template_frame, user_heading,
-                      loop.partner_model(truth.take).spacing_scale(loop.user_height_m()));
+                      true_model.spacing_scale(loop.user_height_m()));
       r.user_distance_m =
           horizontal_distance(out.partner_positions_ws[0], user_heading.translation);
       r.true_user_distance_m =
@@ -195,7 +196,6 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
           mean_joint_distance_m(out.partner_positions_ws, sampler.placed_positions_ws());
 
       const PartnerModel& model = loop.partner_model(out.partner_take);
-      const PartnerModel& true_model = loop.partner_model(truth.take);
       const int true_frame = std::clamp(static_cast<int>(std::lround(truth.template_frame)), 0,
                                         true_model.frame_count() - 1);
       const JointRoles& partner_roles = model.response_roles();
