@@ -77,6 +77,25 @@ void PostureBias::reset() noexcept {
   lost_s_ = 0.0;
 }
 
+void PostureBias::adopt(std::span<const float> offset, double seconds) noexcept {
+  if (!params_.enabled || offset.size() != mean_.size()) return;
+  double sum_squares = 0.0;
+  for (std::size_t d = 0; d < mean_.size(); ++d) {
+    if (!std::isfinite(offset[d])) return;
+  }
+  for (std::size_t d = 0; d < mean_.size(); ++d) {
+    mean_[d] = std::clamp(mean_[d] + offset[d], -params_.max_offset, params_.max_offset);
+    offset_[d] = mean_[d];
+    sum_squares += static_cast<double>(offset_[d]) * offset_[d];
+  }
+  offset_rms_ =
+      mean_.empty()
+          ? 0.0f
+          : static_cast<float>(std::sqrt(sum_squares / static_cast<double>(mean_.size())));
+  learnt_s_ = std::max(learnt_s_, std::isfinite(seconds) ? seconds : 0.0);
+  lost_s_ = 0.0;
+}
+
 void PostureBias::note_lost(bool lost, double dt_s) noexcept {
   if (!lost) {
     lost_s_ = 0.0;

@@ -33,6 +33,8 @@ FollowSession::FollowSession(const DuetLibrary& library, FeatureExtractor extrac
       features_(static_cast<std::size_t>(extractor_.dimension())),
       bias_(extractor_.spec().block_begin(FeatureBlock::kPosture),
             extractor_.spec().block_size(FeatureBlock::kPosture), bias),
+      search_(extractor_.spec().block_begin(FeatureBlock::kPosture),
+              extractor_.spec().block_size(FeatureBlock::kPosture), extractor_.dimension()),
       repeats_(joints) {}
 
 FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
@@ -77,6 +79,7 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
                                        static_cast<std::size_t>(rows.cols())),
                 dt_s, result.confidence, result.sensor_noise_per_dim);
   }
+  search_offset(result, dt_s);
   // A frame without evidence neither breaks nor extends a lost run.
   if (!result.missing) bias_.note_lost(result.lost, dt_s);
   result.rig_offset = bias_.offset_rms();
@@ -89,6 +92,40 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
   }
   if (library_->grown()) report_captured_place(result);
   return result;
+}
+
+void FollowSession::search_offset(const FollowResult& result, double dt_s) noexcept {
+  const PostureBiasParams& params = bias_.params();
+  const TemplateModel& model = library_->model();
+  // Only while the input is unexplained (the pause state holds it, or it is lost) and no offset of
+  // size is held (a held one is let go after release_after_lost_s lost; the search starts then).
+  if (!params.enabled || !params.search.enabled || !(result.in_pause || result.lost) ||
+      result.missing || result.state < 0 || result.state >= model.num_states() ||
+      bias_.offset_rms() > params.release_offset_rms) {
+    if (!result.missing) {
+      search_.reset();
+      search_state_ = -1;
+    }
+    return;
+  }
+  // The matched frames follow one another as a dance does: within the take, forward by up to the
+  // band's reach, or back by a few frames of jitter.
+  constexpr int kJitterFrames = 6;
+  const int moved = result.state - search_state_;
+  const bool continues = search_state_ >= 0 && model.take_of(search_state_) == result.take &&
+                         moved >= -kJitterFrames &&
+                         moved <= 2 * std::max(result.steps, 1) + kJitterFrames;
+  search_state_ = result.state;
+  const auto& rows = model.features();
+  const std::span<const float> matched(rows.row(result.state).data(),
+                                       static_cast<std::size_t>(rows.cols()));
+  if (search_.observe(features_, matched, continues,
+                      params.learn_distance_limit(result.sensor_noise_per_dim), dt_s,
+                      params.search)) {
+    bias_.adopt(search_.offset(), search_.held_s());
+    search_.reset();
+    search_state_ = -1;
+  }
 }
 
 void FollowSession::report_captured_place(FollowResult& result) noexcept {
@@ -138,6 +175,8 @@ void FollowSession::reset() noexcept {
   context_.reset();
   tracker_->reset();
   bias_.reset();
+  search_.reset();
+  search_state_ = -1;
   repeats_.reset();
   has_previous_ = false;
   previous_state_ = -1;

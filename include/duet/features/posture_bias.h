@@ -21,6 +21,8 @@
 #include <span>
 #include <vector>
 
+#include "duet/features/offset_search.h"
+
 namespace duet {
 
 struct PostureBiasParams {
@@ -70,6 +72,9 @@ struct PostureBiasParams {
   // young (young_offset_confidence.h): at a standing start on another rig the follower matched
   // another take's stance at 0.9+ confidence and was right on 30-60 % of those frames.
   bool young_offset_confidence = true;
+  // While the pause state holds the input, FollowSession looks for an offset beyond the learning
+  // gate (offset_search.h): a suit calibrated 8 degrees off per joint was lost for 15 s.
+  OffsetSearchParams search;
 };
 
 class PostureBias {
@@ -87,6 +92,9 @@ class PostureBias {
   void learn(std::span<const float> corrected, std::span<const float> matched, double dt_s,
              float confidence, float sensor_noise = 0.0f) noexcept;
   void reset() noexcept;
+  // Takes on an offset found while lost (OffsetSearch), on top of the one held, as if learnt over
+  // `seconds`; the lost run starts again.
+  void adopt(std::span<const float> offset, double seconds) noexcept;
   // One frame's lost flag (FollowResult::lost) dt_s after the previous frame: lets the offset go
   // after PostureBiasParams::release_after_lost_s lost in a row. Allocates nothing.
   void note_lost(bool lost, double dt_s) noexcept;

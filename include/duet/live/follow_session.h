@@ -67,6 +67,9 @@ class FollowSession {
                 std::unique_ptr<Tracker> tracker, const PostureBiasParams& bias, int joints);
   // A grown library: the estimate's take and frame as the captured take's.
   void report_captured_place(FollowResult& result) noexcept;
+  // While lost: looks for a posture offset beyond bias_'s learning gate, and adopts it once the
+  // input with it removed has been explained along the dance for a while (offset_search.h).
+  void search_offset(const FollowResult& result, double dt_s) noexcept;
 
   const DuetLibrary* library_;
   FeatureExtractor extractor_;
@@ -74,6 +77,8 @@ class FollowSession {
   std::unique_ptr<Tracker> tracker_;
   std::vector<float> features_;
   PostureBias bias_;  // the user's rig's posture offset, learnt online
+  OffsetSearch search_;                      // an offset beyond bias_'s gate, looked for while lost
+  int search_state_ = -1;                    // the template state search_ last matched
   std::optional<ArmsForward> arms_forward_;  // set_arms_forward
   RepeatedFrameDetector repeats_;
   double previous_time_s_ = 0.0;
