@@ -157,6 +157,23 @@ std::vector<EvalCase> noise_sweep_cases() {
   return cases;
 }
 
+std::vector<EvalCase> suit_sweep_cases(const CaseSettings& settings) {
+  std::vector<EvalCase> cases;
+  for (int deg = 0; deg <= 10; deg += 2) {
+    EvalCase c;
+    c.name = fmt::format("suit-sweep-{}", deg);
+    c.description = fmt::format(
+        "suit-drift with {} deg of calibration and {} deg of drift per "
+        "joint (noise {:g} deg, {:g} cm)",
+        deg, deg, settings.noise_rotation_deg, settings.noise_position_m * 100.0);
+    c.recipe.noise = {settings.noise_rotation_deg, settings.noise_position_m, 0};
+    c.recipe.noise.bias_deg = deg;
+    c.recipe.noise.drift_deg = deg;
+    cases.push_back(std::move(c));
+  }
+  return cases;
+}
+
 std::vector<EvalCase> cases_on_rigs(const std::vector<EvalCase>& cases,
                                     const std::vector<EvalRig>& rigs) {
   std::vector<EvalCase> out;

@@ -500,6 +500,21 @@ TEST(EvalCases, HarshCaseAndNoiseSweepHaveIssue11sMagnitudes) {
     EXPECT_TRUE(c.recipe.improvise);
   }
 
+  // The suit sweep: suit-drift's recipe at 0 to 10 degrees, with the settings' noise.
+  CaseSettings noisier;
+  noisier.noise_rotation_deg = 4.0;
+  const std::vector<EvalCase> suits = suit_sweep_cases(noisier);
+  ASSERT_EQ(suits.size(), 6u);
+  for (int i = 0; i < 6; ++i) {
+    const EvalCase& c = suits[static_cast<std::size_t>(i)];
+    EXPECT_EQ(c.name, "suit-sweep-" + std::to_string(2 * i));
+    EXPECT_DOUBLE_EQ(c.recipe.noise.bias_deg, 2.0 * i);
+    EXPECT_DOUBLE_EQ(c.recipe.noise.drift_deg, 2.0 * i);
+    EXPECT_DOUBLE_EQ(c.recipe.noise.rotation_deg, 4.0);
+    EXPECT_DOUBLE_EQ(c.recipe.noise.position_m, CaseSettings{}.noise_position_m);
+    EXPECT_FALSE(c.recipe.improvise);
+  }
+
   // The inertial suit: the default noise plus its calibration error and drift.
   const auto suit = std::ranges::find(cases, std::string("suit-drift"), &EvalCase::name);
   ASSERT_NE(suit, cases.end());

@@ -72,6 +72,11 @@ std::vector<EvalCase> standard_cases(const CaseSettings& settings = {});
 // the take's rate with 0 to 5 degrees of rotation noise per axis (and 1 cm of root noise above 0).
 std::vector<EvalCase> noise_sweep_cases();
 
+// The suit sweep (`duet eval --suit-sweep`): suit-sweep-0, -2, ... -10, the suit-drift case (the
+// whole take, the settings' white noise) with 0 to 10 degrees of calibration error and as much
+// drift per joint: how far off a suit may be before the follower loses the dance.
+std::vector<EvalCase> suit_sweep_cases(const CaseSettings& settings = {});
+
 enum class TrackerKind {
   kHmm,               // the jump HMM with EvalOptions::hmm (the defaults unless tuned)
   kHmmPaper,          // FollowParams::paper() transitions, emission settings from EvalOptions::hmm
