@@ -69,6 +69,18 @@ TEST(NoisySensorFollow, FourDegreesPerAxisAtThirtyHertzIsFollowedNotLost) {
   EXPECT_LE(clean.metrics.confidence_ece, 0.02);
 }
 
+// The HMM follower through FollowSession with the posture offset's params `bias`, scored.
+Metrics follow_with(const DuetLibrary& library, const Performance& performance,
+                    const PostureBiasParams& bias) {
+  Result<std::unique_ptr<Tracker>> tracker =
+      make_eval_tracker(TrackerKind::kHmm, library.model(), EvalOptions{});
+  EXPECT_TRUE(tracker);
+  Result<std::vector<FrameEstimate>> estimates =
+      follow_performance(library, performance, std::move(tracker).value(), bias);
+  EXPECT_TRUE(estimates) << estimates.error().message;
+  return compute_metrics(performance, estimates.value());
+}
+
 // Means over `suits` inertial suits (seeds 1..suits: 5 degrees of calibration and 5 of drift per
 // joint, 3 degrees of white noise, 1 cm at the root) of one take followed with today's posture
 // offset (now) and with `before`'s (then). Prints each suit's figures.
@@ -92,13 +104,7 @@ SuitComparison compare_through_suits(int take_index, int suits, const PostureBia
     EXPECT_TRUE(performance) << performance.error().message;
     if (!performance) return mean;
     auto follow = [&](const PostureBiasParams& bias) {
-      Result<std::unique_ptr<Tracker>> tracker =
-          make_eval_tracker(TrackerKind::kHmm, library.model(), EvalOptions{});
-      EXPECT_TRUE(tracker);
-      Result<std::vector<FrameEstimate>> estimates =
-          follow_performance(library, performance.value(), std::move(tracker).value(), bias);
-      EXPECT_TRUE(estimates) << estimates.error().message;
-      return compute_metrics(performance.value(), estimates.value());
+      return follow_with(library, performance.value(), bias);
     };
     const Metrics now = follow({});
     const Metrics then = follow(before);
@@ -168,13 +174,7 @@ TEST(NoisySensorFollow, ASuitCalibratedFarOffHasItsOffsetFoundWhileLost) {
     Result<Performance> performance = make_performance({&source, 1}, recipe, seed);
     ASSERT_TRUE(performance) << performance.error().message;
     auto follow = [&](const PostureBiasParams& bias) {
-      Result<std::unique_ptr<Tracker>> tracker =
-          make_eval_tracker(TrackerKind::kHmm, library.model(), EvalOptions{});
-      EXPECT_TRUE(tracker);
-      Result<std::vector<FrameEstimate>> estimates =
-          follow_performance(library, performance.value(), std::move(tracker).value(), bias);
-      EXPECT_TRUE(estimates) << estimates.error().message;
-      return compute_metrics(performance.value(), estimates.value());
+      return follow_with(library, performance.value(), bias);
     };
     const Metrics with = follow({});
     const Metrics off = follow(without);
