@@ -34,7 +34,7 @@ void PostureBias::learn(std::span<const float> corrected, std::span<const float>
   // frame unsure until the offset is learnt.
   const double weight = std::max(static_cast<double>(confidence), params_.min_weight);
   learnt_s_ += weight * dt_s;
-  const double tau = std::min(params_.time_constant_s, learnt_s_);
+  const double tau = std::min(params_.time_constant(sensor_noise), learnt_s_);
   const auto rate = static_cast<float>(weight * (1.0 - std::exp(-dt_s / tau)));
   // The running mean of white noise of variance s^2 has variance s^2 a / (2 - a).
   const double mean_variance =
@@ -56,6 +56,13 @@ void PostureBias::learn(std::span<const float> corrected, std::span<const float>
       offset_.empty()
           ? 0.0f
           : static_cast<float>(std::sqrt(sum_squares / static_cast<double>(offset_.size())));
+}
+
+double PostureBiasParams::time_constant(float sensor_noise) const noexcept {
+  if (!(sensor_noise > 0.0f) || !(noisy_time_constant_level > 0.0f)) return time_constant_s;
+  const double scaled = noisy_time_constant_s *
+                        std::sqrt(static_cast<double>(sensor_noise / noisy_time_constant_level));
+  return std::clamp(scaled, time_constant_s, std::max(time_constant_s, noisy_time_constant_s));
 }
 
 float PostureBiasParams::learn_distance_limit(float sensor_noise) const noexcept {

@@ -137,7 +137,8 @@ TEST(PostureBias, ARunawayOffsetIsBounded) {
 
 TEST(PostureBias, FollowsADriftingOffset) {
   // An inertial suit's drift: the offset moves by 0.1 standardised units a second for 12 s. The
-  // average (2 s) lags it by about 0.1 x 2 s; the old 4 s average lagged twice as far.
+  // average (1 s on a steady sensor) lags it by about 0.1 x 1 s; session 10's 2 s average lagged
+  // twice as far, the 4 s before it four times.
   auto lag_after_ramp = [](double time_constant_s) {
     PostureBiasParams params;
     params.time_constant_s = time_constant_s;
@@ -153,9 +154,40 @@ TEST(PostureBias, FollowsADriftingOffset) {
     return truth - bias.offset()[0];
   };
   const float lag = lag_after_ramp(PostureBiasParams{}.time_constant_s);
-  EXPECT_GT(lag, 0.15f);
-  EXPECT_LT(lag, 0.22f);
-  EXPECT_GT(lag_after_ramp(4.0), 1.7f * lag);
+  EXPECT_GT(lag, 0.07f);
+  EXPECT_LT(lag, 0.12f);
+  EXPECT_GT(lag_after_ramp(2.0), 1.7f * lag);
+  EXPECT_GT(lag_after_ramp(4.0), 3.4f * lag);
+}
+
+TEST(PostureBias, TheAverageLengthensAsTheSensorsNoiseRises) {
+  // A steady sensor's offset is a suit's calibration and drift, to be followed; a noisy sensor's
+  // average must keep its white noise out: as the square root of the noise, between the two.
+  const PostureBiasParams params;
+  const float level = params.noisy_time_constant_level;
+  EXPECT_DOUBLE_EQ(params.time_constant(0.0f), params.time_constant_s);
+  EXPECT_DOUBLE_EQ(params.time_constant(level), params.noisy_time_constant_s);
+  EXPECT_DOUBLE_EQ(params.time_constant(10.0f * level), params.noisy_time_constant_s);
+  EXPECT_NEAR(params.time_constant(0.5625f * level), 0.75 * params.noisy_time_constant_s, 1e-6);
+  EXPECT_DOUBLE_EQ(params.time_constant(0.01f * level), params.time_constant_s);
+  EXPECT_LT(params.time_constant_s, params.noisy_time_constant_s);
+  EXPECT_DOUBLE_EQ(params.time_constant(std::numeric_limits<float>::quiet_NaN()),
+                   params.time_constant_s);
+  EXPECT_DOUBLE_EQ(params.time_constant(-1.0f), params.time_constant_s);
+
+  // Under that noise the offset follows a step more slowly.
+  auto learnt_after_one_second = [](float sensor_noise) {
+    PostureBias bias(0, 1, {});
+    const std::vector<float> matched = {0.0f};
+    for (int f = 0; f < 600; ++f) {  // 10 s at 0.5, then 1 s at 1.5
+      std::vector<float> x = {f < 540 ? 0.5f : 1.5f};
+      bias.correct(x);
+      bias.learn(x, matched, 1.0 / 60.0, 1.0f, sensor_noise);
+    }
+    return bias.mean()[0];
+  };
+  EXPECT_NEAR(learnt_after_one_second(0.0f), 1.5f - std::exp(-1.0f), 0.02f);
+  EXPECT_NEAR(learnt_after_one_second(level), 1.5f - std::exp(-0.5f), 0.02f);
 }
 
 TEST(PostureBias, TheLearningDistanceNarrowsAsTheSensorsNoiseRises) {

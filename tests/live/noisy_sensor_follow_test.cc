@@ -158,16 +158,17 @@ TEST(NoisySensorFollow, ASuitCalibratedFarOffHasItsOffsetFoundWhileLost) {
   // Take 60_14 through a suit 8 degrees off per joint (no drift; 3 degrees of white noise): every
   // frame is 0.010-0.022 per dimension from its match, beyond what may teach the posture offset,
   // the pause state holds the input and the follower was lost for its first 15 s. The offset
-  // search (offset_search.h) finds the offset along the dance. Of 24 suits (seeds) two were
-  // lost so: suit 4 25.1 -> 67.6 % within 100 ms (84.4 -> 33.8 % lost), suit 24 38.3 -> 71.0 %
-  // (61.8 -> 26.4 %); the other 22 the same to the digit, suit 1 among them. Printed per suit.
+  // search (offset_search.h) finds the offset along the dance. Of 30 suits (seeds) one is lost
+  // so with today's offset average (1 s on this steady a sensor): suit 4, 26.2 -> 66.2 % within
+  // 100 ms (81.6 -> 32.6 % lost); the other 29 the same to the digit, suit 1 among them (with the
+  // 2 s average before session 31, suit 24 too: 38.3 -> 71.0 %). Printed per suit.
   const DuetLibrary& library = test::salsa_library();
   const DuetTake& take = library.takes()[12];
   const SourceTake source{12, &take.template_motion.clip, take.template_motion.roles};
   PostureBiasParams without;
   without.search.enabled = false;
   double lost_with = 0.0, lost_without = 0.0, within_with = 0.0, within_without = 0.0;
-  for (const std::uint64_t seed : {1, 4, 24}) {
+  for (const std::uint64_t seed : {1, 4}) {
     PerformanceRecipe recipe;
     recipe.noise = {3.0, 0.01, 0};
     recipe.noise.bias_deg = 8.0;
@@ -184,10 +185,10 @@ TEST(NoisySensorFollow, ASuitCalibratedFarOffHasItsOffsetFoundWhileLost) {
         static_cast<int>(seed), take.name.c_str(), 100.0 * with.within_100ms,
         100.0 * with.lost_fraction, 100.0 * off.within_100ms, 100.0 * off.lost_fraction);
     EXPECT_GE(with.within_100ms, off.within_100ms) << "suit " << seed;
-    lost_with += with.lost_fraction / 3.0;
-    lost_without += off.lost_fraction / 3.0;
-    within_with += with.within_100ms / 3.0;
-    within_without += off.within_100ms / 3.0;
+    lost_with += with.lost_fraction / 2.0;
+    lost_without += off.lost_fraction / 2.0;
+    within_with += with.within_100ms / 2.0;
+    within_without += off.within_100ms / 2.0;
   }
   EXPECT_LT(lost_with, 0.6 * lost_without);
   EXPECT_GT(within_with, within_without + 0.15);

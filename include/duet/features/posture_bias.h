@@ -27,9 +27,22 @@ namespace duet {
 
 struct PostureBiasParams {
   bool enabled = true;
-  // The average's time constant (seconds of confident frames). Short enough to follow an inertial
-  // suit's drift (4 -> 2 s in session 10; the shrinkage below keeps the white noise out).
-  double time_constant_s = 2.0;
+  // The average's time constant (seconds of confident frames): time_constant_s on a steady
+  // sensor, longer as the sensor's white noise rises, as the square root of the noise (the
+  // steady-state gain of a Kalman filter for a level that wanders, sqrt(wander / noise)), up to
+  // noisy_time_constant_s at noisy_time_constant_level. Session 10 shortened it from 4 to 2 s to
+  // follow an inertial suit's drift (the shrinkage below keeps the white noise out). Session 31:
+  // at 1 s throughout a suit 8 + 8 degrees off was followed 67.2 -> 73.9 % within 100 ms
+  // (`--suit-sweep`, 28 performances), but `noise-sweep-4` (4 degrees per axis, a noise of about
+  // 0.008) lost 0.06-0.25 points on five rigs; a suit's 3 degrees of white noise is about 0.002.
+  // docs/evaluation.md, "An offset found while lost".
+  double time_constant_s = 1.0;
+  double noisy_time_constant_s = 2.0;
+  float noisy_time_constant_level = 0.008f;
+  // Three points (a headset and two controllers) keep 2 s throughout: there the shorter average
+  // gained nothing on the suit and cost `improv-30hz-noisy` 0.8-1.4 points on the Bandai and
+  // proportioned rigs. FollowSession uses it as time_constant_s for a three-point input.
+  double head_hands_time_constant_s = 2.0;
   double min_weight = 0.2;       // a frame's weight is the follower's confidence, at least this
   float max_offset = 2.0f;       // per dimension, in standardised units (a runaway guard)
   // Frames whose best template match is further than this (squared standardised distance per
@@ -55,6 +68,8 @@ struct PostureBiasParams {
   float learn_noise_factor = 2.0f;
   // The limit above for a sensor whose white-noise variance per dimension is sensor_noise.
   float learn_distance_limit(float sensor_noise) const noexcept;
+  // The average's time constant for that sensor.
+  double time_constant(float sensor_noise) const noexcept;
   // Per dimension the applied offset is mean * max(0, 1 - (k se / mean)^2), se^2 the variance
   // of the running mean given the sensor's noise (James-Stein-like positive-part shrinkage).
   // 2 / 3 / 4 / 6 swept in docs/evaluation.md ("Results", session 8); 0 applies the mean as learnt.
