@@ -50,8 +50,9 @@ class OffsetSearch {
   // One frame the pause state holds: `input` the (already corrected) features, `matched` the
   // template row the tracker rates best, `continues` whether that row follows the previous
   // frame's as the dance does, `limit` the learning gate (squared distance per dimension, as
-  // PostureBiasParams::learn_distance_limit). Returns true when the trial has held for hold_s:
-  // offset() is then the posture offset to remove on top of the one already removed.
+  // PostureBiasParams::learn_distance_limit). Returns true when the trial has held for hold_s and
+  // the matched frames moved enough: offset() is then the posture offset to remove on top of the
+  // one already removed.
   // Non-finite input counts for nothing.
   bool observe(std::span<const float> input, std::span<const float> matched, bool continues,
                float limit, double dt_s, const OffsetSearchParams& params) noexcept;
@@ -68,7 +69,7 @@ class OffsetSearch {
   std::vector<float> mean_;          // running mean of input - matched over the posture block
   std::vector<float> matched_mean_;  // running mean of the matched rows' posture
   double motion_ = 0.0;     // running mean of their squared distance from it, per dimension
-  double seen_s_ = 0.0;     // seconds of the current path
+  double seen_s_ = 0.0;     // seconds observed since reset()
   double held_s_ = 0.0;     // seconds the path has been explained with the trial removed
   double explained_ = 0.0;  // running mean of that distance per dimension
 };
