@@ -152,10 +152,8 @@ void CapturedDuetSampler::compute(double template_frame, const Transform& user_h
                      std::span(rotations_scratch_).first(rn));
 
   const RootPlacement placement = model_->alignment().placement_at(frame);
-  Vec3 position_hs = placement.position_hs;
-  position_hs.x() *= spacing_scale;
-  position_hs.z() *= spacing_scale;
-  Transform root = user_heading * Transform{placement.rotation_hs, position_hs};
+  Transform root =
+      user_heading * Transform{placement.rotation_hs, placement.spaced_position_hs(spacing_scale)};
   root.rotation.normalize();
   placed_pose_.translations_ls = response_pose_.translations_ls;
   placed_pose_.rotations_ls = response_pose_.rotations_ls;

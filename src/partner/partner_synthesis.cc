@@ -698,13 +698,9 @@ bool PartnerSynthesisJob::run() const noexcept {
     const RootPlacement placement = has_position ? model->alignment().placement_at(frame_position)
                                                  : model->alignment().placement(frame);
     // The captured spacing, fitted to the user's body (a taller user stands further away).
-    Vec3 position_hs = placement.position_hs;
-    if (user != nullptr) {
-      const double spacing = model->spacing_scale(user->height_m);
-      position_hs.x() *= spacing;
-      position_hs.z() *= spacing;
-    }
-    const Transform root = heading * Transform{placement.rotation_hs, position_hs};
+    const double spacing = user != nullptr ? model->spacing_scale(user->height_m) : 1.0;
+    const Transform root =
+        heading * Transform{placement.rotation_hs, placement.spaced_position_hs(spacing)};
     out_t[0] = root.translation;
     out_r[0] = root.rotation.normalized();
   }

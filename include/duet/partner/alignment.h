@@ -41,6 +41,11 @@ struct RootPlacement {
 
   // The response's heading minus the template's, wrapped to (-pi, pi].
   double relative_yaw_rad() const noexcept;
+  // position_hs with its horizontal offset scaled by spacing_scale (the captured spacing fitted
+  // to the user's body, PartnerModel::spacing_scale); the height stays.
+  Vec3 spaced_position_hs(double spacing_scale) const noexcept {
+    return {position_hs.x() * spacing_scale, position_hs.y(), position_hs.z() * spacing_scale};
+  }
 };
 
 // The partner's root world transform for a user whose root is at `user_root_position_ws` with
