@@ -4,6 +4,15 @@
 #include <cmath>
 
 namespace duet {
+namespace {
+
+// The root mean square of `count` values whose squares sum to sum_squares (0 for none).
+float root_mean_square(double sum_squares, std::size_t count) {
+  return count == 0 ? 0.0f
+                    : static_cast<float>(std::sqrt(sum_squares / static_cast<double>(count)));
+}
+
+}  // namespace
 
 PostureBias::PostureBias(int begin, int size, const PostureBiasParams& params)
     : begin_(begin),
@@ -52,10 +61,7 @@ void PostureBias::learn(std::span<const float> corrected, std::span<const float>
     offset_[d] = static_cast<float>(mean_[d] * keep);
     sum_squares += static_cast<double>(offset_[d]) * offset_[d];
   }
-  offset_rms_ =
-      offset_.empty()
-          ? 0.0f
-          : static_cast<float>(std::sqrt(sum_squares / static_cast<double>(offset_.size())));
+  offset_rms_ = root_mean_square(sum_squares, offset_.size());
 }
 
 double PostureBiasParams::time_constant(float sensor_noise) const noexcept {
@@ -86,19 +92,16 @@ void PostureBias::reset() noexcept {
 
 void PostureBias::adopt(std::span<const float> offset, double seconds) noexcept {
   if (!params_.enabled || offset.size() != mean_.size()) return;
-  double sum_squares = 0.0;
   for (std::size_t d = 0; d < mean_.size(); ++d) {
     if (!std::isfinite(offset[d])) return;
   }
+  double sum_squares = 0.0;
   for (std::size_t d = 0; d < mean_.size(); ++d) {
     mean_[d] = std::clamp(mean_[d] + offset[d], -params_.max_offset, params_.max_offset);
     offset_[d] = mean_[d];
     sum_squares += static_cast<double>(offset_[d]) * offset_[d];
   }
-  offset_rms_ =
-      mean_.empty()
-          ? 0.0f
-          : static_cast<float>(std::sqrt(sum_squares / static_cast<double>(mean_.size())));
+  offset_rms_ = root_mean_square(sum_squares, offset_.size());
   learnt_s_ = std::max(learnt_s_, std::isfinite(seconds) ? seconds : 0.0);
   lost_s_ = 0.0;
 }
