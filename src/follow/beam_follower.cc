@@ -474,8 +474,7 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
     follow_detail::describe_state(model, alpha, 1.0f, sparse_argmax(context),
                                   params.confidence_window_frames, result, context.beam_);
     result.in_pause = alpha[num_states] > 0.5f;
-    result.jumped =
-        follow_detail::is_jump(model, context.history_.previous_state, result.state, result.steps);
+    result.jumped = model.is_jump(context.history_.previous_state, result.state, result.steps);
   }
   const bool unexplained =
       phi != nullptr &&

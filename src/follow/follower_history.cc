@@ -50,8 +50,8 @@ void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams
   const int advanced = previous_state >= 0 && result.state >= 0 ? result.state - previous_state : 0;
   // A move out of the band's reach the follower did not call a jump (before the first placement
   // settles none is, JumpGate) is the estimate being refined, not a dancer's pace.
-  const bool moved_far = follow_detail::is_jump(
-      model, previous_state, result.state, std::max(result.steps, 1), params.jump_tolerance_frames);
+  const bool moved_far = model.is_jump(previous_state, result.state, std::max(result.steps, 1),
+                                       params.jump_tolerance_frames);
   previous_state = result.state;
   previous_lost = result.lost;
   previous_outlier = result.outlier;

@@ -191,14 +191,6 @@ void normalise(float* mass, int count, int uniform_count) noexcept {
   m.head(uniform_count).setConstant(1.0f / static_cast<float>(uniform_count));
 }
 
-bool is_jump(const TemplateModel& model, int previous_state, int state, int steps,
-             int tolerance) noexcept {
-  if (previous_state < 0 || state < 0) return false;
-  const int moved = state - previous_state;
-  if (moved < -tolerance || moved > 2 * steps + tolerance) return true;
-  return model.take_of(previous_state) != model.take_of(state);
-}
-
 void describe_state(const TemplateModel& model, const float* posterior, float total, int state,
                     int window, FollowResult& result, std::span<const int> support) noexcept {
   const int take = model.take_of(state);
@@ -238,7 +230,7 @@ void decide(const TemplateModel& model, const float* posterior, float total, flo
   }
   describe_state(model, posterior, total, state, window, result);
   result.in_pause = pause_mass > 0.5f * total;
-  result.jumped = is_jump(model, previous_state, state, steps);
+  result.jumped = model.is_jump(previous_state, state, steps);
 }
 
 }  // namespace duet::follow_detail

@@ -104,10 +104,4 @@ void describe_state(const TemplateModel& model, const float* posterior, float to
 void decide(const TemplateModel& model, const float* posterior, float total, float pause_mass,
             int previous_state, int steps, int window, FollowResult& result) noexcept;
 
-// True when going from previous_state to state is not a band move: 0..2*steps frames forward in
-// the same take, where a step back by up to `tolerance` frames counts as no jump (JumpGate's
-// jitter). False when either state is -1.
-bool is_jump(const TemplateModel& model, int previous_state, int state, int steps,
-             int tolerance = 0) noexcept;
-
 }  // namespace duet::follow_detail

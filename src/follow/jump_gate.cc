@@ -37,11 +37,11 @@ bool JumpGate::through_spell(const TemplateModel& model, const FollowParams& par
   if (adrift || unknown) return true;
   // Found again: a jump if out of reach of the place before the spell over the time it lasted
   // (a few frames back from it is jitter, as on any frame).
-  result.jumped = settled(params) &&
-                  follow_detail::is_jump(model, steady_state_, result.state,
-                                         steps_since_steady_ + std::max(result.steps, 1),
-                                         params.jump_tolerance_frames) &&
-                  !looks_alike(model, params, steady_state_, result.state);
+  result.jumped =
+      settled(params) &&
+      model.is_jump(steady_state_, result.state, steps_since_steady_ + std::max(result.steps, 1),
+                    params.jump_tolerance_frames) &&
+      !looks_alike(model, params, steady_state_, result.state);
   in_spell_ = false;
   forget_candidate();
   return true;
@@ -73,14 +73,15 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
   const int steps = std::max(result.steps, 1);
   const double step_s = static_cast<double>(steps) / model.frame_rate_hz();
   if (previous_state < 0 || result.missing || result.state < 0 ||
-      !follow_detail::is_jump(model, previous_state, result.state, steps, tolerance)) {
+      !model.is_jump(previous_state, result.state, steps, tolerance)) {
     // Within reach of the old place: no jump, whatever the raw maximum's step was.
     result.jumped = false;
     // Settling counts the frames the follower is sure of; once settled, it stays settled.
     const bool sure = settled(params) || result.window_mass >= params.jump_settle_mass;
     if (previous_state >= 0 && result.state >= 0 && sure) {
       settled_s_ += step_s;
-      // Within reach a move forward stays in the take (is_jump: another take is a jump).
+      // Within reach a move forward stays in the take (TemplateModel::is_jump: another take is a
+      // jump).
       if (result.state > previous_state) {
         advanced_s_ += static_cast<double>(result.state - previous_state) / model.frame_rate_hz();
       }
@@ -106,8 +107,7 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
   // The maximum is far from the old place. The same far place (moving along its take) holds on;
   // another one starts over.
   const bool same_candidate =
-      candidate_state_ >= 0 &&
-      !follow_detail::is_jump(model, candidate_state_, result.state, steps, tolerance);
+      candidate_state_ >= 0 && !model.is_jump(candidate_state_, result.state, steps, tolerance);
   held_s_ = same_candidate ? held_s_ + step_s : step_s;
   candidate_state_ = result.state;
   // The old place's reach: where its continuation would be.

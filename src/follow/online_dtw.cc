@@ -139,7 +139,7 @@ FollowResult OnlineDtwTracker::step(std::span<const float> features, double dt_s
   result.state = state;
   result.take = window_take;
   result.frame_in_take = state - model.take_begin(window_take);
-  result.jumped = follow_detail::is_jump(model, previous_state_, state, result.steps);
+  result.jumped = model.is_jump(previous_state_, state, result.steps);
   previous_state_ = state;
   previous_lost_ = result.lost;
   return result;

@@ -124,10 +124,9 @@ void FollowSession::search_offset(const FollowResult& result, double dt_s) noexc
   // The matched frames follow one another as a dance does: within the take, forward by up to the
   // band's reach, or back by a few frames of jitter.
   constexpr int kJitterFrames = 6;
-  const int moved = result.state - search_state_;
-  const bool continues = search_state_ >= 0 && model.take_of(search_state_) == result.take &&
-                         moved >= -kJitterFrames &&
-                         moved <= 2 * std::max(result.steps, 1) + kJitterFrames;
+  const bool continues =
+      search_state_ >= 0 &&
+      !model.is_jump(search_state_, result.state, std::max(result.steps, 1), kJitterFrames);
   search_state_ = result.state;
   const auto& rows = model.features();
   const std::span<const float> matched(rows.row(result.state).data(),

@@ -38,6 +38,24 @@ TEST(TemplateModel, BuildsAndFindsTakes) {
   for (int i = 0; i < 10; ++i) EXPECT_EQ(m.take_of(i), expected_take[i]) << i;
 }
 
+TEST(TemplateModel, AJumpIsAMoveOutOfTheBandOrIntoAnotherTake) {
+  Result<TemplateModel> model = TemplateModel::build(ones(40, 2), {0, 20}, 60.0);
+  ASSERT_TRUE(model.ok()) << error_of(model);
+  const TemplateModel& m = model.value();
+  // One step reaches 0..2 frames forward (self, next, skip).
+  EXPECT_FALSE(m.is_jump(5, 5, 1));
+  EXPECT_FALSE(m.is_jump(5, 7, 1));
+  EXPECT_TRUE(m.is_jump(5, 8, 1));
+  EXPECT_FALSE(m.is_jump(5, 11, 3));    // three steps: up to 6 frames
+  EXPECT_TRUE(m.is_jump(5, 4, 1));      // back is a jump ...
+  EXPECT_FALSE(m.is_jump(5, 2, 1, 3));  // ... unless within the jitter tolerance
+  EXPECT_FALSE(m.is_jump(5, 10, 1, 3));
+  EXPECT_TRUE(m.is_jump(5, 11, 1, 3));
+  EXPECT_TRUE(m.is_jump(19, 20, 1));   // the next state is another take
+  EXPECT_FALSE(m.is_jump(-1, 30, 1));  // no place yet
+  EXPECT_FALSE(m.is_jump(30, -1, 1));
+}
+
 TEST(TemplateModel, EmptyTakeListIsOneTake) {
   Result<TemplateModel> model = TemplateModel::build(ones(5, 2), {}, 30.0);
   ASSERT_TRUE(model.ok());

@@ -70,6 +70,11 @@ class TemplateModel {
   int take_end(int take) const { return take_start_[static_cast<std::size_t>(take) + 1]; }
   // The take that contains state (O(log takes)); state must be in [0, M).
   int take_of(int state) const;
+  // True when moving from state `from` to `to` over `steps` template steps leaves the band of
+  // self/next/skip moves (method.md 2): anything but 0..2*steps frames forward in the same take,
+  // where a step back by up to `tolerance` frames counts as no jump (a follower's jitter). False
+  // when either state is -1 (no place yet).
+  bool is_jump(int from, int to, int steps, int tolerance = 0) const noexcept;
 
   // A library grown with copies of its takes (copy_places.h): where each state sits in the
   // captured takes, for a confidence that counts every copy of a moment. Null otherwise. Set
