@@ -3,12 +3,19 @@
 #include <algorithm>
 #include <cmath>
 
+#include "duet/math/lookup_table.h"
+
 namespace duet {
 
 namespace {
 
 constexpr int kBands = 5;
-constexpr int kKnots = 21;  // at coordinates 0, 0.1, ..., 0.9, 0.91, ..., 1.0
+constexpr int kKnots = 21;
+// Where the table's values sit in coordinate(): scripts/fit_confidence_calibration.py's KNOTS,
+// 0, 0.1, ..., 0.9, then 0.9 again and 0.91, ..., 1.0 (its two 0.9 values are the same).
+constexpr float kKnotCoordinates[kKnots] = {0.0f,  0.1f,  0.2f,  0.3f,  0.4f,  0.5f,  0.6f,
+                                            0.7f,  0.8f,  0.9f,  0.9f,  0.91f, 0.92f, 0.93f,
+                                            0.94f, 0.95f, 0.96f, 0.97f, 0.98f, 0.99f, 1.0f};
 // Band b holds noise in [kNoiseEdges[b - 1], kNoiseEdges[b]): clean, about 2, 3, 4.5 and 6+
 // degrees of rotation noise per joint (RMS).
 constexpr float kNoiseEdges[kBands - 1] = {3e-4f, 1.5e-3f, 4e-3f, 8e-3f};
@@ -50,15 +57,9 @@ float ConfidenceCalibration::coordinate(float window_mass) noexcept {
 }
 
 float ConfidenceCalibration::apply(float window_mass, float noise) noexcept {
-  int band = 0;
-  while (band < kBands - 1 && noise >= kNoiseEdges[band]) ++band;  // NaN noise: band 0
-  const float x = coordinate(window_mass);
-  // Knot k sits at k / 10 for k <= 9, at 0.9 + (k - 9) / 100 above.
-  const float position = x <= 0.9f ? x * 10.0f : 9.0f + (x - 0.9f) * 100.0f;
-  const int k = std::clamp(static_cast<int>(position), 0, kKnots - 2);
-  const float t = std::clamp(position - static_cast<float>(k), 0.0f, 1.0f);
-  const float* row = kTable[band];
-  return std::clamp(row[k] + t * (row[k + 1] - row[k]), 0.0f, 1.0f);
+  const float* row = kTable[band_of(noise, kNoiseEdges)];
+  return interpolate_knots(kKnotCoordinates, std::span<const float>(row, kKnots),
+                           coordinate(window_mass));
 }
 
 }  // namespace duet

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <iterator>
 
+#include "duet/math/lookup_table.h"
+
 namespace duet {
 namespace {
 
@@ -170,12 +172,6 @@ constexpr float kTable[kInputs][kOffsetBands][kLearntBands][kKnotCount] = {
     },
 };
 
-int band_of(float value, const float* edges, int edge_count) {
-  int band = 0;
-  while (band < edge_count && value >= edges[band]) ++band;  // NaN: band 0
-  return band;
-}
-
 }  // namespace
 
 float YoungOffsetConfidence::apply(float confidence, float offset_rms, float learnt_s,
@@ -183,13 +179,9 @@ float YoungOffsetConfidence::apply(float confidence, float offset_rms, float lea
   const float c = std::isfinite(confidence) ? std::clamp(confidence, 0.0f, 1.0f) : 0.0f;
   if (!(learnt_s < kSettledS)) return c;  // settled (or NaN)
   const int input = points == InputPoints::kHeadHands ? 1 : 0;
-  const float* row = kTable[input][band_of(offset_rms, kOffsetEdges, kOffsetBands - 1)]
-                           [band_of(learnt_s, kLearntEdges, kLearntBands - 1)];
-  const int k =
-      std::clamp(static_cast<int>(std::upper_bound(kKnots, kKnots + kKnotCount, c) - kKnots) - 1, 0,
-                 kKnotCount - 2);
-  const float t = (c - kKnots[k]) / (kKnots[k + 1] - kKnots[k]);
-  return std::clamp(row[k] + std::clamp(t, 0.0f, 1.0f) * (row[k + 1] - row[k]), 0.0f, 1.0f);
+  const float* row =
+      kTable[input][band_of(offset_rms, kOffsetEdges)][band_of(learnt_s, kLearntEdges)];
+  return interpolate_knots(kKnots, std::span<const float>(row, kKnotCount), c);
 }
 
 }  // namespace duet
