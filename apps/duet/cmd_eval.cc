@@ -507,7 +507,9 @@ Command register_eval(CLI::App& app) {
                  "120hz-noisy (a 120 Hz sensor with the noise), dropouts (the noise, and the "
                  "sensor loses the dancer for 0.3-1 s every 8 s), suit-drift (an inertial "
                  "suit: the noise, and every joint off by a calibration error and a slow drift), "
-                 "tilted (the noise in a tilted world, as a camera pitched down sees it)")
+                 "tilted (the noise in a tilted world, as a camera pitched down sees it), occluded "
+                 "(the noise, and one arm held where last seen for 0.3-1.5 s every 6 s, as an "
+                 "optical system does when the partner hides its markers)")
       ->delimiter(',');
   app.add_flag("--noise-sweep", args->noise_sweep,
                "Also run noise-sweep-0 ... noise-sweep-5: improv-pause with 0 to 5 degrees of "

@@ -382,6 +382,68 @@ void record_true_headings(Performance& performance) {
 
 namespace {
 
+// Spans of [min_s, max_s] seconds of the performance's time, one every every_s on average
+// (exponential waits between them; never the first frame): per frame the index of the span it
+// falls in, -1 outside. Empty when there are none.
+std::vector<int> random_spans(const std::vector<double>& times_s, double every_s, double min_s,
+                              double max_s, Rng& rng) {
+  const int frames = static_cast<int>(times_s.size());
+  if (!(every_s > 0.0) || frames == 0) return {};
+  std::exponential_distribution<double> wait(1.0 / every_s);
+  const double low = std::max(min_s, 0.0);
+  const double high = std::max(max_s, low);
+  std::vector<int> span_of(static_cast<std::size_t>(frames), -1);
+  double start = times_s.front() + wait(rng);
+  int f = 1;  // the first frame is never in a span
+  for (int span = 0; start <= times_s.back(); ++span) {
+    const double end = start + uniform(rng, low, high);
+    for (; f < frames && times_s[static_cast<std::size_t>(f)] < end; ++f) {
+      if (times_s[static_cast<std::size_t>(f)] >= start)
+        span_of[static_cast<std::size_t>(f)] = span;
+    }
+    start = end + wait(rng);
+  }
+  return span_of;
+}
+
+// SensorNoiseOptions' occlusions: per frame, the arm (Side) held still, -1 for none. Spans from
+// random_spans, each holding one arm drawn at random; their own random stream.
+std::vector<int> occluded_arms(const Performance& performance, const SensorNoiseOptions& options) {
+  Rng rng(derive_seed(options.seed, 8));
+  std::vector<int> arm_of = random_spans(performance.times_s, options.occlusion_every_s,
+                                         options.occlusion_min_s, options.occlusion_max_s, rng);
+  std::vector<int> arm_of_span;
+  std::bernoulli_distribution right(0.5);
+  for (int& arm : arm_of) {
+    if (arm < 0) continue;
+    while (static_cast<int>(arm_of_span.size()) <= arm) arm_of_span.push_back(right(rng) ? 1 : 0);
+    arm = arm_of_span[static_cast<std::size_t>(arm)];
+  }
+  return arm_of;
+}
+
+// An occluded arm keeps its shoulder's, elbow's and wrist's local rotations of the frame before
+// the occlusion began, while the rest of the body moves on. Before the noise, which the sensor
+// goes on adding.
+void hold_occluded_arms(Performance& performance, const SensorNoiseOptions& options) {
+  const std::vector<int> occluded = occluded_arms(performance, options);
+  constexpr std::array<std::array<Role, 3>, 2> kArmJoints = {
+      {{Role::kLeftShoulder, Role::kLeftElbow, Role::kLeftWrist},
+       {Role::kRightShoulder, Role::kRightElbow, Role::kRightWrist}}};
+  Clip& motion = performance.motion;
+  for (std::size_t f = 1; f < occluded.size(); ++f) {
+    const int arm = occluded[f];
+    if (arm < 0) continue;
+    const int frame = static_cast<int>(f);
+    for (const Role role : kArmJoints[static_cast<std::size_t>(arm)]) {
+      const int joint = performance.roles[role];
+      if (joint < 0) continue;
+      const auto i = static_cast<std::size_t>(joint);
+      motion.rotations_ls(frame)[i] = motion.rotations_ls(frame - 1)[i];
+    }
+  }
+}
+
 // SensorNoiseOptions' slow errors: per joint a constant offset plus a drifting one, as rotation
 // vectors, advanced frame by frame with the performance's timestamps.
 class SlowRotationErrors {
@@ -433,6 +495,7 @@ Performance with_sensor_noise(Performance performance, const SensorNoiseOptions&
   Clip& motion = performance.motion;
   const Skeleton& skeleton = motion.skeleton();
   SlowRotationErrors slow(options, skeleton.joint_count());
+  hold_occluded_arms(performance, options);
   for (int f = 0; f < motion.frame_count(); ++f) {
     auto translations = motion.translations_ls(f);
     auto rotations = motion.rotations_ls(f);
@@ -489,26 +552,11 @@ namespace {
 // Which frames fall into a tracking loss (FrameLossOptions::gap_every_s); empty when there are
 // none. Its own random stream, so performances without losses stay what they were.
 std::vector<bool> tracking_losses(const Performance& performance, const FrameLossOptions& options) {
-  const int frames = performance.frame_count();
-  if (!(options.gap_every_s > 0.0) || frames == 0) return {};
   Rng rng(derive_seed(options.seed, 5));
-  std::exponential_distribution<double> wait(1.0 / options.gap_every_s);
-  const double low = std::max(options.gap_min_s, 0.0);
-  const double high = std::max(options.gap_max_s, low);
-  std::vector<bool> lost(static_cast<std::size_t>(frames), false);
-  const double first = performance.times_s.front();
-  const double last = performance.times_s.back();
-  double start = first + wait(rng);
-  int f = 1;  // the first frame is always kept
-  while (start <= last) {
-    const double end = start + uniform(rng, low, high);
-    for (; f < frames && performance.times_s[static_cast<std::size_t>(f)] < end; ++f) {
-      if (performance.times_s[static_cast<std::size_t>(f)] >= start) {
-        lost[static_cast<std::size_t>(f)] = true;
-      }
-    }
-    start = end + wait(rng);
-  }
+  const std::vector<int> spans = random_spans(performance.times_s, options.gap_every_s,
+                                              options.gap_min_s, options.gap_max_s, rng);
+  std::vector<bool> lost(spans.size(), false);
+  for (std::size_t f = 0; f < spans.size(); ++f) lost[f] = spans[f] >= 0;
   return lost;
 }
 

@@ -372,6 +372,73 @@ TEST(Perturbations, ASuitsCalibrationIsConstantAndItsDriftWandersSlowly) {
   EXPECT_EQ(a.motion.translations_ls(7)[0], b.motion.translations_ls(7)[0]);
 }
 
+TEST(Perturbations, AnOccludedArmIsHeldWhereLastSeenWhileTheBodyMovesOn) {
+  const Fixture f = make_fixture(1800);
+  const Performance clean = play(f.source(), {});
+  SensorNoiseOptions options;
+  options.occlusion_every_s = 4.0;  // 30 s of take: about 7 spans of 0.3-1.5 s
+  options.seed = 5;
+  const Performance occluded = with_sensor_noise(clean, options);
+  const std::array<std::array<Role, 3>, 2> arms = {
+      {{Role::kLeftShoulder, Role::kLeftElbow, Role::kLeftWrist},
+       {Role::kRightShoulder, Role::kRightElbow, Role::kRightWrist}}};
+  const auto same = [](const Quat& a, const Quat& b) { return a.angularDistance(b) < 1e-12; };
+  int held_frames = 0, spans = 0;
+  std::array<int, 2> spans_of_arm{};
+  int previous_arm = -1;
+  for (int k = 0; k < clean.frame_count(); ++k) {
+    // Which arm (if any) differs from the clean take at frame k.
+    int arm = -1;
+    for (int a = 0; a < 2; ++a) {
+      for (const Role role : arms[static_cast<std::size_t>(a)]) {
+        const auto i = static_cast<std::size_t>(f.roles[role]);
+        if (!same(occluded.motion.rotations_ls(k)[i], clean.motion.rotations_ls(k)[i])) arm = a;
+      }
+    }
+    // Every other joint, and the root's place, is the clean take's.
+    for (int j = 0; j < clean.motion.joint_count(); ++j) {
+      const auto i = static_cast<std::size_t>(j);
+      const bool in_arm = arm >= 0 && std::ranges::any_of(arms[static_cast<std::size_t>(arm)],
+                                                          [&](Role r) { return f.roles[r] == j; });
+      if (!in_arm) {
+        ASSERT_TRUE(same(occluded.motion.rotations_ls(k)[i], clean.motion.rotations_ls(k)[i]))
+            << "joint " << j << " frame " << k;
+      }
+    }
+    EXPECT_EQ(occluded.motion.translations_ls(k)[0], clean.motion.translations_ls(k)[0]);
+    if (arm >= 0) {
+      ASSERT_GT(k, 0) << "the first frame is never occluded";
+      // The held arm shows the previous frame's rotations: still while the take moves it.
+      for (const Role role : arms[static_cast<std::size_t>(arm)]) {
+        const auto i = static_cast<std::size_t>(f.roles[role]);
+        EXPECT_TRUE(
+            same(occluded.motion.rotations_ls(k)[i], occluded.motion.rotations_ls(k - 1)[i]))
+            << "frame " << k;
+      }
+      ++held_frames;
+      if (previous_arm != arm) {
+        ++spans;
+        ++spans_of_arm[static_cast<std::size_t>(arm)];
+      }
+    }
+    previous_arm = arm;
+  }
+  // About 7 spans of 0.9 s on average: 6 % to 40 % of the frames, both arms.
+  EXPECT_GE(spans, 3);
+  EXPECT_GT(held_frames, clean.frame_count() / 16);
+  EXPECT_LT(held_frames, clean.frame_count() * 2 / 5);
+  EXPECT_GT(spans_of_arm[0], 0);
+  EXPECT_GT(spans_of_arm[1], 0);
+  // The white noise is what it was without occlusions: the occlusions have their own stream.
+  SensorNoiseOptions white{3.0, 0.01, 11};
+  SensorNoiseOptions white_and_occluded = white;
+  white_and_occluded.occlusion_every_s = 4.0;
+  const Performance a = with_sensor_noise(clean, white);
+  const Performance b = with_sensor_noise(clean, white_and_occluded);
+  EXPECT_EQ(a.motion.translations_ls(7)[0], b.motion.translations_ls(7)[0]);
+  EXPECT_EQ(a.motion.rotations_ls(9)[0].coeffs(), b.motion.rotations_ls(9)[0].coeffs());
+}
+
 // Frames flagged as the start of a jump in a performance's truth.
 int count_jumps(const Performance& performance) {
   return static_cast<int>(
@@ -527,6 +594,11 @@ TEST(EvalCases, HarshCaseAndNoiseSweepHaveIssue11sMagnitudes) {
   ASSERT_NE(tilted, cases.end());
   EXPECT_DOUBLE_EQ(tilted->recipe.world_tilt_deg, 12.0);
   EXPECT_TRUE(tilted->recipe.noise.active());
+  // An optical system's occluded arms: the noise, and an arm held every 6 s on average.
+  const auto occluded = std::ranges::find(cases, std::string("occluded"), &EvalCase::name);
+  ASSERT_NE(occluded, cases.end());
+  EXPECT_DOUBLE_EQ(occluded->recipe.noise.occlusion_every_s, 6.0);
+  EXPECT_GT(occluded->recipe.noise.rotation_deg, 0.0);
 }
 
 TEST(Perturbations, ATiltedWorldIsLevelledAsALoadedFileIsAndTheRealWristsTurnWithIt) {

@@ -140,6 +140,12 @@ Result<Performance> recorded_performance(Clip clip, const JointRoles& roles, int
 // sensors drift (drift_deg, RMS angle of a random rotation per joint that wanders with time
 // constant drift_time_s: an Ornstein-Uhlenbeck process per axis, in the performance's time).
 // Both come after the joint's rotation and before the white noise, from their own random stream.
+//
+// An optical system loses an arm's markers whenever the partner's body hides them: spans of
+// [occlusion_min_s, occlusion_max_s] seconds, one every occlusion_every_s on average (exponential
+// waits, never the first frame), in which one arm drawn at random is held where it was last seen
+// (its shoulder's, elbow's and wrist's local rotations frozen while the body moves on, as a live
+// solver holds a segment it cannot see). The white noise goes on on top; its own random stream.
 struct SensorNoiseOptions {
   double rotation_deg = 0.0;
   double position_m = 0.0;
@@ -147,9 +153,13 @@ struct SensorNoiseOptions {
   double bias_deg = 0.0;
   double drift_deg = 0.0;
   double drift_time_s = 10.0;
+  double occlusion_every_s = 0.0;  // 0: no occlusions
+  double occlusion_min_s = 0.3;
+  double occlusion_max_s = 1.5;
 
   bool active() const {
-    return rotation_deg > 0.0 || position_m > 0.0 || bias_deg > 0.0 || drift_deg > 0.0;
+    return rotation_deg > 0.0 || position_m > 0.0 || bias_deg > 0.0 || drift_deg > 0.0 ||
+           occlusion_every_s > 0.0;
   }
 };
 Performance with_sensor_noise(Performance performance, const SensorNoiseOptions& options);

@@ -65,7 +65,8 @@ struct CaseSettings {
 // 120hz-noisy (a sensor faster than the template, with the noise), dropouts (the noise, and
 // tracking lost for 0.3-1 s every 8 s on average), suit-drift (an inertial suit: the noise, and
 // every joint off by a calibration error and a slow drift), tilted (the noise, in a world tilted as
-// a pitched camera sees it; levelled as a loaded file is).
+// a pitched camera sees it; levelled as a loaded file is), occluded (the noise, and one arm held
+// where last seen for 0.3-1.5 s every 6 s on average).
 std::vector<EvalCase> standard_cases(const CaseSettings& settings = {});
 
 // The noise sweep (`duet eval --noise-sweep`): noise-sweep-0 ... noise-sweep-5, improv-pause at
