@@ -26,6 +26,7 @@
 #include "motion_options.h"
 #include "number_checks.h"
 #include "progress.h"
+#include "tracker_options.h"
 
 namespace duet::app {
 
@@ -65,6 +66,8 @@ struct EvalArgs {
   std::optional<int> jump_tolerance;
   std::optional<float> jump_settle;
   std::optional<float> noisy_jump_hold;
+  std::optional<float> unexplained_jump_hold;
+  std::optional<float> unexplained_jump_ratio;
   std::optional<float> jump_old_place_mass;
   std::optional<float> jump_alike_distance;
   std::optional<float> jump_settle_mass;
@@ -251,6 +254,8 @@ int run_eval(EvalArgs& args) {
   if (args.jump_tolerance) hmm.jump_tolerance_frames = *args.jump_tolerance;
   if (args.jump_settle) hmm.jump_settle_s = *args.jump_settle;
   if (args.noisy_jump_hold) hmm.noisy_jump_hold_s = *args.noisy_jump_hold;
+  if (args.unexplained_jump_hold) hmm.unexplained_jump_hold_s = *args.unexplained_jump_hold;
+  if (args.unexplained_jump_ratio) hmm.unexplained_jump_ratio = *args.unexplained_jump_ratio;
   if (args.jump_old_place_mass) hmm.jump_old_place_mass = *args.jump_old_place_mass;
   if (args.jump_alike_distance) hmm.jump_alike_distance_per_dim = *args.jump_alike_distance;
   if (args.jump_settle_mass) hmm.jump_settle_mass = *args.jump_settle_mass;
@@ -291,6 +296,8 @@ int run_eval(EvalArgs& args) {
   if (!args.arms_forward_error_cm.empty() && !args.tell_arms_forward) {
     return usage_error("--arms-forward-error-cm: needs --tell-arms-forward");
   }
+  // As `duet follow` and `duet serve` make the follower for these input points, unless asked.
+  if (!args.unexplained_jump_hold) hmm = suited_to_points(hmm, features.input_points);
 
   std::string gnuplot;
   if (!args.plots_dir.empty()) {
@@ -401,7 +408,8 @@ int run_eval(EvalArgs& args) {
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
       "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s "
-      "(mass {}, advance {} s) noisy_jump_hold {} s jump_old_place_mass {} jump_alike_distance {}\n"
+      "(mass {}, advance {} s) noisy_jump_hold {} s unexplained_jump_hold {} s (over {} x noise) "
+      "jump_old_place_mass {} jump_alike_distance {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
       "lost_residual_factor {} lost_confirm {} s lost_velocity_cap {}/dim{} emission_noise_factor "
       "{} "
@@ -412,12 +420,12 @@ int run_eval(EvalArgs& args) {
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
       hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.jump_settle_mass,
-      hmm.jump_settle_advance_s, hmm.noisy_jump_hold_s, hmm.jump_old_place_mass,
-      hmm.jump_alike_distance_per_dim, hmm.pause_noise_factor, hmm.lost_residual_per_dim,
-      hmm.lost_noise_factor, hmm.lost_residual_factor, hmm.lost_confirm_s,
-      hmm.lost_velocity_cap_per_dim, hmm.pause_reported_lost ? " pause_reported_lost" : "",
-      hmm.emission_noise_factor, hmm.emission_noise_allowance, hmm.noise_filter_density,
-      hmm.noise_filter_allowance);
+      hmm.jump_settle_advance_s, hmm.noisy_jump_hold_s, hmm.unexplained_jump_hold_s,
+      hmm.unexplained_jump_ratio, hmm.jump_old_place_mass, hmm.jump_alike_distance_per_dim,
+      hmm.pause_noise_factor, hmm.lost_residual_per_dim, hmm.lost_noise_factor,
+      hmm.lost_residual_factor, hmm.lost_confirm_s, hmm.lost_velocity_cap_per_dim,
+      hmm.pause_reported_lost ? " pause_reported_lost" : "", hmm.emission_noise_factor,
+      hmm.emission_noise_allowance, hmm.noise_filter_density, hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
   if (!non_dance.value().empty()) {
     fmt::print(
@@ -734,6 +742,16 @@ Command register_eval(CLI::App& app) {
                    "noisy_jump_hold_s: the jump hold under a noisy sensor, reached at "
                    "noisy_jump_hold_level of estimated noise (template seconds; 0 for none)")
       ->check(number_between(0.0, 10.0));
+  tuning
+      ->add_option("--unexplained-jump-hold", args->unexplained_jump_hold,
+                   "unexplained_jump_hold_s: the jump hold for a far place the input fits "
+                   "poorly, its best distance over --unexplained-jump-ratio x the sensor's noise "
+                   "and over the lost residual (template seconds; 0 for none)")
+      ->check(number_between(0.0, 10.0));
+  tuning
+      ->add_option("--unexplained-jump-ratio", args->unexplained_jump_ratio,
+                   "unexplained_jump_ratio: see --unexplained-jump-hold")
+      ->check(CLI::PositiveNumber);
   tuning
       ->add_option("--jump-old-place-mass", args->jump_old_place_mass,
                    "jump_old_place_mass: a far place is reported only once the old place's "

@@ -75,8 +75,7 @@ std::optional<double> lost_as_other_role(const FollowArgs& args, const Clip& use
   other.model_cache.clear();  // the cache holds this role's model; do not overwrite it
   std::optional<DuetLibrary> library = load_library(other, "follow", features);
   if (!library) return std::nullopt;
-  Result<std::unique_ptr<Tracker>> tracker =
-      make_tracker(args.tracker, library->model(), library->candidate_index());
+  Result<std::unique_ptr<Tracker>> tracker = make_tracker(args.tracker, *library);
   if (!tracker) return std::nullopt;
   Result<FollowSession> session =
       FollowSession::create(*library, user.skeleton_ptr(), roles, std::move(tracker).value());
@@ -205,8 +204,7 @@ int run_follow(const FollowArgs& args) {
     return kExitFailure;
   }
 
-  Result<std::unique_ptr<Tracker>> tracker =
-      make_tracker(args.tracker, library->model(), library->candidate_index());
+  Result<std::unique_ptr<Tracker>> tracker = make_tracker(args.tracker, *library);
   if (!tracker) {
     fmt::print(stderr, "duet follow: {}\n", tracker.error().message);
     return kExitFailure;

@@ -274,8 +274,7 @@ Result<std::unique_ptr<LiveLoop>> make_loop(std::shared_ptr<const DuetLibrary> l
                                             const TrackerArgs& tracker_args,
                                             const SourceSkeleton& user,
                                             const PartnerParams& params) {
-  Result<std::unique_ptr<Tracker>> tracker =
-      make_tracker(tracker_args, library->model(), library->candidate_index());
+  Result<std::unique_ptr<Tracker>> tracker = make_tracker(tracker_args, *library);
   if (!tracker) return tracker.error();
   Result<LiveLoop> loop =
       LiveLoop::create(std::move(library), user, std::move(tracker).value(), params);

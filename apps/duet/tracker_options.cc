@@ -39,9 +39,16 @@ void add_tracker_options(CLI::App& app, TrackerArgs& args) {
                "the beam may have lost the dancer (docs/follower.md \"Beam mode\")");
 }
 
-Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args, const TemplateModel& model,
-                                              std::shared_ptr<const JumpCandidateIndex> index) {
-  FollowParams params = args.preset == "paper" ? FollowParams::paper() : FollowParams{};
+FollowParams suited_to_points(FollowParams params, InputPoints points) {
+  if (points == InputPoints::kHeadHands) params.unexplained_jump_hold_s = 0.0f;
+  return params;
+}
+
+Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args, const DuetLibrary& library) {
+  const TemplateModel& model = library.model();
+  FollowParams params =
+      suited_to_points(args.preset == "paper" ? FollowParams::paper() : FollowParams{},
+                       library.options().features.input_points);
   if (args.sigma) params.emission_sigma = *args.sigma;
   if (args.fixed_band) params.tempo_adaptive = false;
   if (args.beam && args.kind != "hmm") {
@@ -51,9 +58,9 @@ Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args, const Tem
   if (args.kind == "dtw") return boxed(OnlineDtwTracker::create(model, OnlineDtwParams{}));
   if (args.kind == "naive") return boxed(NaiveHmmFollower::create(model, params));
   if (args.kind == "left-to-right") params.jump_enabled = false;
-  if (args.beam && index) {
-    return boxed(
-        BeamFollower::create(model, params, BeamParams::suited_to(params), std::move(index)));
+  if (args.beam && library.candidate_index()) {
+    return boxed(BeamFollower::create(model, params, BeamParams::suited_to(params),
+                                      library.candidate_index()));
   }
   if (args.beam) return boxed(BeamFollower::create(model, params, BeamParams::suited_to(params)));
   return boxed(HmmFollower::create(model, params));

@@ -27,6 +27,7 @@ FollowParams FollowParams::paper() {
   params.jump_settle_mass = 0.0f;
   params.jump_settle_advance_s = 0.0f;
   params.noisy_jump_hold_s = 0.0f;
+  params.unexplained_jump_hold_s = 0.0f;
   params.jump_old_place_mass = 1.0f;
   params.jump_alike_distance_per_dim = 0.0f;
   params.gate_outliers = false;
@@ -123,6 +124,14 @@ Status FollowParams::validate(int num_states) const {
   if (!(noisy_jump_hold_s >= 0.0f && noisy_jump_hold_s <= 10.0f)) {
     return params_error("noisy_jump_hold_s must be in [0, 10] s, got " +
                         std::to_string(noisy_jump_hold_s));
+  }
+  if (!(unexplained_jump_hold_s >= 0.0f && unexplained_jump_hold_s <= 10.0f)) {
+    return params_error("unexplained_jump_hold_s must be in [0, 10] s, got " +
+                        std::to_string(unexplained_jump_hold_s));
+  }
+  if (!(unexplained_jump_ratio > 0.0f && std::isfinite(unexplained_jump_ratio))) {
+    return params_error("unexplained_jump_ratio must be finite and > 0, got " +
+                        std::to_string(unexplained_jump_ratio));
   }
   if (!(jump_old_place_mass >= 0.0f && jump_old_place_mass <= 1.0f)) {
     return params_error("jump_old_place_mass must be in [0, 1], got " +

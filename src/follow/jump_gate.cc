@@ -7,13 +7,19 @@
 
 namespace duet {
 
-float JumpGate::hold_s(const FollowParams& params, float sensor_noise_per_dim) noexcept {
+float JumpGate::hold_s(const FollowParams& params, float sensor_noise_per_dim,
+                       float best_distance_per_dim) noexcept {
   const float level = params.noisy_jump_hold_level;
+  const bool noise_known = std::isfinite(sensor_noise_per_dim);
   const float ramp =
-      std::isfinite(sensor_noise_per_dim)
-          ? std::clamp((sensor_noise_per_dim - 0.5f * level) / (0.5f * level), 0.0f, 1.0f)
-          : 0.0f;
-  return std::max(params.jump_hold_s, ramp * params.noisy_jump_hold_s);
+      noise_known ? std::clamp((sensor_noise_per_dim - 0.5f * level) / (0.5f * level), 0.0f, 1.0f)
+                  : 0.0f;
+  const float hold = std::max(params.jump_hold_s, ramp * params.noisy_jump_hold_s);
+  // A far place the input fits poorly: a held limb fitting another pose for a moment.
+  const float fits_up_to =
+      std::max(params.unexplained_jump_ratio * (noise_known ? sensor_noise_per_dim : 0.0f),
+               params.lost_residual_per_dim);
+  return best_distance_per_dim > fits_up_to ? std::max(hold, params.unexplained_jump_hold_s) : hold;
 }
 
 bool JumpGate::looks_alike(const TemplateModel& model, const FollowParams& params, int from,
@@ -97,7 +103,7 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
     forget_candidate();
     return;
   }
-  const float hold = hold_s(params, result.sensor_noise_per_dim);
+  const float hold = hold_s(params, result.sensor_noise_per_dim, result.best_distance_per_dim);
   if (previous_lost || result.in_pause) {
     result.jumped =
         !looks_alike(model, params, previous_state, result.state);  // nothing to hold on to

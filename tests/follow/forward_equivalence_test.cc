@@ -91,8 +91,8 @@ TEST(ForwardEquivalence, SameAlphaAndEstimatesOverJumpsRatesAndMissingFrames) {
   for (const Scenario& scenario : scenarios()) {
     SCOPED_TRACE(scenario.name);
     // The naive forward is the paper's model with fixed levels: the O(M) step is compared with
-    // the pause level and the emission's scale fixed, the input unfiltered and the raw window
-    // mass (the noise scaling is tested on its own, sensor_noise_test.cc and
+    // the pause level and the emission's scale fixed, the input unfiltered, no jump hold and the
+    // raw window mass (the noise scaling is tested on its own, sensor_noise_test.cc and
     // noise_filter_test.cc; it changes no part of the forward but the emissions and the input).
     // Nor has it the outlier gate (tested in hmm_follower_test.cc).
     Scenario s = scenario;
@@ -101,6 +101,7 @@ TEST(ForwardEquivalence, SameAlphaAndEstimatesOverJumpsRatesAndMissingFrames) {
     s.params.emission_noise_factor = 0.0f;
     s.params.noise_filter_density = 0.0f;
     s.params.noisy_jump_hold_s = 0.0f;
+    s.params.unexplained_jump_hold_s = 0.0f;
     s.params.calibrate_confidence = false;
     const TemplateModel model = test::make_model(s.takes, 16, 11, 60.0, s.velocity_dims);
     HmmFollower fast = HmmFollower::create(model, s.params).value();

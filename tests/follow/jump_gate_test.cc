@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace duet {
@@ -427,6 +428,52 @@ TEST(JumpGate, UnderANoisySensorAFarPlaceWaitsUntilTheOldPlaceHasLostItsMass) {
   }
 }
 
+TEST(JumpGate, AFarPlaceTheInputFitsPoorlyWaitsTheLongerHold) {
+  FollowParams params;
+  const float noise = 0.0015f;  // about 2 degrees per axis: no noisy hold yet
+  const float fits = params.unexplained_jump_ratio * noise;
+  ASSERT_GT(fits, params.lost_residual_per_dim);
+  EXPECT_EQ(JumpGate::hold_s(params, noise, 0.9f * fits), JumpGate::hold_s(params, noise));
+  EXPECT_EQ(JumpGate::hold_s(params, noise, 1.1f * fits), params.unexplained_jump_hold_s);
+  EXPECT_EQ(JumpGate::hold_s(params, noise, std::nanf("")), JumpGate::hold_s(params, noise));
+  // On a clean sensor the lost residual is the floor of what fits.
+  EXPECT_EQ(JumpGate::hold_s(params, 0.0f, 0.9f * params.lost_residual_per_dim), 0.0f);
+  EXPECT_EQ(JumpGate::hold_s(params, 0.0f, 1.1f * params.lost_residual_per_dim),
+            params.unexplained_jump_hold_s);
+  params.unexplained_jump_hold_s = 0.0f;
+  EXPECT_EQ(JumpGate::hold_s(params, noise, 10.0f * fits), JumpGate::hold_s(params, noise));
+  params.unexplained_jump_hold_s = 0.4f;
+  settle_at_once(params);
+
+  // An arm held where it was last seen fits take 1 better for a moment, and poorly: the old
+  // place goes on until the far place has held for 0.4 s (24 frames at 60 Hz).
+  const TemplateModel model = two_takes();
+  const auto far = [&](int state, float distance) {
+    FollowResult r = maximum_at(model, {}, state);
+    r.sensor_noise_per_dim = noise;
+    r.best_distance_per_dim = distance;
+    return r;
+  };
+  JumpGate gate;
+  int previous = 40;
+  for (int k = 0; k < 24; ++k) {
+    const std::vector<float> p = posterior(120 + k);
+    FollowResult r = far(120 + k, 2.0f * fits);
+    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+    EXPECT_EQ(r.jumped, k == 23) << k;
+    if (k < 23) {
+      EXPECT_EQ(model.take_of(r.state), 0) << k;
+    }
+    previous = r.state;
+  }
+  // A far place that fits as well as the noise allows is taken at once.
+  JumpGate fitting;
+  const std::vector<float> p = posterior(150);
+  FollowResult r = far(150, 0.5f * fits);
+  fitting.apply(model, params, p.data(), 1.0f, 40, false, r);
+  EXPECT_TRUE(r.jumped);
+}
+
 TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
   FollowParams params;
   params.jump_settle_s = -0.1f;
@@ -441,6 +488,14 @@ TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
   params.noisy_jump_hold_level = 0.0f;
   EXPECT_FALSE(params.validate(200));
   params.noisy_jump_hold_level = 0.006f;
+  params.unexplained_jump_hold_s = 11.0f;
+  EXPECT_FALSE(params.validate(200));
+  params.unexplained_jump_hold_s = 0.4f;
+  params.unexplained_jump_ratio = 0.0f;
+  EXPECT_FALSE(params.validate(200));
+  params.unexplained_jump_ratio = std::numeric_limits<float>::infinity();
+  EXPECT_FALSE(params.validate(200));
+  params.unexplained_jump_ratio = 2.2f;
   params.jump_old_place_mass = 1.5f;
   EXPECT_FALSE(params.validate(200));
   params.jump_old_place_mass = std::nanf("");

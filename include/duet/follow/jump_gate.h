@@ -6,7 +6,8 @@
 // not a jump. A move out of the band's reach is reported only once the new place has held the
 // maximum for the hold in template time (a bounded decision delay; until then the best state near
 // the old place is reported): FollowParams::jump_hold_s, or under a noisy sensor the hold that
-// grows with the estimated noise (noisy_jump_hold_s), and once the old place's reach holds at most
+// grows with the estimated noise (noisy_jump_hold_s) or, for a far place the input fits poorly,
+// unexplained_jump_hold_s, and once the old place's reach holds at most
 // jump_old_place_mass of the posterior (a look-alike's brief maximum leaves the old place its
 // evidence; a real jump does not).
 // Adrift (lost, or the pause state holds the posterior) no place explains the input and the
@@ -59,8 +60,10 @@ class JumpGate {
   bool held_a_place(const FollowParams& params) const noexcept {
     return settled_s_ + 1e-6 >= params.jump_settle_s;
   }
-  // The hold (template seconds) at this sensor noise (FollowResult::sensor_noise_per_dim).
-  static float hold_s(const FollowParams& params, float sensor_noise_per_dim) noexcept;
+  // The hold (template seconds) at this sensor noise (FollowResult::sensor_noise_per_dim) for a
+  // far place whose best distance per dimension is best_distance_per_dim (0: one that fits).
+  static float hold_s(const FollowParams& params, float sensor_noise_per_dim,
+                      float best_distance_per_dim = 0.0f) noexcept;
 
  private:
   void forget_candidate() noexcept {
