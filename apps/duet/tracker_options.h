@@ -9,8 +9,6 @@
 #include "duet/base/result.h"
 #include "duet/features/feature_spec.h"
 #include "duet/follow/follow_params.h"
-#include "duet/follow/jump_candidates.h"
-#include "duet/follow/template_model.h"
 #include "duet/follow/tracker.h"
 #include "duet/live/duet_library.h"
 
