@@ -297,7 +297,7 @@ int run_eval(EvalArgs& args) {
     return usage_error("--arms-forward-error-cm: needs --tell-arms-forward");
   }
   // As `duet follow` and `duet serve` make the follower for these input points, unless asked.
-  if (!args.unexplained_jump_hold) hmm = suited_to_points(hmm, features.input_points);
+  if (!args.unexplained_jump_hold) hmm = follow_params_for(features.input_points, hmm);
 
   std::string gnuplot;
   if (!args.plots_dir.empty()) {

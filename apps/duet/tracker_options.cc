@@ -39,16 +39,11 @@ void add_tracker_options(CLI::App& app, TrackerArgs& args) {
                "the beam may have lost the dancer (docs/follower.md \"Beam mode\")");
 }
 
-FollowParams suited_to_points(FollowParams params, InputPoints points) {
-  if (points == InputPoints::kHeadHands) params.unexplained_jump_hold_s = 0.0f;
-  return params;
-}
-
 Result<std::unique_ptr<Tracker>> make_tracker(const TrackerArgs& args, const DuetLibrary& library) {
   const TemplateModel& model = library.model();
   FollowParams params =
-      suited_to_points(args.preset == "paper" ? FollowParams::paper() : FollowParams{},
-                       library.options().features.input_points);
+      follow_params_for(library.options().features.input_points,
+                        args.preset == "paper" ? FollowParams::paper() : FollowParams{});
   if (args.sigma) params.emission_sigma = *args.sigma;
   if (args.fixed_band) params.tempo_adaptive = false;
   if (args.beam && args.kind != "hmm") {

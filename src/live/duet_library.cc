@@ -222,4 +222,9 @@ Result<FeatureExtractor> DuetLibrary::make_extractor(std::shared_ptr<const Skele
   return FeatureExtractor::create(std::move(skeleton), roles, options_.features);
 }
 
+FollowParams follow_params_for(InputPoints points, FollowParams params) {
+  if (points == InputPoints::kHeadHands) params.unexplained_jump_hold_s = 0.0f;
+  return params;
+}
+
 }  // namespace duet

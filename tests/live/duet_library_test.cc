@@ -43,6 +43,17 @@ TEST(DuetLibrary, ConcatenatesTakesAndSwapsRoles) {
   EXPECT_TRUE(a.translations_ls(100)[0].isApprox(b.translations_ls(100)[0]));
 }
 
+TEST(DuetLibrary, ThreePointLibrariesAreFollowedWithoutTheUnexplainedJumpHold) {
+  const FollowParams defaults;
+  ASSERT_GT(defaults.unexplained_jump_hold_s, 0.0f);
+  EXPECT_EQ(follow_params_for(InputPoints::kFullBody, defaults).unexplained_jump_hold_s,
+            defaults.unexplained_jump_hold_s);
+  const FollowParams points = follow_params_for(InputPoints::kHeadHands, defaults);
+  EXPECT_EQ(points.unexplained_jump_hold_s, 0.0f);
+  EXPECT_EQ(points.noisy_jump_hold_s, defaults.noisy_jump_hold_s);  // nothing else changes
+  EXPECT_TRUE(points.validate(100));
+}
+
 TEST(DuetLibrary, RejectsPairsThatAreNotDuets) {
   const std::vector<PairFiles> pairs = {{{salsa("60", "10")}, {salsa("61", "05")}}};
   Result<DuetLibrary> library = DuetLibrary::load(pairs, salsa_options(DancerRole::kLeader));

@@ -12,6 +12,7 @@
 
 #include "duet/base/result.h"
 #include "duet/features/feature_extractor.h"
+#include "duet/follow/follow_params.h"
 #include "duet/follow/jump_candidates.h"
 #include "duet/follow/synthetic_library.h"
 #include "duet/follow/template_model.h"
@@ -65,6 +66,15 @@ struct DuetTake {
   LoadedMotion response_motion;
   int first_state = 0;  // index of this take's frame 0 among all template states
 };
+
+// The follower's parameters for a library of these input points (FeatureSpec::input_points).
+// Three points (a headset and two controllers) take no unexplained-jump hold
+// (FollowParams::unexplained_jump_hold_s): they have no limb an optical system could hold where it
+// last saw it, and fit the template less closely, so the hold delayed true jumps (`improv-library`
+// 2.6 points lower on the handshake rig with the arms-forward calibration; docs/evaluation.md,
+// "An arm held where last seen"). `duet follow`, `duet serve` and `duet eval` make their trackers
+// with it.
+FollowParams follow_params_for(InputPoints points, FollowParams params);
 
 class DuetLibrary {
  public:
