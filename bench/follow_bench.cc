@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "duet/features/feature_spec.h"
 #include "duet/follow/hmm_follower.h"
 #include "duet/follow/naive_hmm.h"
 #include "duet/follow/nearest_neighbour.h"
@@ -29,7 +30,12 @@ TemplateModel random_model(int states, int dims = kDims) {
   std::vector<int> starts;
   for (int s = 0; s < states; s += 2000) starts.push_back(s);
   // The last 8 dimensions are velocities, as in the real features: the HMM caps their distance.
-  return std::move(TemplateModel::build(std::move(f), starts, 60.0, 8)).value();
+  TemplateModel model = std::move(TemplateModel::build(std::move(f), starts, 60.0, 8)).value();
+  // And the full body's limbs, whose share it caps too (FeatureSpec::limb_dims).
+  if (dims - 8 >= FeatureSpec{}.posture_dims()) {
+    if (!model.set_limbs(FeatureSpec{}.limb_dims())) std::abort();
+  }
+  return model;
 }
 
 // Input frames: template frames plus noise, so the emission is realistic.
@@ -141,11 +147,11 @@ void BM_EmissionDistances(benchmark::State& state, SimdLevel level) {
   const TemplateModel model = random_model(kLibraryStates, kLibraryDims);
   const auto inputs = queries(model);
   std::vector<float> out(static_cast<std::size_t>(model.num_states()));
-  const float cap = FollowParams{}.velocity_distance_cap;
+  const follow_detail::DistanceCaps caps = follow_detail::emission_caps(FollowParams{});
   std::size_t q = 0;
   for (auto _ : state) {
     benchmark::DoNotOptimize(
-        follow_detail::emission_distances(model, inputs[q].data(), cap, out.data()));
+        follow_detail::emission_distances(model, inputs[q].data(), caps, out.data()));
     benchmark::ClobberMemory();
     q = (q + 1) % inputs.size();
   }
@@ -166,8 +172,10 @@ void BM_WeighAndNormalise(benchmark::State& state, SimdLevel level) {
   // The dancer exactly on a template frame: the common, fast path (a query far from every
   // template would, with uniform predicted mass, take the rare rescaling path instead).
   const Eigen::RowVectorXf on_template = model.features().row(m / 3);
-  const float best = follow_detail::emission_distances(
-      model, on_template.data(), FollowParams{}.velocity_distance_cap, distance_sq.data());
+  const float best = follow_detail::emission_distances(model, on_template.data(),
+                                                       follow_detail::emission_caps(FollowParams{}),
+                                                       distance_sq.data())
+                         .bounded;
   // The default parameters, as HmmForward::create derives them.
   const FollowParams params;
   const float inv_two_sigma_sq = 1.0f / (2.0f * params.emission_sigma * params.emission_sigma);

@@ -73,8 +73,8 @@ struct EvalArgs {
   std::optional<float> jump_settle_mass;
   std::optional<float> jump_settle_advance;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
-      pause_distance, lost_distance, velocity_cap, pause_noise_factor, lost_residual,
-      lost_noise_factor, lost_residual_factor, lost_confirm, lost_velocity_cap,
+      pause_distance, lost_distance, velocity_cap, limb_ratio, limb_floor, pause_noise_factor,
+      lost_residual, lost_noise_factor, lost_residual_factor, lost_confirm, lost_velocity_cap,
       emission_noise_factor, emission_noise_allowance, noise_filter_density, noise_filter_allowance;
   std::optional<double> tempo_time_constant;
   bool fixed_band = false;
@@ -233,6 +233,8 @@ int run_eval(EvalArgs& args) {
   if (args.pause_distance) hmm.pause_distance_per_dim = *args.pause_distance;
   if (args.lost_distance) hmm.lost_distance_per_dim = *args.lost_distance;
   if (args.velocity_cap) hmm.velocity_distance_cap = *args.velocity_cap;
+  if (args.limb_ratio) hmm.limb_outlier_ratio = *args.limb_ratio;
+  if (args.limb_floor) hmm.limb_outlier_floor = *args.limb_floor;
   if (args.pause_noise_factor) hmm.pause_noise_factor = *args.pause_noise_factor;
   if (args.emission_noise_factor) hmm.emission_noise_factor = *args.emission_noise_factor;
   if (args.noise_filter_density) hmm.noise_filter_density = *args.noise_filter_density;
@@ -407,7 +409,8 @@ int run_eval(EvalArgs& args) {
   fmt::print(
       "library: {} takes, {} states at {:g} fps, user role {}; performances from takes {}; seed "
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
-      "lost_distance {} velocity_cap {} tempo {} jump_hold {} s jump_tolerance {} jump_settle {} s "
+      "lost_distance {} velocity_cap {} limb_outlier {} x (floor {}) tempo {} jump_hold {} s "
+      "jump_tolerance {} jump_settle {} s "
       "(mass {}, advance {} s) noisy_jump_hold {} s unexplained_jump_hold {} s (over {} x noise) "
       "jump_old_place_mass {} jump_alike_distance {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
@@ -417,7 +420,8 @@ int run_eval(EvalArgs& args) {
       library->takes().size(), library->model().num_states(), library->frame_rate(),
       args.library.role, takes, options.seed, hmm.self_prob, hmm.next_prob, hmm.skip_prob,
       hmm.leave_prob, hmm.pause_stay_prob, hmm.emission_sigma, hmm.pause_distance_per_dim,
-      hmm.lost_distance_per_dim, hmm.velocity_distance_cap,
+      hmm.lost_distance_per_dim, hmm.velocity_distance_cap, hmm.limb_outlier_ratio,
+      hmm.limb_outlier_floor,
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
       hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.jump_settle_mass,
       hmm.jump_settle_advance_s, hmm.noisy_jump_hold_s, hmm.unexplained_jump_hold_s,
@@ -676,9 +680,9 @@ Command register_eval(CLI::App& app) {
   tuning
       ->add_option("--lost-velocity-cap-per-dim", args->lost_velocity_cap,
                    "lost_velocity_cap_per_dim: most the velocity blocks add to the lost test's "
-                   "distance, per dimension of the model (and at most --velocity-cap); all HMM "
-                   "variants")
-      ->check(non_negative_check());
+                   "distance, per dimension of the model (and at most --velocity-cap; inf: "
+                   "the emission's); all HMM variants")
+      ->check(cap_check());
   tuning->add_flag("--pause-reported-lost", args->pause_reported_lost,
                    "pause_reported_lost: report frames whose posterior the pause state holds as "
                    "lost although a template frame explains them (the paper preset's reading; "
@@ -713,6 +717,15 @@ Command register_eval(CLI::App& app) {
       ->add_option("--velocity-cap", args->velocity_cap,
                    "velocity_distance_cap: most the velocity blocks add to a squared distance "
                    "(all HMM variants; inf for none)")
+      ->check(cap_check());
+  tuning
+      ->add_option("--limb-outlier-ratio", args->limb_ratio,
+                   "limb_outlier_ratio: the farthest limb adds at most this times the second "
+                   "farthest to a squared distance (all HMM variants; inf for none)")
+      ->check(cap_check());
+  tuning
+      ->add_option("--limb-outlier-floor", args->limb_floor,
+                   "limb_outlier_floor: ... but never less than this (all HMM variants)")
       ->check(non_negative_check());
   tuning
       ->add_option("--tempo-time-constant", args->tempo_time_constant,

@@ -43,6 +43,18 @@ CLI::Validator non_negative_check() {
   return finite_number([](double v) { return v >= 0.0; }, "a finite number >= 0", "NONNEGATIVE");
 }
 
+CLI::Validator cap_check() {
+  const CLI::Validator finite = non_negative_check();
+  return CLI::Validator(
+      [finite](std::string& text) -> std::string {
+        if (text == "inf") return {};
+        return finite(text).empty()
+                   ? std::string()
+                   : fmt::format("must be a finite number >= 0 or inf, got '{}'", text);
+      },
+      "NONNEGATIVE|inf");
+}
+
 CLI::Validator fps_check() { return number_between(kMinFps, kMaxFps, "fps"); }
 
 CLI::Validator scale_check() {

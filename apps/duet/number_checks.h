@@ -25,6 +25,8 @@ CLI::Validator number_between(double low, double high, const std::string& unit =
 // Finite numbers > 0 and >= 0: CLI::PositiveNumber and CLI::NonNegativeNumber without nan and inf.
 CLI::Validator positive_check();
 CLI::Validator non_negative_check();
+// A cap on a distance: a finite number >= 0, or "inf" for none.
+CLI::Validator cap_check();
 
 CLI::Validator fps_check();    // kMinFps..kMaxFps frames per second ("fps")
 CLI::Validator scale_check();  // kMinScale..kMaxScale metres per file unit

@@ -288,6 +288,7 @@ Result<NaiveCheck> run_naive_check(const DuetLibrary& library, const EvalCase& e
       TemplateModel::build(FeatureMatrix(full.features().middleRows(begin, count)), {},
                            full.frame_rate_hz(), full.velocity_dims());
   if (!one) return one.error();
+  if (Status limbs = one.value().set_limbs(full.limbs()); !limbs) return limbs.error();
   const TemplateModel& model = one.value();
   check.states = model.num_states();
 

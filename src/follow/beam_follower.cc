@@ -221,23 +221,31 @@ bool BeamForward::sparse_emission(const float* phi, const CandidateSet& candidat
   const std::size_t count = context.next_.size();
 
   float best = FLT_MAX;
+  float best_plain = FLT_MAX;  // without the limb bound, for lost
   float* d2 = context.distance_sq_.data();
+  const follow_detail::DistanceCaps caps = follow_detail::emission_caps(params);
   for (std::size_t k = 0; k < count; ++k) {
-    d2[k] = follow_detail::state_emission_distance(model, phi, context.next_[k],
-                                                   params.velocity_distance_cap);
+    const follow_detail::EmissionDistance distance =
+        follow_detail::state_emission_distance(model, phi, context.next_[k], caps);
+    d2[k] = distance.bounded;
     best = std::min(best, d2[k]);
+    best_plain = std::min(best_plain, distance.plain);
   }
   // The bound the states left out would have to be beyond for this frame's decisions to be the
-  // exact step's (0: they are already). Lost is decided on the best distance of the whole
-  // library; states left out are >= the bound.
+  // exact step's (0: they are already). Lost is decided on the best plain distance of the whole
+  // library; states left out are >= the bound. (The index bounds the plain distance: a state
+  // left out whose limb bound takes much off can emit above the bound's emission. The beam is an
+  // approximation there.)
   const float bound = candidates.bound;
   float needed = 0.0f;
   const float lost_sq = exact_.noise_levels_.lost_ceiling_sq();
   const float unexplained_sq = exact_.noise_levels_.lost_distance_sq(
       context.frame_noise_, context.history_.explained_residual.level());
   if (candidates.bounded) {
-    if (best > lost_sq && bound <= lost_sq) needed = std::max(needed, lost_sq);
-    if (best > unexplained_sq && bound <= unexplained_sq) needed = std::max(needed, unexplained_sq);
+    if (best_plain > lost_sq && bound <= lost_sq) needed = std::max(needed, lost_sq);
+    if (best_plain > unexplained_sq && bound <= unexplained_sq) {
+      needed = std::max(needed, unexplained_sq);
+    }
   }
 
   const float log_pause = exact_.noise_levels_.log_pause_emission(context.frame_noise_);
@@ -296,8 +304,8 @@ bool BeamForward::sparse_emission(const float* phi, const CandidateSet& candidat
 
   // Accepted. An outlier's evidence is set aside, as in the exact step (FollowParams::
   // gate_outliers); the pause state's majority is settled above.
-  result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
-  result.lost = best > lost_sq;
+  result.best_distance_per_dim = best_plain / static_cast<float>(model.num_dims());
+  result.lost = best_plain > lost_sq;
   if (context.history_.is_outlier(params, pause > 0.5 * sum, best,
                                   exact_.noise_levels_.pause_distance_sq(context.frame_noise_))) {
     renormalise_without_evidence(context);
@@ -476,6 +484,7 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
     result.in_pause = alpha[num_states] > 0.5f;
     result.jumped = model.is_jump(context.history_.previous_state, result.state, result.steps);
   }
+  result.limb_out_of_line = follow_detail::limb_out_of_line(model, params, phi, result.state);
   const bool unexplained =
       phi != nullptr &&
       follow_detail::lost_test_distance(

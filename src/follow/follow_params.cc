@@ -28,6 +28,7 @@ FollowParams FollowParams::paper() {
   params.jump_settle_advance_s = 0.0f;
   params.noisy_jump_hold_s = 0.0f;
   params.unexplained_jump_hold_s = 0.0f;
+  params.limb_outlier_ratio = std::numeric_limits<float>::infinity();
   params.jump_old_place_mass = 1.0f;
   params.jump_alike_distance_per_dim = 0.0f;
   params.gate_outliers = false;
@@ -76,6 +77,14 @@ Status FollowParams::validate(int num_states) const {
   if (!(velocity_distance_cap >= 0.0f)) {  // +inf allowed: no cap
     return params_error("velocity_distance_cap must be >= 0, got " +
                         std::to_string(velocity_distance_cap));
+  }
+  if (!(limb_outlier_ratio >= 1.0f)) {  // +inf allowed: no bound
+    return params_error("limb_outlier_ratio must be >= 1, got " +
+                        std::to_string(limb_outlier_ratio));
+  }
+  if (!(limb_outlier_floor >= 0.0f && std::isfinite(limb_outlier_floor))) {
+    return params_error("limb_outlier_floor must be finite and >= 0, got " +
+                        std::to_string(limb_outlier_floor));
   }
   if (!(lost_velocity_cap_per_dim >= 0.0f)) {  // +inf allowed: the emission's cap
     return params_error("lost_velocity_cap_per_dim must be >= 0, got " +

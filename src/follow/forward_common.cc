@@ -52,65 +52,109 @@ float squared_distances(const FeatureView& features, const float* phi, int begin
   return best;
 }
 
-float emission_distances(const TemplateModel& model, const float* phi, float velocity_cap,
-                         float* out) noexcept {
-  const FeatureView features = model.features();
+DistanceCaps emission_caps(const FollowParams& params) noexcept {
+  return {params.velocity_distance_cap, params.limb_outlier_ratio, params.limb_outlier_floor};
+}
+
+namespace {
+
+// The capped squared distance between phi and one template state whose dimension d is at
+// state[at(d) * stride] (stride 1 and at the identity: a row-major row; kStateBlock and
+// TemplateModel::blocked_dim: a lane of the blocked features).
+template <typename At>
+EmissionDistance capped_distance(const TemplateModel& model, const float* state, std::size_t stride,
+                                 At at, const float* phi, DistanceCaps caps) noexcept {
+  const auto diff_sq = [&](int d) {
+    const float diff = state[static_cast<std::size_t>(at(d)) * stride] - phi[d];
+    return diff * diff;
+  };
+  const auto part = [&](auto&& dims) {
+    float sum = 0.0f;
+    for (const int d : dims) sum += diff_sq(d);
+    return sum;
+  };
+  float posture_d2 = 0.0f;
+  float limb_excess = 0.0f;  // what the limb bound takes off
+  if (limbs_bounded(model, caps)) {
+    posture_d2 = part(model.posture_dims_outside_limbs());
+    float farthest = 0.0f, second = 0.0f;
+    for (const std::vector<int>& limb : model.limbs()) {
+      const float limb_d2 = part(limb);
+      posture_d2 += limb_d2;
+      second = std::max(second, std::min(farthest, limb_d2));
+      farthest = std::max(farthest, limb_d2);
+    }
+    limb_excess =
+        farthest - std::min(farthest, std::max(caps.limb_ratio * second, caps.limb_floor));
+  } else {
+    for (int d = 0; d < model.num_dims() - model.velocity_dims(); ++d) posture_d2 += diff_sq(d);
+  }
+  float velocity_d2 = 0.0f;
+  for (int d = model.num_dims() - model.velocity_dims(); d < model.num_dims(); ++d) {
+    velocity_d2 += diff_sq(d);
+  }
+  const float plain = std::min(posture_d2 + std::min(velocity_d2, caps.velocity), FLT_MAX);
+  return {std::min(plain - limb_excess, FLT_MAX), plain};
+}
+
+bool nothing_capped(const TemplateModel& model, DistanceCaps caps) noexcept {
+  return (model.velocity_dims() == 0 || !(caps.velocity < FLT_MAX)) && !limbs_bounded(model, caps);
+}
+
+}  // namespace
+
+EmissionDistance emission_distances(const TemplateModel& model, const float* phi, DistanceCaps caps,
+                                    float* out) noexcept {
   const int num_states = model.num_states();
-  const Eigen::Index velocity = model.velocity_dims();
-  const bool capped = velocity > 0 && velocity_cap < FLT_MAX;
 #if defined(__x86_64__)
   if (simd_level() == SimdLevel::kAvx2) {
-    return avx2::emission_distances(model.blocked_features().data(), num_states, model.num_dims(),
-                                    capped ? model.velocity_dims() : 0, velocity_cap, phi, out);
+    return avx2::emission_distances(model, caps, phi, out);
   }
 #endif
-  if (!capped) {
-    return squared_distances(features, phi, 0, num_states, out);
+  if (nothing_capped(model, caps)) {
+    const float best = squared_distances(model.features(), phi, 0, num_states, out);
+    return {best, best};
   }
-  const Eigen::Index posture = features.cols() - velocity;
-  const Eigen::Map<const Eigen::RowVectorXf> query(phi, features.cols());
-  float best = FLT_MAX;
+  const FeatureView features = model.features();
+  EmissionDistance best{FLT_MAX, FLT_MAX};
   for (int i = 0; i < num_states; ++i) {
-    const auto row = features.row(i);
-    const float posture_d2 = (row.head(posture) - query.head(posture)).squaredNorm();
-    const float velocity_d2 = (row.tail(velocity) - query.tail(velocity)).squaredNorm();
-    const float d2 = std::min(posture_d2 + std::min(velocity_d2, velocity_cap), FLT_MAX);
-    out[i] = d2;
-    best = std::min(best, d2);
+    const EmissionDistance d2 = capped_distance(
+        model, features.row(i).data(), 1, [](int d) { return d; }, phi, caps);
+    out[i] = d2.bounded;
+    best.bounded = std::min(best.bounded, d2.bounded);
+    best.plain = std::min(best.plain, d2.plain);
   }
   return best;
 }
 
-float state_emission_distance(const TemplateModel& model, const float* phi, int i,
-                              float velocity_cap) noexcept {
+EmissionDistance state_emission_distance(const TemplateModel& model, const float* phi, int i,
+                                         DistanceCaps caps) noexcept {
   constexpr int kBlock = TemplateModel::kStateBlock;
-  const int dims = model.num_dims();
-  const int posture = dims - model.velocity_dims();
   const float* lane =
       model.blocked_features().data() +
-      static_cast<std::size_t>(i / kBlock) * static_cast<std::size_t>(dims) * kBlock +
+      static_cast<std::size_t>(i / kBlock) * static_cast<std::size_t>(model.num_dims()) * kBlock +
       static_cast<std::size_t>(i % kBlock);
-  float posture_d2 = 0.0f, velocity_d2 = 0.0f;
-  for (int d = 0; d < posture; ++d) {
-    const float diff = lane[static_cast<std::size_t>(d) * kBlock] - phi[d];
-    posture_d2 += diff * diff;
-  }
-  for (int d = posture; d < dims; ++d) {
-    const float diff = lane[static_cast<std::size_t>(d) * kBlock] - phi[d];
-    velocity_d2 += diff * diff;
-  }
-  return std::min(posture_d2 + std::min(velocity_d2, velocity_cap), FLT_MAX);
+  return capped_distance(
+      model, lane, kBlock, [&model](int d) { return model.blocked_dim(d); }, phi, caps);
 }
 
 float lost_test_distance(const TemplateModel& model, const FollowParams& params, const float* phi,
-                         float best_emission_sq, int state) noexcept {
-  const float cap =
-      std::min(params.velocity_distance_cap,
-               params.lost_velocity_cap_per_dim * static_cast<float>(model.num_dims()));
-  if (!(cap < params.velocity_distance_cap) || state < 0 || state >= model.num_states()) {
-    return best_emission_sq;
+                         float best_plain_sq, int state) noexcept {
+  DistanceCaps caps = emission_caps(params);
+  caps.velocity = std::min(params.velocity_distance_cap,
+                           params.lost_velocity_cap_per_dim * static_cast<float>(model.num_dims()));
+  if (!(caps.velocity < params.velocity_distance_cap) || state < 0 || state >= model.num_states()) {
+    return best_plain_sq;
   }
-  return std::min(best_emission_sq, state_emission_distance(model, phi, state, cap));
+  return std::min(best_plain_sq, state_emission_distance(model, phi, state, caps).plain);
+}
+
+bool limb_out_of_line(const TemplateModel& model, const FollowParams& params, const float* phi,
+                      int state) noexcept {
+  if (phi == nullptr || state < 0 || state >= model.num_states()) return false;
+  const EmissionDistance distance =
+      state_emission_distance(model, phi, state, emission_caps(params));
+  return distance.bounded < distance.plain;
 }
 
 double weigh_and_normalise(const float* predicted, const float* distance_sq, float best_distance_sq,

@@ -2,6 +2,7 @@
 // All of them are on the per-frame path: no allocation, no exceptions.
 #pragma once
 
+#include <cfloat>
 #include <span>
 
 #if defined(__SSE2__)
@@ -47,25 +48,53 @@ int steps_for(double dt_s, double template_fps, int max_steps) noexcept;
 float squared_distances(const FeatureView& features, const float* phi, int begin, int end,
                         float* out) noexcept;
 
-// The same with the distance over the last model.velocity_dims() dimensions capped at
-// velocity_cap (FollowParams::velocity_distance_cap); plain squared_distances when there are no
-// velocity dimensions or the cap is infinite.
-float emission_distances(const TemplateModel& model, const float* phi, float velocity_cap,
-                         float* out) noexcept;
+// The robust emission's bounds on parts of the squared distance (eq. 7 with
+// FollowParams::velocity_distance_cap and limb_outlier_ratio): the velocity dimensions' share
+// counts at most `velocity`; the limb (TemplateModel::limbs) that is farthest counts at most
+// limb_ratio times the second farthest, and never less than limb_floor. FLT_MAX or more: no
+// bound.
+struct DistanceCaps {
+  float velocity = FLT_MAX;
+  float limb_ratio = FLT_MAX;
+  float limb_floor = 0.0f;
+};
+DistanceCaps emission_caps(const FollowParams& params) noexcept;
+// Whether the farthest limb is bounded: a ratio is set and the model has two limbs or more.
+inline bool limbs_bounded(const TemplateModel& model, DistanceCaps caps) noexcept {
+  return caps.limb_ratio < FLT_MAX && model.limbs().size() >= 2;
+}
 
-// The same for one template state i: ||phi - phi_i||^2 with the velocity part capped at
-// velocity_cap. Read from the blocked features, which the full step keeps resident anyway: the
-// row-major ones may be a memory-mapped cache's (TemplateModel::build_shared), whose pages a
-// beam's scattered jump candidates would otherwise bring in one by one (at 1M states, 150 MB in
-// the first seconds). O(D).
-float state_emission_distance(const TemplateModel& model, const float* phi, int i,
-                              float velocity_cap) noexcept;
+// One state's squared distance with the caps (`bounded`, the emission's) and with only the
+// velocity cap (`plain`). The limb bound decides between places; whether a place explains the
+// input (FollowResult::best_distance_per_dim: the lost test, the residual it scales with, the
+// rig offset's learning) counts every limb: a wave is one arm out of line with a standing body.
+struct EmissionDistance {
+  float bounded = FLT_MAX;
+  float plain = FLT_MAX;
+};
 
-// The squared distance of the lost test (FollowParams::lost_velocity_cap_per_dim): the best
-// emission distance, or at the estimated state with the velocity part capped lower, whichever is
-// smaller. `state` < 0: the best emission distance.
+// out[i] = the bounded distance of every template state i (squared_distances when nothing is
+// capped). Returns the minimum of each kind over the states.
+EmissionDistance emission_distances(const TemplateModel& model, const float* phi, DistanceCaps caps,
+                                    float* out) noexcept;
+
+// The same for one template state i. Read from the blocked features, which the full step keeps
+// resident anyway: the row-major ones may be a memory-mapped cache's
+// (TemplateModel::build_shared), whose pages a beam's scattered jump candidates would otherwise
+// bring in one by one (at 1M states, 150 MB in the first seconds). O(D).
+EmissionDistance state_emission_distance(const TemplateModel& model, const float* phi, int i,
+                                         DistanceCaps caps) noexcept;
+
+// The squared distance of the lost test (FollowParams::lost_velocity_cap_per_dim): the best plain
+// emission distance, or the plain one at the estimated state with the velocity part capped
+// lower, whichever is smaller. `state` < 0: the best plain distance.
 float lost_test_distance(const TemplateModel& model, const FollowParams& params, const float* phi,
-                         float best_emission_sq, int state) noexcept;
+                         float best_plain_sq, int state) noexcept;
+
+// Whether the limb bound takes anything off the emission distance at `state` (FollowResult::
+// limb_out_of_line). False without features (phi null) or a state.
+bool limb_out_of_line(const TemplateModel& model, const FollowParams& params, const float* phi,
+                      int state) noexcept;
 
 // log b = max(-d^2 * inv_two_sigma_sq, kMinLogEmission) (eq. 7, without its constant).
 inline float log_emission(float distance_sq, float inv_two_sigma_sq) noexcept {

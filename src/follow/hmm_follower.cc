@@ -163,12 +163,13 @@ void HmmForward::transition(const float* alpha, const BandProbabilities& band,
   next[num_states] = into_pause;
 }
 
-float HmmForward::emit_all_states(const float* phi, float noise, const FollowerHistory& history,
-                                  std::vector<float>& alpha, std::vector<float>& scratch,
-                                  float* distance_sq, FollowResult& result) const noexcept {
+follow_detail::EmissionDistance HmmForward::emit_all_states(
+    const float* phi, float noise, const FollowerHistory& history, std::vector<float>& alpha,
+    std::vector<float>& scratch, float* distance_sq, FollowResult& result) const noexcept {
   const int num_states = model_->num_states();
-  const float best =
-      follow_detail::emission_distances(*model_, phi, params_.velocity_distance_cap, distance_sq);
+  const follow_detail::EmissionDistance bests = follow_detail::emission_distances(
+      *model_, phi, follow_detail::emission_caps(params_), distance_sq);
+  const float best = bests.bounded;
   const double log_likelihood = follow_detail::weigh_and_normalise(
       alpha.data(), distance_sq, best, noise_levels_.inv_two_sigma_sq(noise), num_states,
       noise_levels_.log_pause_emission(noise), params_.jump_enabled, scratch.data());
@@ -181,9 +182,10 @@ float HmmForward::emit_all_states(const float* phi, float noise, const FollowerH
     result.log_likelihood = log_likelihood;
     alpha.swap(scratch);
   }
-  result.best_distance_per_dim = best / static_cast<float>(model_->num_dims());
-  result.lost = best > noise_levels_.lost_ceiling_sq();
-  return best;
+  // How far the input is from the library counts every limb (FollowResult).
+  result.best_distance_per_dim = bests.plain / static_cast<float>(model_->num_dims());
+  result.lost = bests.plain > noise_levels_.lost_ceiling_sq();
+  return bests;
 }
 
 FollowResult HmmForward::step(std::span<const float> features, double dt_s,
@@ -212,11 +214,12 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   result.sensor_noise_per_dim = context.history_.sensor_noise.variance_per_dim();
   const float noise = result.sensor_noise_per_dim;
   const float* phi = nullptr;  // the filtered features, while the frame has them
-  float best = 0.0f;
+  float best_plain = 0.0f;
   if (!result.missing) {
     phi = context.history_.noise_filter.apply(features, dt_s, noise).data();
-    best = emit_all_states(phi, noise, context.history_, context.alpha_, context.scratch_,
-                           context.distance_sq_.data(), result);
+    best_plain = emit_all_states(phi, noise, context.history_, context.alpha_, context.scratch_,
+                                 context.distance_sq_.data(), result)
+                     .plain;
   } else {
     context.history_.noise_filter.miss(dt_s);
     // No evidence: the transitions conserve mass; renormalise only to stop float drift.
@@ -230,9 +233,10 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   // Past the noise-scaled lost distance. lost is completed below, once in_pause is known. The
   // band's tempo and the jump gate go on the fixed ceiling: taught only by frames within the
   // noise-scaled level, the tempo lagged on clean input at 1.4x (100% -> 98.8% within 100 ms).
+  result.limb_out_of_line = follow_detail::limb_out_of_line(model, params_, phi, result.state);
   const bool unexplained =
       phi != nullptr &&
-      follow_detail::lost_test_distance(model, params_, phi, best, result.state) >
+      follow_detail::lost_test_distance(model, params_, phi, best_plain, result.state) >
           noise_levels_.lost_distance_sq(noise, context.history_.explained_residual.level());
   context.history_.jump_gate.apply(model, params_, alpha, 1.0f, context.history_.previous_state,
                                    context.history_.previous_lost, result, unexplained);

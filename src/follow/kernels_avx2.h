@@ -2,13 +2,17 @@
 // only to be called where cpu_supports(SimdLevel::kAvx2) (forward_common.cc dispatches).
 #pragma once
 
+#include "forward_common.h"
+
 namespace duet::follow_detail::avx2 {
 
-// out[i] = min(||posture_i - posture||^2 + min(||velocity_i - velocity||^2, velocity_cap),
-// FLT_MAX) for the num_states states of blocked (TemplateModel::blocked_features(), dims
-// dimensions, the last velocity_dims of them velocities). Returns the minimum.
-float emission_distances(const float* blocked, int num_states, int dims, int velocity_dims,
-                         float velocity_cap, const float* phi, float* out) noexcept;
+// follow_detail::emission_distances over the model's blocked features:
+// out[i] = min(posture part + min(||velocity_i - velocity||^2, caps.velocity), FLT_MAX), the
+// posture part summing every dimension's squared difference, the farthest limb's bounded by
+// caps.limb_ratio times the second farthest's (at least caps.limb_floor). Returns the minimum
+// of the bounded distances and of the plain ones (no limb bound).
+EmissionDistance emission_distances(const TemplateModel& model, DistanceCaps caps, const float* phi,
+                                    float* out) noexcept;
 
 // out[i] = predicted[i] * exp(max(-distance_sq[i] * inv_two_sigma_sq, kMinLogEmission) - shift)
 // for i < num_states (eq. 7 and the outer factor of eq. 11); returns the sum of out.

@@ -125,14 +125,15 @@ FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s
   }
 
   if (!result.missing) {
-    const float best = follow_detail::emission_distances(
-        model, features.data(), params_.velocity_distance_cap, distance_sq_.data());
+    const follow_detail::EmissionDistance bests = follow_detail::emission_distances(
+        model, features.data(), follow_detail::emission_caps(params_), distance_sq_.data());
+    const float best = bests.bounded;
     result.log_likelihood = follow_detail::weigh_and_normalise(
         alpha_.data(), distance_sq_.data(), best, inv_two_sigma_sq_, num_states,
         log_pause_emission_, params_.jump_enabled, scratch_.data());
     alpha_.swap(scratch_);
-    result.best_distance_per_dim = best / static_cast<float>(model.num_dims());
-    result.lost = best > lost_distance_sq_;
+    result.best_distance_per_dim = bests.plain / static_cast<float>(model.num_dims());
+    result.lost = bests.plain > lost_distance_sq_;  // lost counts every limb, as in the HMM
   } else {
     follow_detail::normalise(alpha_.data(), num_states + 1, num_states);
     result.best_distance_per_dim = -1.0f;

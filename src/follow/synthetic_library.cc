@@ -129,8 +129,11 @@ Result<TemplateModel> synthesize_library(const TemplateModel& real,
       }
     }
   }
-  return TemplateModel::build(std::move(out), std::move(starts), real.frame_rate_hz(),
-                              real.velocity_dims());
+  Result<TemplateModel> model = TemplateModel::build(std::move(out), std::move(starts),
+                                                     real.frame_rate_hz(), real.velocity_dims());
+  if (!model) return model.error();
+  if (Status limbs = model.value().set_limbs(real.limbs()); !limbs) return limbs.error();
+  return model;
 }
 
 Result<std::vector<SyntheticTakeSource>> synthetic_take_sources(

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <numeric>
 #include <string>
 #include <utility>
 
@@ -11,8 +12,9 @@ namespace {
 
 Error model_error(const std::string& reason) { return make_error("template model", 0, reason); }
 
-// The layout of TemplateModel::blocked_features().
-std::vector<float> blocked(const FeatureView& features) {
+// The layout of TemplateModel::blocked_features(): dimension d of the row at blocked_dim
+// position[d] (empty: d).
+std::vector<float> blocked(const FeatureView& features, const std::vector<int>& position = {}) {
   constexpr Eigen::Index kBlock = TemplateModel::kStateBlock;
   const Eigen::Index rows = features.rows();
   const Eigen::Index dims = features.cols();
@@ -22,7 +24,8 @@ std::vector<float> blocked(const FeatureView& features) {
     const Eigen::Index b = i / kBlock;
     const Eigen::Index lane = i % kBlock;
     for (Eigen::Index d = 0; d < dims; ++d) {
-      out[static_cast<std::size_t>((b * dims + d) * kBlock + lane)] = features(i, d);
+      const Eigen::Index at = position.empty() ? d : position[static_cast<std::size_t>(d)];
+      out[static_cast<std::size_t>((b * dims + at) * kBlock + lane)] = features(i, d);
     }
   }
   return out;
@@ -133,7 +136,53 @@ Result<TemplateModel> TemplateModel::finish(std::shared_ptr<const float> data, i
   model.take_start_ = std::move(take_start);
   model.frame_rate_hz_ = frame_rate_hz;
   model.velocity_dims_ = velocity_dims;
+  model.outside_limbs_.resize(static_cast<std::size_t>(num_dims - velocity_dims));
+  std::iota(model.outside_limbs_.begin(), model.outside_limbs_.end(), 0);
   return model;
+}
+
+Status TemplateModel::set_limbs(std::vector<std::vector<int>> limbs) {
+  const int posture = num_dims_ - velocity_dims_;
+  if (!limbs.empty() && num_dims_ > kMaxLimbModelDims) {
+    return model_error("limbs need a model of at most " + std::to_string(kMaxLimbModelDims) +
+                       " dimensions, this one has " + std::to_string(num_dims_));
+  }
+  std::vector<bool> in_limb(static_cast<std::size_t>(posture), false);
+  for (std::size_t limb = 0; limb < limbs.size(); ++limb) {
+    for (const int dim : limbs[limb]) {
+      if (dim < 0 || dim >= posture) {
+        return model_error("limb " + std::to_string(limb) + " names dimension " +
+                           std::to_string(dim) + ", outside the " + std::to_string(posture) +
+                           " posture dimensions");
+      }
+      if (in_limb[static_cast<std::size_t>(dim)]) {
+        return model_error("dimension " + std::to_string(dim) + " is in two limbs");
+      }
+      in_limb[static_cast<std::size_t>(dim)] = true;
+    }
+  }
+  outside_limbs_.clear();
+  for (int dim = 0; dim < posture; ++dim) {
+    if (!in_limb[static_cast<std::size_t>(dim)]) outside_limbs_.push_back(dim);
+  }
+  limbs_ = std::move(limbs);
+  // The blocked features in the limbs' order, each group's dimensions contiguous for the SIMD
+  // kernel: the dimensions in no limb, then each limb's, then the velocities.
+  blocked_position_.assign(static_cast<std::size_t>(num_dims_), 0);
+  limb_blocks_.clear();
+  int at = 0;
+  for (const int dim : outside_limbs_) blocked_position_[static_cast<std::size_t>(dim)] = at++;
+  for (const std::vector<int>& limb : limbs_) {
+    const int begin = at;
+    for (const int dim : limb) blocked_position_[static_cast<std::size_t>(dim)] = at++;
+    limb_blocks_.push_back({begin, at});
+  }
+  for (int dim = posture; dim < num_dims_; ++dim) {
+    blocked_position_[static_cast<std::size_t>(dim)] = at++;
+  }
+  if (limbs_.empty()) blocked_position_.clear();
+  blocked_features_ = blocked(features(), blocked_position_);
+  return Ok{};
 }
 
 int TemplateModel::take_of(int state) const {

@@ -176,8 +176,12 @@ Status DuetLibrary::grow_and_cache(TemplateModel captured, std::uint64_t key) {
     if (options_.grow_to_states == 0) return captured;
     return synthesize_library(captured, grow);
   };
-  // A grown library's confidence counts every copy of a moment (copy_places.h).
-  const auto with_copy_places = [&](TemplateModel model) -> Result<TemplateModel> {
+  // The limbs the emission bounds (FeatureSpec::limb_dims), and a grown library's confidence
+  // counts every copy of a moment (copy_places.h). Neither is in the model cache.
+  const auto finish_model = [&](TemplateModel model) -> Result<TemplateModel> {
+    if (Status limbs = model.set_limbs(options_.features.limb_dims()); !limbs) {
+      return limbs.error();
+    }
     if (copy_sources_.empty()) return model;
     Result<CopyPlaces> places = CopyPlaces::build(model, captured.num_takes(), copy_sources_);
     if (!places) return places.error();
@@ -187,14 +191,14 @@ Status DuetLibrary::grow_and_cache(TemplateModel captured, std::uint64_t key) {
   if (options_.model_cache.empty()) {
     Result<TemplateModel> model = build();
     if (!model) return model.error();
-    Result<TemplateModel> placed = with_copy_places(std::move(model).value());
+    Result<TemplateModel> placed = finish_model(std::move(model).value());
     if (!placed) return placed.error();
     model_ = std::make_shared<const TemplateModel>(std::move(placed).value());
   } else {
     Result<CachedModel> cached =
         load_or_build_model_cache(options_.model_cache, key, build, &model_cache_note_);
     if (!cached) return cached.error();
-    Result<TemplateModel> placed = with_copy_places(std::move(cached.value().model));
+    Result<TemplateModel> placed = finish_model(std::move(cached.value().model));
     if (!placed) return placed.error();
     model_ = std::make_shared<const TemplateModel>(std::move(placed).value());
     candidate_index_ = std::make_shared<const JumpCandidateIndex>(std::move(cached.value().index));

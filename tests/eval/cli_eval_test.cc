@@ -258,6 +258,33 @@ TEST(CliEval, ThreePointsTakeNoUnexplainedJumpHoldUnlessAsked) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
 }
 
+TEST(CliEval, DistanceCapsTakeANumberOrInf) {
+  // A cap on a part of the emission distance: inf turns it off, as FollowParams documents.
+  const std::string base = "eval " + pair("10") +
+                           " --fps 60 --trackers hmm --cases clean --no-partner-metrics "
+                           "--non-dance none";
+  auto r = run_duet(base + " --limb-outlier-ratio inf --velocity-cap inf");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("velocity_cap inf limb_outlier inf x"), std::string::npos) << r.output;
+  r = run_duet(base);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("velocity_cap 0.05 limb_outlier 3 x (floor 0.15)"), std::string::npos)
+      << r.output;
+  for (const char* bad : {"-1", "nan", "many"}) {
+    r = run_duet(base + " --limb-outlier-ratio " + bad);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(std::string("--limb-outlier-ratio: must be a finite number >= 0 or "
+                                        "inf, got '") +
+                            bad + "'"),
+              std::string::npos)
+        << r.output;
+  }
+  // Below 1 the farthest limb would count less than the second: the parameters say so.
+  r = run_duet(base + " --limb-outlier-ratio 0.5");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("limb_outlier_ratio must be >= 1"), std::string::npos) << r.output;
+}
+
 TEST(CliImprovise, WritesAPerformanceAndItsTruthThatFollowReads) {
   const auto dir = scratch_dir("improvise");
   const std::string perf = (dir / "perf.bvh").string();

@@ -51,6 +51,37 @@ TEST_F(FeatureExtractorTest, DoesNotDependOnPlaceOrFacingInTheRoom) {
   EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-4f);
 }
 
+TEST_F(FeatureExtractorTest, ALimbsDimensionsAreTheOnesItsJointsMove) {
+  // Each limb's bend (elbow, knee) changes that limb's posture dimensions and no others.
+  const std::vector<std::vector<int>> limbs = spec_.limb_dims();
+  ASSERT_EQ(limbs.size(), 4u);
+  const Clip clip = make_dance(skeleton_, 60.0, 60);
+  const FeatureMatrix plain = extractor_->extract_clip(clip);
+  const JointRoles roles = daz_roles(*skeleton_);
+  const Role bends[] = {Role::kLeftElbow, Role::kRightElbow, Role::kLeftKnee, Role::kRightKnee};
+  for (std::size_t limb = 0; limb < limbs.size(); ++limb) {
+    EXPECT_EQ(limbs[limb].size(), 9u) << "two bones and an end point";
+    Clip bent = clip;
+    for (int f = 0; f < bent.frame_count(); ++f) {
+      Quat& rotation = bent.rotations_ls(f)[static_cast<std::size_t>(roles[bends[limb]])];
+      rotation = rotation * Quat(Eigen::AngleAxisd(0.4, Vec3(1, 0, 1).normalized()));
+    }
+    const FeatureMatrix moved = extractor_->extract_clip(bent);
+    int changed_inside = 0;
+    for (int d = 0; d < spec_.posture_dims(); ++d) {
+      const bool changed = (moved.col(d) - plain.col(d)).cwiseAbs().maxCoeff() > 1e-4f;
+      const bool inside = std::count(limbs[limb].begin(), limbs[limb].end(), d) > 0;
+      EXPECT_FALSE(changed && !inside) << "limb " << limb << " moved dimension " << d;
+      changed_inside += changed && inside;
+    }
+    EXPECT_GE(changed_inside, 4) << "limb " << limb;
+  }
+  // Three points' posture is the hands: no limb of its own to bound.
+  FeatureSpec head_hands;
+  head_hands.input_points = InputPoints::kHeadHands;
+  EXPECT_TRUE(head_hands.limb_dims().empty());
+}
+
 TEST_F(FeatureExtractorTest, VelocitiesAreRealSpeedsAtAnyInputRate) {
   // A body gliding forward at 1.5 m/s while it turns: forward speed 1.5 m/s whatever the rate, in
   // leg lengths per second.

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "duet/features/feature_spec.h"
 #include "duet/follow/hmm_follower.h"
 #include "duet/follow/simd.h"
 #include "follow/forward_common.h"
@@ -61,24 +62,27 @@ TEST(SimdDispatch, DuetSimdScalarForcesTheScalarPathAndAvx2IsChosenWhereTheCpuHa
 }
 
 // Distances through the dispatcher at both levels, within 1e-4 relative, same minimum.
-void expect_same_distances(const TemplateModel& model, float velocity_cap) {
+void expect_same_distances(const TemplateModel& model, float velocity_cap,
+                           float limb_ratio = std::numeric_limits<float>::infinity()) {
+  const follow_detail::DistanceCaps caps{velocity_cap, limb_ratio, 0.05f};
   const RestoreSimdLevel restore;
   const auto size = static_cast<std::size_t>(model.num_states());
   std::vector<float> scalar(size), fast(size);
   for (const int state : {0, model.num_states() / 2, model.num_states() - 1}) {
     const std::vector<float> phi = query_near(model, state, static_cast<unsigned>(state));
     ASSERT_TRUE(set_simd_level(SimdLevel::kScalar));
-    const float best_scalar =
-        follow_detail::emission_distances(model, phi.data(), velocity_cap, scalar.data());
+    const follow_detail::EmissionDistance best_scalar =
+        follow_detail::emission_distances(model, phi.data(), caps, scalar.data());
     ASSERT_TRUE(set_simd_level(SimdLevel::kAvx2));
-    const float best_fast =
-        follow_detail::emission_distances(model, phi.data(), velocity_cap, fast.data());
+    const follow_detail::EmissionDistance best_fast =
+        follow_detail::emission_distances(model, phi.data(), caps, fast.data());
     int rounded_otherwise = 0;  // proof that the other kernel ran: another summation order
     for (std::size_t i = 0; i < size; ++i) {
       ASSERT_NEAR(fast[i], scalar[i], 1e-4f * scalar[i]) << "state " << i;
       rounded_otherwise += fast[i] != scalar[i];
     }
-    EXPECT_NEAR(best_fast, best_scalar, 1e-4f * best_scalar);
+    EXPECT_NEAR(best_fast.bounded, best_scalar.bounded, 1e-4f * best_scalar.bounded);
+    EXPECT_NEAR(best_fast.plain, best_scalar.plain, 1e-4f * best_scalar.plain);
     if (model.num_dims() > 8) {
       EXPECT_GT(rounded_otherwise, 0);
     }
@@ -96,8 +100,52 @@ TEST(SimdKernels, Avx2EmissionDistancesMatchTheScalarPath) {
   expect_same_distances(model, 4.0f);                                    // capped velocity
   expect_same_distances(model, std::numeric_limits<float>::infinity());  // no cap
   expect_same_distances(test::make_model({1003}, 50, 4), 4.0f);          // no velocity dims
+  TemplateModel limbed = test::make_model({600, 403}, 50, 3, 60.0, 8);
+  ASSERT_TRUE(limbed.set_limbs(FeatureSpec{}.limb_dims()).ok());
+  expect_same_distances(limbed, 4.0f, 1.5f);  // the farthest limb bounded
+  expect_same_distances(limbed, 4.0f);        // limbs, no bound
   expect_same_distances(test::make_model({5}, 7, 5, 60.0, 2), 1.0f);
   expect_same_distances(test::make_model({64}, 3, 6, 60.0, 3), 0.5f);  // velocity only
+}
+
+TEST(SimdKernels, TheFarthestLimbAndTheVelocitiesCountAtMostTheirBound) {
+  // Posture 0..4: dimension 0 in no limb, limbs {1, 2}, {3} and {4}; velocities 5..6.
+  FeatureMatrix features(9, 7);  // 9 states: one whole block of 8 and a partial one
+  features.setZero();
+  features.row(0) << 1, 3, 4, 1, 0, 0, 0;        // limbs 25, 1, 0: 25 counts 3 x 1
+  features.row(1) << 0, 0.1f, 0.2f, 0, 0, 2, 0;  // limbs 0.05, 0, 0: the floor; velocity 4 -> 0.3
+  features.row(8) << 0, 0, 0, 2, 1, 0, 0;        // limbs 0, 4, 1: 4 counts 3 x 1
+  TemplateModel model = TemplateModel::build(features, {}, 60.0, 2).value();
+  ASSERT_TRUE(model.set_limbs({{1, 2}, {3}, {4}}).ok());
+  const std::vector<float> phi(7, 0.0f);
+  const follow_detail::DistanceCaps caps{0.3f, 3.0f, 0.05f};
+  const RestoreSimdLevel restore;
+  for (const SimdLevel level : {SimdLevel::kScalar, SimdLevel::kAvx2}) {
+    if (!set_simd_level(level)) continue;
+    std::vector<float> out(9);
+    const follow_detail::EmissionDistance best =
+        follow_detail::emission_distances(model, phi.data(), caps, out.data());
+    EXPECT_FLOAT_EQ(out[0], 1.0f + 3.0f + 1.0f) << to_string(level);
+    EXPECT_FLOAT_EQ(out[1], 0.05f + 0.3f) << to_string(level);
+    EXPECT_FLOAT_EQ(out[8], 3.0f + 1.0f) << to_string(level);
+    EXPECT_FLOAT_EQ(best.bounded, 0.0f);
+    EXPECT_FLOAT_EQ(best.plain, 0.0f);
+    for (const int i : {0, 1, 8}) {
+      const follow_detail::EmissionDistance one =
+          follow_detail::state_emission_distance(model, phi.data(), i, caps);
+      EXPECT_FLOAT_EQ(one.bounded, out[static_cast<std::size_t>(i)]);
+    }
+    // The plain distance counts every limb in full (the velocity cap stays).
+    EXPECT_FLOAT_EQ(follow_detail::state_emission_distance(model, phi.data(), 0, caps).plain,
+                    27.0f);
+    EXPECT_FLOAT_EQ(follow_detail::state_emission_distance(model, phi.data(), 1, caps).plain,
+                    0.35f);
+    // No bounds: the plain squared distance.
+    follow_detail::emission_distances(model, phi.data(), {}, out.data());
+    EXPECT_FLOAT_EQ(out[0], 27.0f);
+    EXPECT_FLOAT_EQ(out[1], 4.05f);
+    EXPECT_FLOAT_EQ(out[8], 5.0f);
+  }
 }
 
 TEST(SimdKernels, Avx2ExpIsWithinOneMillionthOfExpOverTheUsedRange) {

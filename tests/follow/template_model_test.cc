@@ -56,6 +56,24 @@ TEST(TemplateModel, AJumpIsAMoveOutOfTheBandOrIntoAnotherTake) {
   EXPECT_FALSE(m.is_jump(30, -1, 1));
 }
 
+TEST(TemplateModel, LimbsNamePostureDimensionsOnceEach) {
+  TemplateModel model = TemplateModel::build(ones(4, 6), {}, 60.0, 2).value();  // posture 0..3
+  EXPECT_TRUE(model.limbs().empty());
+  EXPECT_EQ(model.posture_dims_outside_limbs(), (std::vector<int>{0, 1, 2, 3}));
+  ASSERT_TRUE(model.set_limbs({{1, 3}, {2}}).ok());
+  EXPECT_EQ(model.limbs().size(), 2u);
+  EXPECT_EQ(model.posture_dims_outside_limbs(), (std::vector<int>{0}));
+  // A velocity dimension, a dimension past the end or in two limbs: refused, the limbs as before.
+  EXPECT_NE(error_of(model.set_limbs({{4}})).find("outside the 4 posture dimensions"),
+            std::string::npos);
+  EXPECT_FALSE(model.set_limbs({{-1}}).ok());
+  EXPECT_NE(error_of(model.set_limbs({{0, 1}, {1}})).find("dimension 1 is in two limbs"),
+            std::string::npos);
+  EXPECT_EQ(model.posture_dims_outside_limbs(), (std::vector<int>{0}));
+  ASSERT_TRUE(model.set_limbs({}).ok());
+  EXPECT_EQ(model.posture_dims_outside_limbs(), (std::vector<int>{0, 1, 2, 3}));
+}
+
 TEST(TemplateModel, EmptyTakeListIsOneTake) {
   Result<TemplateModel> model = TemplateModel::build(ones(5, 2), {}, 30.0);
   ASSERT_TRUE(model.ok());
@@ -117,6 +135,7 @@ TEST(FollowParams, DefaultsAndPresetsAreValid) {
   EXPECT_TRUE(FollowParams::left_to_right().validate(10).ok());
   EXPECT_FALSE(FollowParams::left_to_right().jump_enabled);
   EXPECT_FALSE(FollowParams::paper().tempo_adaptive);  // the paper's band is fixed
+  EXPECT_TRUE(std::isinf(FollowParams::paper().limb_outlier_ratio));  // the plain Gaussian
   FollowParams uncapped;
   uncapped.velocity_distance_cap = std::numeric_limits<float>::infinity();
   EXPECT_TRUE(uncapped.validate(10).ok());
@@ -140,6 +159,8 @@ TEST(FollowParams, RejectsBadValues) {
   check([](FollowParams& p) { p.lost_distance_per_dim = std::nanf(""); }, "lost_distance");
   check([](FollowParams& p) { p.confidence_window_frames = -1; }, "confidence_window");
   check([](FollowParams& p) { p.velocity_distance_cap = -0.1f; }, "velocity_distance_cap");
+  check([](FollowParams& p) { p.limb_outlier_ratio = 0.5f; }, "limb_outlier_ratio");
+  check([](FollowParams& p) { p.limb_outlier_floor = -1.0f; }, "limb_outlier_floor");
   check([](FollowParams& p) { p.tempo_time_constant_s = 0.0; }, "tempo_time_constant_s");
   check([](FollowParams& p) { p.max_tempo = 2.0f; }, "tempo range");
   check([](FollowParams& p) { p.min_tempo = 0.0f; }, "tempo range");

@@ -104,6 +104,12 @@ struct FeatureSpec {
   int effector_speed_dims() const { return input_points == InputPoints::kHeadHands ? 2 : 4; }
   int velocity_dims() const { return kRootVelocityDims + effector_speed_dims(); }
   int dimension() const { return posture_dims() + velocity_dims(); }
+  // The posture dimensions of each limb: an arm's are its upper arm's and forearm's directions
+  // and its hand's position, a leg's likewise (a segment counts when both its roles are the
+  // limb's). The emission bounds the share of a limb far out of line with the others
+  // (FollowParams::limb_outlier_ratio): a live system holds an arm whose markers the partner
+  // hides. Empty for three points, whose hands are the whole posture.
+  std::vector<std::vector<int>> limb_dims() const;
   // First dimension and size of a block.
   int block_begin(FeatureBlock block) const;
   int block_size(FeatureBlock block) const;

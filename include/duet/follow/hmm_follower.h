@@ -24,6 +24,10 @@
 
 namespace duet {
 
+namespace follow_detail {
+struct EmissionDistance;  // src/follow/forward_common.h
+}  // namespace follow_detail
+
 // State between frames. alpha has M + 1 entries: the template states, then the pause state N.
 // Float on purpose: the step streams alpha and the features every frame (memory bandwidth);
 // alpha is renormalised every frame so float's range is never approached. Only the running
@@ -104,11 +108,14 @@ class HmmForward {
   // this sensor noise: alpha (M + 1, the prediction) becomes the posterior, through scratch (the
   // two are swapped), and distance_sq (M) receives the distances. An outlier frame
   // (FollowParams::gate_outliers, judged from history) keeps the prediction alone. Sets
-  // result.outlier, log_likelihood, best_distance_per_dim and lost (the fixed ceiling; the pause
-  // state's share is added by the caller) and returns the best squared distance.
-  float emit_all_states(const float* phi, float noise, const FollowerHistory& history,
-                        std::vector<float>& alpha, std::vector<float>& scratch, float* distance_sq,
-                        FollowResult& result) const noexcept;
+  // result.outlier, log_likelihood, best_distance_per_dim and lost (the fixed ceiling, on the
+  // plain distance; the pause state's share is added by the caller) and returns the best squared
+  // distances, bounded and plain.
+  follow_detail::EmissionDistance emit_all_states(const float* phi, float noise,
+                                                  const FollowerHistory& history,
+                                                  std::vector<float>& alpha,
+                                                  std::vector<float>& scratch, float* distance_sq,
+                                                  FollowResult& result) const noexcept;
 
   const TemplateModel* model_ = nullptr;
   FollowParams params_;

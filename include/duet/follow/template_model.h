@@ -61,8 +61,9 @@ class TemplateModel {
   FeatureView features() const { return {features_.get(), num_states_, num_dims_}; }
   // The same features blocked for the SIMD emission kernel: states in blocks of kStateBlock, and
   // within a block dimension-major, so one load gives dimension d of kStateBlock states:
-  // blocked_features()[(b * D + d) * kStateBlock + l] = phi_{b * kStateBlock + l}(d). The last
-  // block is padded with zeros. Built once with the model (a second copy of the features).
+  // blocked_features()[(b * D + blocked_dim(d)) * kStateBlock + l] = phi_{b * kStateBlock + l}(d).
+  // The last block is padded with zeros. Built with the model (a second copy of the features)
+  // and again, in the limbs' order, by set_limbs.
   static constexpr int kStateBlock = 8;
   std::span<const float> blocked_features() const { return blocked_features_; }
   // First state of take k, and one past its last state.
@@ -75,6 +76,29 @@ class TemplateModel {
   // where a step back by up to `tolerance` frames counts as no jump (a follower's jitter). False
   // when either state is -1 (no place yet).
   bool is_jump(int from, int to, int steps, int tolerance = 0) const noexcept;
+
+  // The posture dimensions grouped by limb (FeatureSpec::limb_dims): the emission bounds the
+  // share of the farthest (FollowParams::limb_outlier_ratio). Each dimension is below
+  // num_dims() - velocity_dims() and in one limb at most; empty (the default) bounds none. Set
+  // once, before the model is shared.
+  // At most kMaxLimbModelDims dimensions (the kernel reorders the input on its stack).
+  Status set_limbs(std::vector<std::vector<int>> limbs);
+  static constexpr int kMaxLimbModelDims = 256;
+  const std::vector<std::vector<int>>& limbs() const { return limbs_; }
+  // The posture dimensions in no limb, ascending (all of them when there are no limbs).
+  const std::vector<int>& posture_dims_outside_limbs() const { return outside_limbs_; }
+  // Where dimension d sits in a state's lane of blocked_features() (below): d itself without
+  // limbs; with them the dimensions in no limb come first, then each limb's (limb k at
+  // blocked_limbs()[k], [begin, end)), then the velocities, so the SIMD kernel loads every group
+  // contiguously.
+  int blocked_dim(int d) const {
+    return blocked_position_.empty() ? d : blocked_position_[static_cast<std::size_t>(d)];
+  }
+  struct DimRange {
+    int begin;
+    int end;
+  };
+  const std::vector<DimRange>& blocked_limbs() const { return limb_blocks_; }
 
   // A library grown with copies of its takes (copy_places.h): where each state sits in the
   // captured takes, for a confidence that counts every copy of a moment. Null otherwise. Set
@@ -99,6 +123,10 @@ class TemplateModel {
   std::vector<int> take_start_;          // num_takes + 1 entries; the last one is M
   double frame_rate_hz_ = 0.0;
   int velocity_dims_ = 0;
+  std::vector<std::vector<int>> limbs_;
+  std::vector<int> outside_limbs_;
+  std::vector<int> blocked_position_;  // see blocked_dim(); empty: the identity
+  std::vector<DimRange> limb_blocks_;
   std::shared_ptr<const CopyPlaces> copy_places_;
 };
 

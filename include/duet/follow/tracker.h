@@ -27,11 +27,17 @@ struct FollowResult {
   // state the majority right after a frame that was followed, so it was set aside like a dropped
   // frame's (the estimate moved on along the band).
   bool outlier = false;
+  // At the estimated state one limb is far out of line with the others, so the emission bounded
+  // its share (FollowParams::limb_outlier_ratio): a held or gesturing limb the library does not
+  // hold. Such a frame does not teach the explained residual (explained_residual.h).
+  bool limb_out_of_line = false;
   int steps = 0;          // template-rate transitions applied for this frame
   // log p(phi_t | phi_1..t-1), up to the Gaussian's constant normaliser; 0 for missing frames.
   // Trackers that are not probabilistic report the negative best distance / (2 sigma^2).
   double log_likelihood = 0.0;
-  // min_i ||phi - phi_i||^2 / D over all states (online DTW: over its window); -1 if missing.
+  // min_i ||phi - phi_i||^2 / D over all states (online DTW: over its window), the HMM's with
+  // the velocity cap (FollowParams::velocity_distance_cap) but every limb in full: how far the
+  // input is from the library, whatever the emission's limb bound weighs; -1 if missing.
   float best_distance_per_dim = 0.0f;
   // The input sensor's white-noise variance per posture dimension as the tracker estimates it
   // online (sensor_noise.h); 0 for trackers that do not.
