@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "duet/follow/copy_places.h"
@@ -58,14 +59,13 @@ DistanceCaps emission_caps(const FollowParams& params) noexcept {
 
 namespace {
 
-// The capped squared distance between phi and one template state whose dimension d is at
-// state[at(d) * stride] (stride 1 and at the identity: a row-major row; kStateBlock and
-// TemplateModel::blocked_dim: a lane of the blocked features).
-template <typename At>
-EmissionDistance capped_distance(const TemplateModel& model, const float* state, std::size_t stride,
-                                 At at, const float* phi, DistanceCaps caps) noexcept {
+// The capped squared distance between phi and one template state whose dimension d is
+// feature(d).
+template <typename Feature>
+EmissionDistance capped_distance(const TemplateModel& model, Feature feature, const float* phi,
+                                 DistanceCaps caps) noexcept {
   const auto diff_sq = [&](int d) {
-    const float diff = state[static_cast<std::size_t>(at(d)) * stride] - phi[d];
+    const float diff = feature(d) - phi[d];
     return diff * diff;
   };
   const auto part = [&](auto&& dims) {
@@ -118,8 +118,9 @@ EmissionDistance emission_distances(const TemplateModel& model, const float* phi
   const FeatureView features = model.features();
   EmissionDistance best{FLT_MAX, FLT_MAX};
   for (int i = 0; i < num_states; ++i) {
+    const float* row = features.row(i).data();
     const EmissionDistance d2 = capped_distance(
-        model, features.row(i).data(), 1, [](int d) { return d; }, phi, caps);
+        model, [row](int d) { return row[d]; }, phi, caps);
     out[i] = d2.bounded;
     best.bounded = std::min(best.bounded, d2.bounded);
     best.plain = std::min(best.plain, d2.plain);
@@ -129,13 +130,18 @@ EmissionDistance emission_distances(const TemplateModel& model, const float* phi
 
 EmissionDistance state_emission_distance(const TemplateModel& model, const float* phi, int i,
                                          DistanceCaps caps) noexcept {
+  // From the blocked copy, not the row-major features: those may stay in a model cache's map,
+  // and a beam's scattered states would page them in (docs/follower.md, "Start-up").
   constexpr int kBlock = TemplateModel::kStateBlock;
-  const float* lane =
+  const std::uint16_t* lane =
       model.blocked_features().data() +
       static_cast<std::size_t>(i / kBlock) * static_cast<std::size_t>(model.num_dims()) * kBlock +
       static_cast<std::size_t>(i % kBlock);
-  return capped_distance(
-      model, lane, kBlock, [&model](int d) { return model.blocked_dim(d); }, phi, caps);
+  const auto feature = [lane, &model](int d) {
+    const std::uint16_t bits = lane[static_cast<std::size_t>(model.blocked_dim(d)) * kBlock];
+    return static_cast<float>(Eigen::numext::bit_cast<Eigen::half>(bits));
+  };
+  return capped_distance(model, feature, phi, caps);
 }
 
 float lost_test_distance(const TemplateModel& model, const FollowParams& params, const float* phi,

@@ -21,7 +21,8 @@ const char* to_string(SimdLevel level) noexcept {
 bool cpu_supports(SimdLevel level) noexcept {
   if (level == SimdLevel::kScalar) return true;
 #if defined(__x86_64__)
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+         __builtin_cpu_supports("f16c");
 #else
   return false;
 #endif

@@ -3,29 +3,39 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdlib>
 #include <numeric>
 #include <string>
 #include <utility>
 
 namespace duet {
+
+float TemplateModel::held_precision(float value) {
+  constexpr float kLargestHalf = 65504.0f;
+  if (!std::isfinite(value)) return value;  // for build to refuse
+  return static_cast<float>(Eigen::half(std::clamp(value, -kLargestHalf, kLargestHalf)));
+}
+
 namespace {
 
 Error model_error(const std::string& reason) { return make_error("template model", 0, reason); }
 
 // The layout of TemplateModel::blocked_features(): dimension d of the row at blocked_dim
 // position[d] (empty: d).
-std::vector<float> blocked(const FeatureView& features, const std::vector<int>& position = {}) {
+std::vector<std::uint16_t> blocked(const FeatureView& features,
+                                   const std::vector<int>& position = {}) {
   constexpr Eigen::Index kBlock = TemplateModel::kStateBlock;
   const Eigen::Index rows = features.rows();
   const Eigen::Index dims = features.cols();
   const Eigen::Index blocks = (rows + kBlock - 1) / kBlock;
-  std::vector<float> out(static_cast<std::size_t>(blocks * dims * kBlock), 0.0f);
+  std::vector<std::uint16_t> out(static_cast<std::size_t>(blocks * dims * kBlock), 0);  // +0
   for (Eigen::Index i = 0; i < rows; ++i) {
     const Eigen::Index b = i / kBlock;
     const Eigen::Index lane = i % kBlock;
     for (Eigen::Index d = 0; d < dims; ++d) {
       const Eigen::Index at = position.empty() ? d : position[static_cast<std::size_t>(d)];
-      out[static_cast<std::size_t>((b * dims + at) * kBlock + lane)] = features(i, d);
+      out[static_cast<std::size_t>((b * dims + at) * kBlock + lane)] =
+          Eigen::numext::bit_cast<std::uint16_t>(Eigen::half(features(i, d)));
     }
   }
   return out;
@@ -56,6 +66,7 @@ Result<TemplateModel> TemplateModel::build(FeatureMatrix features, std::vector<i
     return model_error("too many template frames or dimensions: " + std::to_string(num_frames) +
                        " x " + std::to_string(num_dims));
   }
+  features = features.unaryExpr(&held_precision);
   auto owned = std::make_shared<const FeatureMatrix>(std::move(features));
   std::shared_ptr<const float> data(owned, owned->data());
   return finish(std::move(data), static_cast<int>(num_frames), static_cast<int>(num_dims),
@@ -78,6 +89,12 @@ Result<TemplateModel> TemplateModel::build_shared(std::shared_ptr<const void> st
                                                   std::vector<int> take_start, double frame_rate_hz,
                                                   int velocity_dims) {
   if (Status s = check_buffer(features_row_major, num_frames, num_dims); !s) return s.error();
+  const bool held = std::all_of(features_row_major.begin(), features_row_major.end(),
+                                [](float v) { return held_precision(v) == v; });
+  if (!held) {
+    return build(features_row_major, num_frames, num_dims, std::move(take_start), frame_rate_hz,
+                 velocity_dims);
+  }
   std::shared_ptr<const float> data(std::move(storage), features_row_major.data());
   return finish(std::move(data), num_frames, num_dims, std::move(take_start), frame_rate_hz,
                 velocity_dims);

@@ -113,7 +113,9 @@ TEST(SimdKernels, TheFarthestLimbAndTheVelocitiesCountAtMostTheirBound) {
   FeatureMatrix features(9, 7);  // 9 states: one whole block of 8 and a partial one
   features.setZero();
   features.row(0) << 1, 3, 4, 1, 0, 0, 0;        // limbs 25, 1, 0: 25 counts 3 x 1
-  features.row(1) << 0, 0.1f, 0.2f, 0, 0, 2, 0;  // limbs 0.05, 0, 0: the floor; velocity 4 -> 0.3
+  // Values a half float holds exactly (TemplateModel::held_precision).
+  features.row(1) << 0, 0.125f, 0.25f, 0, 0, 2, 0;  // limbs 0.078, 0, 0: the floor 0.05;
+                                                    // velocity 4 -> 0.3
   features.row(8) << 0, 0, 0, 2, 1, 0, 0;        // limbs 0, 4, 1: 4 counts 3 x 1
   TemplateModel model = TemplateModel::build(features, {}, 60.0, 2).value();
   ASSERT_TRUE(model.set_limbs({{1, 2}, {3}, {4}}).ok());
@@ -139,11 +141,11 @@ TEST(SimdKernels, TheFarthestLimbAndTheVelocitiesCountAtMostTheirBound) {
     EXPECT_FLOAT_EQ(follow_detail::state_emission_distance(model, phi.data(), 0, caps).plain,
                     27.0f);
     EXPECT_FLOAT_EQ(follow_detail::state_emission_distance(model, phi.data(), 1, caps).plain,
-                    0.35f);
+                    0.078125f + 0.3f);
     // No bounds: the plain squared distance.
     follow_detail::emission_distances(model, phi.data(), {}, out.data());
     EXPECT_FLOAT_EQ(out[0], 27.0f);
-    EXPECT_FLOAT_EQ(out[1], 4.05f);
+    EXPECT_FLOAT_EQ(out[1], 4.078125f);
     EXPECT_FLOAT_EQ(out[8], 5.0f);
   }
 }

@@ -114,7 +114,7 @@ TEST(SyntheticLibrary, MirrorsEverySecondCopy) {
     if (source.mirrored) {
       EXPECT_FLOAT_EQ(big.features()(row, 0), x(1));
       EXPECT_FLOAT_EQ(big.features()(row, 1), x(0));
-      EXPECT_FLOAT_EQ(big.features()(row, 2), 1.0f - x(2));
+      EXPECT_FLOAT_EQ(big.features()(row, 2), TemplateModel::held_precision(1.0f - x(2)));
       EXPECT_FLOAT_EQ(big.features()(row, 5), -x(5));
     } else {
       EXPECT_TRUE(big.features().row(row).isApprox(x));

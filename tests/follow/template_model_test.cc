@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -89,6 +90,36 @@ TEST(TemplateModel, BuildsFromRowMajorBuffer) {
   EXPECT_EQ(model.value().features()(0, 2), 3.0f);
 }
 
+TEST(TemplateModel, HoldsItsFeaturesAtHalfPrecision) {
+  // 0.1 is not a binary16 value: the nearest is 0.0999755859375 (11 significant bits).
+  FeatureMatrix features(2, 3);
+  features << 0.1f, 1.0f, -2.5f, 1e6f, -1e6f, 3.0e-3f;
+  const TemplateModel model = TemplateModel::build(features, {}, 60.0).value();
+  EXPECT_EQ(model.features()(0, 0), 0.0999755859375f);
+  EXPECT_EQ(model.features()(0, 1), 1.0f);
+  EXPECT_EQ(model.features()(0, 2), -2.5f);
+  EXPECT_EQ(model.features()(1, 0), 65504.0f);  // the largest half, not infinity
+  EXPECT_EQ(model.features()(1, 1), -65504.0f);
+  EXPECT_NEAR(model.features()(1, 2), 3.0e-3f, 3.0e-3f * 5e-4f);
+  for (Eigen::Index i = 0; i < features.size(); ++i) {
+    const float held = model.features().data()[i];
+    EXPECT_EQ(TemplateModel::held_precision(held), held);  // rounding again changes nothing
+  }
+  // Non-finite features are still refused, not rounded to a finite value.
+  features(1, 0) = std::numeric_limits<float>::infinity();
+  EXPECT_FALSE(TemplateModel::build(features, {}, 60.0));
+}
+
+TEST(TemplateModel, SharesFeaturesAlreadyAtItsPrecisionAndCopiesOthersRounded) {
+  auto held = std::make_shared<std::vector<float>>(std::vector<float>{0.5f, 0.25f, 3.0f, -1.0f});
+  const TemplateModel shared = TemplateModel::build_shared(held, *held, 2, 2, {}, 60.0).value();
+  EXPECT_EQ(shared.features().data(), held->data());
+  auto finer = std::make_shared<std::vector<float>>(std::vector<float>{0.1f, 0.25f, 3.0f, -1.0f});
+  const TemplateModel copied = TemplateModel::build_shared(finer, *finer, 2, 2, {}, 60.0).value();
+  EXPECT_NE(copied.features().data(), finer->data());
+  EXPECT_EQ(copied.features()(0, 0), TemplateModel::held_precision(0.1f));
+  EXPECT_EQ(copied.features()(1, 1), -1.0f);
+}
 TEST(TemplateModel, RejectsBadInputWithClearMessages) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   EXPECT_NE(error_of(TemplateModel::build(FeatureMatrix(0, 3), {}, 60.0)).find("no template"),

@@ -21,7 +21,7 @@
 
 namespace duet {
 
-inline constexpr std::uint32_t kModelCacheVersion = 1;
+inline constexpr std::uint32_t kModelCacheVersion = 2;  // 2: features at half precision
 
 struct CachedModel {
   TemplateModel model;

@@ -1,6 +1,7 @@
 // Which instruction set the follower's per-frame kernels use (emission distances and the
 // exponentials of eq. 7 and 11). Chosen at run time, so one binary runs on any x86-64: AVX2 with
-// FMA where the CPU has both, the portable scalar/Eigen code elsewhere. The environment variable
+// FMA and F16C (the template's half-precision features) where the CPU has them (every x86-64 with
+// AVX2 so far), the portable scalar/Eigen code elsewhere. The environment variable
 // DUET_SIMD=scalar forces the portable code (to compare both paths on one machine).
 #pragma once
 

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <vector>
@@ -41,7 +42,8 @@ class TemplateModel {
                                      int num_dims, std::vector<int> take_start,
                                      double frame_rate_hz, int velocity_dims = 0);
   // Same, on features the model does not copy: `storage` keeps them alive (e.g. a memory-mapped
-  // model cache, model_cache.h) as long as the model or a copy of it lives. At a million states
+  // model cache, model_cache.h) as long as the model or a copy of it lives. Features not already
+  // at the model's precision (features()) are copied, rounded. At a million states
   // the row-major features are 200 MB that the follower reads only a few rows of per frame (the
   // SIMD kernel reads the blocked copy), so from a mapped file they stay mostly on disk.
   static Result<TemplateModel> build_shared(std::shared_ptr<const void> storage,
@@ -57,15 +59,22 @@ class TemplateModel {
   // The last velocity_dims() of the D dimensions are velocities (see build).
   int velocity_dims() const { return velocity_dims_; }
 
-  // Row i is phi_i. A cheap view: copies of the model share the features.
+  // Row i is phi_i. A cheap view: copies of the model share the features. Held at half precision
+  // (IEEE binary16 values, stored as floats): build rounds every feature to the nearest (beyond
+  // +-65504, to +-65504). 11 significant bits, a relative error under 5e-4, a thousandth of a
+  // sensor's noise in standardised units, so the emission kernel can stream half as many bytes
+  // (blocked_features) and every path still computes on the same values.
   FeatureView features() const { return {features_.get(), num_states_, num_dims_}; }
-  // The same features blocked for the SIMD emission kernel: states in blocks of kStateBlock, and
-  // within a block dimension-major, so one load gives dimension d of kStateBlock states:
+  // The same features blocked for the SIMD emission kernel, as binary16 bits: states in blocks of
+  // kStateBlock, and within a block dimension-major, so one load gives dimension d of
+  // kStateBlock states:
   // blocked_features()[(b * D + blocked_dim(d)) * kStateBlock + l] = phi_{b * kStateBlock + l}(d).
-  // The last block is padded with zeros. Built with the model (a second copy of the features)
+  // The last block is padded with zeros. Built with the model (half the size of the features)
   // and again, in the limbs' order, by set_limbs.
   static constexpr int kStateBlock = 8;
-  std::span<const float> blocked_features() const { return blocked_features_; }
+  std::span<const std::uint16_t> blocked_features() const { return blocked_features_; }
+  // A feature as the model holds it (see features()).
+  static float held_precision(float value);
   // First state of take k, and one past its last state.
   int take_begin(int take) const { return take_start_[static_cast<std::size_t>(take)]; }
   int take_end(int take) const { return take_start_[static_cast<std::size_t>(take) + 1]; }
@@ -119,7 +128,7 @@ class TemplateModel {
   std::shared_ptr<const float> features_;  // M x D row-major, owned or shared (build_shared)
   int num_states_ = 0;
   int num_dims_ = 0;
-  std::vector<float> blocked_features_;  // see blocked_features()
+  std::vector<std::uint16_t> blocked_features_;  // see blocked_features()
   std::vector<int> take_start_;          // num_takes + 1 entries; the last one is M
   double frame_rate_hz_ = 0.0;
   int velocity_dims_ = 0;
