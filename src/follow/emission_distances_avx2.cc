@@ -18,6 +18,9 @@ namespace {
 
 constexpr int kBlock = TemplateModel::kStateBlock;
 static_assert(kBlock == 8, "one __m256 per block");
+constexpr int kPrefetchBlocks = 8;  // 4 pairs, 6.4 KB at D = 50 (4 and 16: the same)
+// Every line of the pair ahead (every second one left 1M states 1.25x slower).
+constexpr std::ptrdiff_t kCacheLine = 64;
 
 // The 8 binary16 values at half as floats.
 __attribute__((target("avx2,fma,f16c"), always_inline)) inline __m256 load_half(
@@ -118,6 +121,44 @@ __attribute__((target("avx2,fma,f16c"), always_inline)) inline void block_emissi
   }
 }
 
+// The emission of blocks [0, 2 * (full_blocks / 2)) two at a time into out, their minima into
+// best_bounded / best_plain; returns the first block not done. kPrefetch: the pair kPrefetchBlocks
+// ahead is asked for before each pair. From memory (a library beyond the caches) the hardware's
+// prefetcher alone left the loop 1.6x slower than one block at a time; within the caches it
+// keeps up, and the software prefetch cost 5 %.
+template <bool kPrefetch>
+__attribute__((target("avx2,fma,f16c"), always_inline)) inline int block_pairs(
+    const std::uint16_t* blocked, int full_blocks, const float* phi, const Layout& layout,
+    float* out, __m256& best_bounded, __m256& best_plain) noexcept {
+  const std::ptrdiff_t block_size = static_cast<std::ptrdiff_t>(layout.dims) * kBlock;
+  const std::ptrdiff_t pair_bytes =
+      2 * block_size * static_cast<std::ptrdiff_t>(sizeof(std::uint16_t));
+  int b = 0;
+  for (; b + 2 <= full_blocks; b += 2) {
+    const std::uint16_t* blocks[2] = {blocked + b * block_size, blocked + (b + 1) * block_size};
+    if constexpr (kPrefetch) {
+      const int ahead_block = std::min(b + kPrefetchBlocks, full_blocks - 2);
+      const char* ahead = reinterpret_cast<const char*>(blocked + ahead_block * block_size);
+      for (std::ptrdiff_t at = 0; at < pair_bytes; at += kCacheLine) {
+        _mm_prefetch(ahead + at, _MM_HINT_T0);
+      }
+    }
+    __m256 bounded[2], plain[2];
+    block_emission<2>(blocks, phi, layout, bounded, plain);
+    for (int n = 0; n < 2; ++n) {
+      _mm256_storeu_ps(out + (b + n) * kBlock, bounded[n]);
+      best_bounded = _mm256_min_ps(best_bounded, bounded[n]);
+      best_plain = _mm256_min_ps(best_plain, plain[n]);
+    }
+  }
+  return b;
+}
+
+// Blocked features up to this size are fetched ahead by the hardware alone. Measured at D = 50:
+// 2.7 MB (27k states) 5 % faster without the software prefetch, 10 MB (100k) 1.2x and 100 MB
+// (1M) 1.45x faster with it.
+constexpr std::size_t kHardwarePrefetchBytes = std::size_t{4} << 20;
+
 }  // namespace
 
 __attribute__((target("avx2,fma,f16c"))) EmissionDistance emission_distances(
@@ -142,19 +183,13 @@ __attribute__((target("avx2,fma,f16c"))) EmissionDistance emission_distances(
   __m256 best_bounded = _mm256_set1_ps(FLT_MAX);
   __m256 best_plain = best_bounded;
   const int full_blocks = num_states / kBlock;
-  // Two blocks at a time: twice the independent FMA chains and half the broadcasts (on 27k states
-  // 120 -> 96 us a frame, docs/follower.md "Cost").
-  int b = 0;
-  for (; b + 2 <= full_blocks; b += 2) {
-    const std::uint16_t* blocks[2] = {blocked + b * block_size, blocked + (b + 1) * block_size};
-    __m256 bounded[2], plain[2];
-    block_emission<2>(blocks, phi, layout, bounded, plain);
-    for (int n = 0; n < 2; ++n) {
-      _mm256_storeu_ps(out + (b + n) * kBlock, bounded[n]);
-      best_bounded = _mm256_min_ps(best_bounded, bounded[n]);
-      best_plain = _mm256_min_ps(best_plain, plain[n]);
-    }
-  }
+  // Two blocks at a time: twice the independent FMA chains and half the broadcasts (docs/
+  // follower.md, "Half-precision features, two blocks at a time").
+  const std::size_t blocked_bytes = model.blocked_features().size_bytes();
+  int b =
+      blocked_bytes > kHardwarePrefetchBytes
+          ? block_pairs<true>(blocked, full_blocks, phi, layout, out, best_bounded, best_plain)
+          : block_pairs<false>(blocked, full_blocks, phi, layout, out, best_bounded, best_plain);
   for (; b < full_blocks; ++b) {
     const std::uint16_t* blocks[1] = {blocked + b * block_size};
     __m256 bounded[1], plain[1];
