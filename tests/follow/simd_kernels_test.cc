@@ -104,6 +104,11 @@ TEST(SimdKernels, Avx2EmissionDistancesMatchTheScalarPath) {
   ASSERT_TRUE(limbed.set_limbs(FeatureSpec{}.limb_dims()).ok());
   expect_same_distances(limbed, 4.0f, 1.5f);  // the farthest limb bounded
   expect_same_distances(limbed, 4.0f);        // limbs, no bound
+  // Blocked features beyond 4 MB: the kernel's loop that fetches the blocks ahead.
+  TemplateModel large = test::make_model({30000, 15003}, 50, 7, 60.0, 8);
+  ASSERT_TRUE(large.set_limbs(FeatureSpec{}.limb_dims()).ok());
+  ASSERT_GT(large.blocked_features().size_bytes(), std::size_t{4} << 20);
+  expect_same_distances(large, 4.0f, 1.5f);
   expect_same_distances(test::make_model({5}, 7, 5, 60.0, 2), 1.0f);
   expect_same_distances(test::make_model({64}, 3, 6, 60.0, 3), 0.5f);  // velocity only
 }
