@@ -11,6 +11,7 @@
 #include "duet/follow/copy_places.h"
 #include "duet/follow/simd.h"
 #include "kernels_avx2.h"
+#include "kernels_portable.h"
 
 namespace duet::follow_detail {
 namespace {
@@ -115,17 +116,7 @@ EmissionDistance emission_distances(const TemplateModel& model, const float* phi
     const float best = squared_distances(model.features(), phi, 0, num_states, out);
     return {best, best};
   }
-  const FeatureView features = model.features();
-  EmissionDistance best{FLT_MAX, FLT_MAX};
-  for (int i = 0; i < num_states; ++i) {
-    const float* row = features.row(i).data();
-    const EmissionDistance d2 = capped_distance(
-        model, [row](int d) { return row[d]; }, phi, caps);
-    out[i] = d2.bounded;
-    best.bounded = std::min(best.bounded, d2.bounded);
-    best.plain = std::min(best.plain, d2.plain);
-  }
-  return best;
+  return portable::emission_distances(model, caps, phi, out);
 }
 
 EmissionDistance state_emission_distance(const TemplateModel& model, const float* phi, int i,
