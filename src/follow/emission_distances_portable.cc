@@ -19,7 +19,7 @@ namespace {
 
 constexpr int kBlock = TemplateModel::kStateBlock;
 // Four states' values: GCC and Clang's vector extensions, one SSE2 or NEON register; a block of 8
-// states is two (the 32-byte vector, split by the compiler where the target has no AVX, ran 1.6x
+// states is two (the 32-byte vector, split by the compiler where the target has no AVX, ran 1.7x
 // slower).
 using Quad = float __attribute__((vector_size(4 * sizeof(float))));
 using HalfQuad = std::uint16_t __attribute__((vector_size(4 * sizeof(std::uint16_t))));
