@@ -60,44 +60,6 @@ DistanceCaps emission_caps(const FollowParams& params) noexcept {
 
 namespace {
 
-// The capped squared distance between phi and one template state whose dimension d is
-// feature(d).
-template <typename Feature>
-EmissionDistance capped_distance(const TemplateModel& model, Feature feature, const float* phi,
-                                 DistanceCaps caps) noexcept {
-  const auto diff_sq = [&](int d) {
-    const float diff = feature(d) - phi[d];
-    return diff * diff;
-  };
-  const auto part = [&](auto&& dims) {
-    float sum = 0.0f;
-    for (const int d : dims) sum += diff_sq(d);
-    return sum;
-  };
-  float posture_d2 = 0.0f;
-  float limb_excess = 0.0f;  // what the limb bound takes off
-  if (limbs_bounded(model, caps)) {
-    posture_d2 = part(model.posture_dims_outside_limbs());
-    float farthest = 0.0f, second = 0.0f;
-    for (const std::vector<int>& limb : model.limbs()) {
-      const float limb_d2 = part(limb);
-      posture_d2 += limb_d2;
-      second = std::max(second, std::min(farthest, limb_d2));
-      farthest = std::max(farthest, limb_d2);
-    }
-    limb_excess =
-        farthest - std::min(farthest, std::max(caps.limb_ratio * second, caps.limb_floor));
-  } else {
-    for (int d = 0; d < model.num_dims() - model.velocity_dims(); ++d) posture_d2 += diff_sq(d);
-  }
-  float velocity_d2 = 0.0f;
-  for (int d = model.num_dims() - model.velocity_dims(); d < model.num_dims(); ++d) {
-    velocity_d2 += diff_sq(d);
-  }
-  const float plain = std::min(posture_d2 + std::min(velocity_d2, caps.velocity), FLT_MAX);
-  return {std::min(plain - limb_excess, FLT_MAX), plain};
-}
-
 bool nothing_capped(const TemplateModel& model, DistanceCaps caps) noexcept {
   return (model.velocity_dims() == 0 || !(caps.velocity < FLT_MAX)) && !limbs_bounded(model, caps);
 }
@@ -122,17 +84,49 @@ EmissionDistance emission_distances(const TemplateModel& model, const float* phi
 EmissionDistance state_emission_distance(const TemplateModel& model, const float* phi, int i,
                                          DistanceCaps caps) noexcept {
   // From the blocked copy, not the row-major features: those may stay in a model cache's map,
-  // and a beam's scattered states would page them in (docs/follower.md, "Start-up").
+  // and a beam's scattered states would page them in (docs/follower.md, "Start-up"). The groups
+  // and the order of the sums are the kernels' (TemplateModel::blocked_limbs).
   constexpr int kBlock = TemplateModel::kStateBlock;
+  const int dims = model.num_dims();
+  const int posture = dims - model.velocity_dims();
   const std::uint16_t* lane =
       model.blocked_features().data() +
-      static_cast<std::size_t>(i / kBlock) * static_cast<std::size_t>(model.num_dims()) * kBlock +
+      static_cast<std::size_t>(i / kBlock) * static_cast<std::size_t>(dims) * kBlock +
       static_cast<std::size_t>(i % kBlock);
-  const auto feature = [lane, &model](int d) {
-    const std::uint16_t bits = lane[static_cast<std::size_t>(model.blocked_dim(d)) * kBlock];
-    return static_cast<float>(Eigen::numext::bit_cast<Eigen::half>(bits));
+  float phi_blocked[TemplateModel::kMaxLimbModelDims];
+  if (!model.limbs().empty()) {
+    for (int d = 0; d < dims; ++d) phi_blocked[model.blocked_dim(d)] = phi[d];
+    phi = phi_blocked;
+  }
+  const auto range_distance = [&](int begin, int end) {
+    float sum = 0.0f;
+    for (int k = begin; k < end; ++k) {
+      const std::uint16_t bits = lane[static_cast<std::size_t>(k) * kBlock];
+      const float diff = static_cast<float>(Eigen::numext::bit_cast<Eigen::half>(bits)) - phi[k];
+      sum += diff * diff;
+    }
+    return sum;
   };
-  return capped_distance(model, feature, phi, caps);
+  float posture_d2 = 0.0f;
+  float limb_excess = 0.0f;  // what the limb bound takes off
+  if (limbs_bounded(model, caps)) {
+    const std::vector<TemplateModel::DimRange>& limbs = model.blocked_limbs();
+    posture_d2 = range_distance(0, limbs.front().begin);
+    float farthest = 0.0f, second = 0.0f;
+    for (const TemplateModel::DimRange& limb : limbs) {
+      const float limb_d2 = range_distance(limb.begin, limb.end);
+      posture_d2 += limb_d2;
+      second = std::max(second, std::min(farthest, limb_d2));
+      farthest = std::max(farthest, limb_d2);
+    }
+    limb_excess =
+        farthest - std::min(farthest, std::max(caps.limb_ratio * second, caps.limb_floor));
+  } else {
+    posture_d2 = range_distance(0, posture);
+  }
+  const float velocity_d2 = range_distance(posture, dims);
+  const float plain = std::min(posture_d2 + std::min(velocity_d2, caps.velocity), FLT_MAX);
+  return {std::min(plain - limb_excess, FLT_MAX), plain};
 }
 
 float lost_test_distance(const TemplateModel& model, const FollowParams& params, const float* phi,

@@ -4,7 +4,6 @@
 #include <cassert>
 #include <cmath>
 #include <cstdlib>
-#include <numeric>
 #include <string>
 #include <utility>
 
@@ -153,8 +152,6 @@ Result<TemplateModel> TemplateModel::finish(std::shared_ptr<const float> data, i
   model.take_start_ = std::move(take_start);
   model.frame_rate_hz_ = frame_rate_hz;
   model.velocity_dims_ = velocity_dims;
-  model.outside_limbs_.resize(static_cast<std::size_t>(num_dims - velocity_dims));
-  std::iota(model.outside_limbs_.begin(), model.outside_limbs_.end(), 0);
   return model;
 }
 
@@ -178,9 +175,9 @@ Status TemplateModel::set_limbs(std::vector<std::vector<int>> limbs) {
       in_limb[static_cast<std::size_t>(dim)] = true;
     }
   }
-  outside_limbs_.clear();
+  std::vector<int> outside_limbs;
   for (int dim = 0; dim < posture; ++dim) {
-    if (!in_limb[static_cast<std::size_t>(dim)]) outside_limbs_.push_back(dim);
+    if (!in_limb[static_cast<std::size_t>(dim)]) outside_limbs.push_back(dim);
   }
   limbs_ = std::move(limbs);
   // The blocked features in the limbs' order, each group's dimensions contiguous for the SIMD
@@ -188,7 +185,7 @@ Status TemplateModel::set_limbs(std::vector<std::vector<int>> limbs) {
   blocked_position_.assign(static_cast<std::size_t>(num_dims_), 0);
   limb_blocks_.clear();
   int at = 0;
-  for (const int dim : outside_limbs_) blocked_position_[static_cast<std::size_t>(dim)] = at++;
+  for (const int dim : outside_limbs) blocked_position_[static_cast<std::size_t>(dim)] = at++;
   for (const std::vector<int>& limb : limbs_) {
     const int begin = at;
     for (const int dim : limb) blocked_position_[static_cast<std::size_t>(dim)] = at++;

@@ -57,22 +57,39 @@ TEST(TemplateModel, AJumpIsAMoveOutOfTheBandOrIntoAnotherTake) {
   EXPECT_FALSE(m.is_jump(30, -1, 1));
 }
 
+// Where each dimension sits in the blocked features, dimension by dimension.
+std::vector<int> blocked_order(const TemplateModel& model) {
+  std::vector<int> at;
+  for (int d = 0; d < model.num_dims(); ++d) at.push_back(model.blocked_dim(d));
+  return at;
+}
+
 TEST(TemplateModel, LimbsNamePostureDimensionsOnceEach) {
   TemplateModel model = TemplateModel::build(ones(4, 6), {}, 60.0, 2).value();  // posture 0..3
   EXPECT_TRUE(model.limbs().empty());
-  EXPECT_EQ(model.posture_dims_outside_limbs(), (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_TRUE(model.blocked_limbs().empty());
+  EXPECT_EQ(blocked_order(model), (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  // The blocked features in the limbs' order: dimension 0 (in no limb), then {1, 3}, then {2},
+  // then the velocities.
   ASSERT_TRUE(model.set_limbs({{1, 3}, {2}}).ok());
   EXPECT_EQ(model.limbs().size(), 2u);
-  EXPECT_EQ(model.posture_dims_outside_limbs(), (std::vector<int>{0}));
+  EXPECT_EQ(blocked_order(model), (std::vector<int>{0, 1, 3, 2, 4, 5}));
+  ASSERT_EQ(model.blocked_limbs().size(), 2u);
+  EXPECT_EQ(model.blocked_limbs()[0].begin, 1);
+  EXPECT_EQ(model.blocked_limbs()[0].end, 3);
+  EXPECT_EQ(model.blocked_limbs()[1].begin, 3);
+  EXPECT_EQ(model.blocked_limbs()[1].end, 4);
   // A velocity dimension, a dimension past the end or in two limbs: refused, the limbs as before.
   EXPECT_NE(error_of(model.set_limbs({{4}})).find("outside the 4 posture dimensions"),
             std::string::npos);
   EXPECT_FALSE(model.set_limbs({{-1}}).ok());
   EXPECT_NE(error_of(model.set_limbs({{0, 1}, {1}})).find("dimension 1 is in two limbs"),
             std::string::npos);
-  EXPECT_EQ(model.posture_dims_outside_limbs(), (std::vector<int>{0}));
+  EXPECT_EQ(blocked_order(model), (std::vector<int>{0, 1, 3, 2, 4, 5}));
+  EXPECT_EQ(model.blocked_limbs().size(), 2u);
   ASSERT_TRUE(model.set_limbs({}).ok());
-  EXPECT_EQ(model.posture_dims_outside_limbs(), (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(blocked_order(model), (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  EXPECT_TRUE(model.blocked_limbs().empty());
 }
 
 TEST(TemplateModel, EmptyTakeListIsOneTake) {

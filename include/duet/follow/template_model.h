@@ -94,8 +94,6 @@ class TemplateModel {
   Status set_limbs(std::vector<std::vector<int>> limbs);
   static constexpr int kMaxLimbModelDims = 256;
   const std::vector<std::vector<int>>& limbs() const { return limbs_; }
-  // The posture dimensions in no limb, ascending (all of them when there are no limbs).
-  const std::vector<int>& posture_dims_outside_limbs() const { return outside_limbs_; }
   // Where dimension d sits in a state's lane of blocked_features() (below): d itself without
   // limbs; with them the dimensions in no limb come first, then each limb's (limb k at
   // blocked_limbs()[k], [begin, end)), then the velocities, so the SIMD kernel loads every group
@@ -133,7 +131,6 @@ class TemplateModel {
   double frame_rate_hz_ = 0.0;
   int velocity_dims_ = 0;
   std::vector<std::vector<int>> limbs_;
-  std::vector<int> outside_limbs_;
   std::vector<int> blocked_position_;  // see blocked_dim(); empty: the identity
   std::vector<DimRange> limb_blocks_;
   std::shared_ptr<const CopyPlaces> copy_places_;
