@@ -231,4 +231,12 @@ FollowParams follow_params_for(InputPoints points, FollowParams params) {
   return params;
 }
 
+PostureBiasParams posture_bias_params_for(InputPoints points, PostureBiasParams params) {
+  if (points == InputPoints::kHeadHands) {
+    params.time_constant_s = params.head_hands_time_constant_s;
+    params.noisy_time_constant_s = std::max(params.noisy_time_constant_s, params.time_constant_s);
+  }
+  return params;
+}
+
 }  // namespace duet

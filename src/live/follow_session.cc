@@ -10,18 +10,6 @@
 #include "duet/live/young_offset_confidence.h"
 
 namespace duet {
-namespace {
-
-// The posture offset's params for this kind of input: three points average over their own time.
-PostureBiasParams bias_params_for(InputPoints points, PostureBiasParams params) {
-  if (points == InputPoints::kHeadHands) {
-    params.time_constant_s = params.head_hands_time_constant_s;
-    params.noisy_time_constant_s = std::max(params.noisy_time_constant_s, params.time_constant_s);
-  }
-  return params;
-}
-
-}  // namespace
 
 Result<FollowSession> FollowSession::create(const DuetLibrary& library,
                                             std::shared_ptr<const Skeleton> user_skeleton,
@@ -45,7 +33,7 @@ FollowSession::FollowSession(const DuetLibrary& library, FeatureExtractor extrac
       features_(static_cast<std::size_t>(extractor_.dimension())),
       bias_(extractor_.spec().block_begin(FeatureBlock::kPosture),
             extractor_.spec().block_size(FeatureBlock::kPosture),
-            bias_params_for(extractor_.spec().input_points, bias)),
+            posture_bias_params_for(extractor_.spec().input_points, bias)),
       search_(extractor_.spec().block_begin(FeatureBlock::kPosture),
               extractor_.spec().block_size(FeatureBlock::kPosture), extractor_.dimension()),
       repeats_(joints) {}

@@ -54,6 +54,19 @@ TEST(DuetLibrary, ThreePointLibrariesAreFollowedWithoutTheUnexplainedJumpHold) {
   EXPECT_TRUE(points.validate(100));
 }
 
+TEST(DuetLibrary, ThreePointLibrariesAverageTheRigOffsetOverTheirOwnTime) {
+  PostureBiasParams defaults;
+  defaults.head_hands_time_constant_s = 2.5;
+  defaults.noisy_time_constant_s = 1.5;
+  const PostureBiasParams body = posture_bias_params_for(InputPoints::kFullBody, defaults);
+  EXPECT_EQ(body.time_constant_s, defaults.time_constant_s);
+  EXPECT_EQ(body.noisy_time_constant_s, 1.5);
+  const PostureBiasParams points = posture_bias_params_for(InputPoints::kHeadHands, defaults);
+  EXPECT_EQ(points.time_constant_s, 2.5);
+  EXPECT_EQ(points.noisy_time_constant_s, 2.5);       // never shorter than the steady one
+  EXPECT_EQ(points.max_offset, defaults.max_offset);  // nothing else changes
+}
+
 TEST(DuetLibrary, RejectsPairsThatAreNotDuets) {
   const std::vector<PairFiles> pairs = {{{salsa("60", "10")}, {salsa("61", "05")}}};
   Result<DuetLibrary> library = DuetLibrary::load(pairs, salsa_options(DancerRole::kLeader));

@@ -12,6 +12,7 @@
 
 #include "duet/base/result.h"
 #include "duet/features/feature_extractor.h"
+#include "duet/features/posture_bias.h"
 #include "duet/follow/follow_params.h"
 #include "duet/follow/jump_candidates.h"
 #include "duet/follow/synthetic_library.h"
@@ -75,6 +76,10 @@ struct DuetTake {
 // "An arm held where last seen"). `duet follow`, `duet serve` and `duet eval` make their trackers
 // with it.
 FollowParams follow_params_for(InputPoints points, FollowParams params);
+// The rig offset's parameters for these input points: three points average it over
+// PostureBiasParams::head_hands_time_constant_s (also while the sensor is noisy). FollowSession
+// applies it to the parameters it is given.
+PostureBiasParams posture_bias_params_for(InputPoints points, PostureBiasParams params);
 
 class DuetLibrary {
  public:
