@@ -173,10 +173,7 @@ __attribute__((target("avx2,fma,f16c"))) EmissionDistance emission_distances(
   layout.limb_floor = _mm256_set1_ps(caps.limb_floor);
   // The input in the blocked features' order (the limbs' order, when the model has limbs).
   alignas(32) float phi_blocked[TemplateModel::kMaxLimbModelDims];
-  if (!model.limbs().empty()) {
-    for (int d = 0; d < layout.dims; ++d) phi_blocked[model.blocked_dim(d)] = phi[d];
-    phi = phi_blocked;
-  }
+  phi = model.in_blocked_order(phi, phi_blocked);
   const std::uint16_t* blocked = model.blocked_features().data();
   const int num_states = model.num_states();
   const std::ptrdiff_t block_size = static_cast<std::ptrdiff_t>(layout.dims) * kBlock;

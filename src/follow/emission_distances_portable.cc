@@ -112,10 +112,7 @@ EmissionDistance emission_distances(const TemplateModel& model, DistanceCaps cap
   if (limbs_bounded(model, caps)) layout.limbs = &model.blocked_limbs();
   // The input in the blocked features' order (the limbs' order, when the model has limbs).
   float phi_blocked[TemplateModel::kMaxLimbModelDims];
-  if (!model.limbs().empty()) {
-    for (int d = 0; d < layout.dims; ++d) phi_blocked[model.blocked_dim(d)] = phi[d];
-    phi = phi_blocked;
-  }
+  phi = model.in_blocked_order(phi, phi_blocked);
   const std::uint16_t* blocked = model.blocked_features().data();
   const std::ptrdiff_t block_size = static_cast<std::ptrdiff_t>(layout.dims) * kBlock;
   const int num_states = model.num_states();

@@ -94,10 +94,7 @@ EmissionDistance state_emission_distance(const TemplateModel& model, const float
       static_cast<std::size_t>(i / kBlock) * static_cast<std::size_t>(dims) * kBlock +
       static_cast<std::size_t>(i % kBlock);
   float phi_blocked[TemplateModel::kMaxLimbModelDims];
-  if (!model.limbs().empty()) {
-    for (int d = 0; d < dims; ++d) phi_blocked[model.blocked_dim(d)] = phi[d];
-    phi = phi_blocked;
-  }
+  phi = model.in_blocked_order(phi, phi_blocked);
   const auto range_distance = [&](int begin, int end) {
     float sum = 0.0f;
     for (int k = begin; k < end; ++k) {

@@ -101,6 +101,13 @@ class TemplateModel {
   int blocked_dim(int d) const {
     return blocked_position_.empty() ? d : blocked_position_[static_cast<std::size_t>(d)];
   }
+  // A vector of the D features (phi) in that order: phi itself without limbs, else its values
+  // written into scratch (kMaxLimbModelDims floats). No allocation.
+  const float* in_blocked_order(const float* phi, float* scratch) const noexcept {
+    if (blocked_position_.empty()) return phi;
+    for (int d = 0; d < num_dims_; ++d) scratch[blocked_dim(d)] = phi[d];
+    return scratch;
+  }
   struct DimRange {
     int begin;
     int end;
