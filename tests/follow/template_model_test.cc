@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -136,6 +137,27 @@ TEST(TemplateModel, SharesFeaturesAlreadyAtItsPrecisionAndCopiesOthersRounded) {
   EXPECT_NE(copied.features().data(), finer->data());
   EXPECT_EQ(copied.features()(0, 0), TemplateModel::held_precision(0.1f));
   EXPECT_EQ(copied.features()(1, 1), -1.0f);
+  // Over every scale a half holds (subnormal halves, the largest): values at the precision are
+  // shared, the float next to each is copied.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> exponent(-26.0f, 16.0f);
+  std::vector<float> values = {0.0f, -0.0f, 65504.0f, -65504.0f, 0x1p-24f, 0x1p-14f, 0x3ffp-24f};
+  while (values.size() < 400) {
+    const float value = std::exp2(exponent(rng)) * (values.size() % 2 == 0 ? 1.0f : -1.0f);
+    values.push_back(TemplateModel::held_precision(value));
+  }
+  auto all = std::make_shared<std::vector<float>>(values);
+  const int rows = static_cast<int>(values.size()) / 2;
+  EXPECT_EQ(TemplateModel::build_shared(all, *all, rows, 2, {}, 60.0).value().features().data(),
+            all->data());
+  for (std::size_t i = 0; i < values.size(); i += 7) {
+    auto one_off = std::make_shared<std::vector<float>>(values);
+    (*one_off)[i] = std::nextafter(values[i], std::numeric_limits<float>::infinity());
+    const TemplateModel model =
+        TemplateModel::build_shared(one_off, *one_off, rows, 2, {}, 60.0).value();
+    EXPECT_NE(model.features().data(), one_off->data()) << values[i];
+    EXPECT_EQ(model.features().data()[i], TemplateModel::held_precision((*one_off)[i]));
+  }
 }
 TEST(TemplateModel, RejectsBadInputWithClearMessages) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
