@@ -69,6 +69,17 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
   }
 }
 
+void JumpGate::note_advance(const TemplateModel& model, int from, int to) noexcept {
+  // Within reach a move stays in the take (TemplateModel::is_jump: another take is a jump); a
+  // spell adrift can end anywhere, and the count starts again there.
+  if (advance_origin_ < 0 || model.take_of(advance_origin_) != model.take_of(from)) {
+    advance_origin_ = from;
+    advance_furthest_ = from;
+  }
+  advance_furthest_ = std::max(advance_furthest_, to);
+  advanced_s_ = static_cast<double>(advance_furthest_ - advance_origin_) / model.frame_rate_hz();
+}
+
 void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
                       const float* posterior, float total, int previous_state, bool previous_lost,
                       FollowResult& result) noexcept {
@@ -83,14 +94,11 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
     // Within reach of the old place: no jump, whatever the raw maximum's step was.
     result.jumped = false;
     // Settling counts the frames the follower is sure of; once settled, it stays settled.
-    const bool sure = settled(params) || result.window_mass >= params.jump_settle_mass;
+    const bool was_settled = settled(params);
+    const bool sure = was_settled || result.window_mass >= params.jump_settle_mass;
     if (previous_state >= 0 && result.state >= 0 && sure) {
       settled_s_ += step_s;
-      // Within reach a move forward stays in the take (TemplateModel::is_jump: another take is a
-      // jump).
-      if (result.state > previous_state) {
-        advanced_s_ += static_cast<double>(result.state - previous_state) / model.frame_rate_hz();
-      }
+      if (!was_settled) note_advance(model, previous_state, result.state);
     }
     forget_candidate();
     return;
@@ -99,7 +107,7 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
     // Still finding the first place: take the new one and start settling there.
     result.jumped = false;
     settled_s_ = 0.0;
-    advanced_s_ = 0.0;
+    forget_advance();
     forget_candidate();
     return;
   }

@@ -335,6 +335,36 @@ TEST(JumpGate, TheFirstPlacementSettlesOnlyOnceTheEstimateMovesForward) {
   EXPECT_TRUE(r.jumped);
 }
 
+TEST(JumpGate, JitterBackAndForthIsNoMoveForward) {
+  const TemplateModel model = two_takes();
+  FollowParams params;
+  params.jump_settle_s = 0.1f;
+  params.jump_settle_advance_s = 0.1f;  // 6 template frames forward
+  JumpGate gate;
+  // A standing start read through a noisy suit: the maximum jitters 3 frames forward and back
+  // about one place for a second. Summed, its forward steps would make 0.75 s; it has gone 3
+  // frames forward of where it began.
+  int previous = 60;
+  for (int k = 0; k < 60; ++k) {
+    const int state = 60 + (k / 3) % 2 * 3;
+    const std::vector<float> p = posterior(state);
+    FollowResult r = maximum_at(model, p, state);
+    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+    EXPECT_FALSE(r.jumped);
+    previous = r.state;
+  }
+  EXPECT_FALSE(gate.settled(params));
+  // Three frames past the furthest it had reached make the six from where it began.
+  for (int state = 64; state <= 66; ++state) {
+    EXPECT_FALSE(gate.settled(params)) << state;
+    const std::vector<float> p = posterior(state);
+    FollowResult r = maximum_at(model, p, state);
+    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+    previous = r.state;
+  }
+  EXPECT_TRUE(gate.settled(params));
+}
+
 TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
   FollowParams params;
   // The hold grows with the estimated sensor noise: none on a clean sensor, all of it from the

@@ -221,8 +221,9 @@ struct FollowParams {
   // window mass of 0.6-0.97 before the maximum moves on. 0: every frame within reach counts.
   float jump_settle_mass = 0.99f;
   // ... and only once the estimate has also moved forward through its take for
-  // jump_settle_advance_s (template time of forward moves within reach, frames it is sure of): a
-  // dancer found is a dancer followed while moving. Every take begins with its dancers standing,
+  // jump_settle_advance_s (template time from where it began to the furthest it has reached, on
+  // frames within reach it is sure of; jitter back and forth moves it nowhere): a dancer found is
+  // a dancer followed while moving. Every take begins with its dancers standing,
   // and a standing start looks like every standing moment of every take: under an inertial
   // suit's calibration error the estimate sat on another take's standing frame, sure of it, for
   // seconds, then moved between such places, each move a reported jump (`suit-drift`, takes 2, 4,

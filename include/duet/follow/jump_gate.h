@@ -16,9 +16,9 @@
 // first frame found again is a jump if it is out of reach of the place reported before the spell,
 // over the time the spell lasted. After a lost frame with no such place the new place is taken at
 // once. Until the estimate has first settled (FollowParams::jump_settle_s of frames within reach
-// with a window mass of at least jump_settle_mass, over which it moved forward through its take
-// for jump_settle_advance_s) a far move is the first placement being refined: no jump is
-// reported (half the false jumps left at 4 degrees per axis were those, and nearly all of an
+// with a window mass of at least jump_settle_mass, over which it reached jump_settle_advance_s
+// forward of where it began in its take) a far move is the first placement being refined: no jump
+// is reported (half the false jumps left at 4 degrees per axis were those, and nearly all of an
 // inertial suit's, whose standing start sat on other takes' standing frames).
 #pragma once
 
@@ -34,7 +34,7 @@ class JumpGate {
   void reset() noexcept {
     forget_candidate();
     settled_s_ = 0.0;
-    advanced_s_ = 0.0;
+    forget_advance();
     steady_state_ = -1;
     steps_since_steady_ = 0;
     in_spell_ = false;
@@ -71,6 +71,16 @@ class JumpGate {
     held_s_ = 0.0;
   }
 
+  void forget_advance() noexcept {
+    advanced_s_ = 0.0;
+    advance_origin_ = -1;
+    advance_furthest_ = -1;
+  }
+  // A sure frame within reach moved the estimate from `from` to `to`: advanced_s_ is how far
+  // forward of where the count began the estimate has been. Jitter back and forth adds nothing
+  // (summing each forward step did: a standing start jittering a frame or two about one place
+  // settled there).
+  void note_advance(const TemplateModel& model, int from, int to) noexcept;
   // While adrift, and on the frame found again: decides the frame and returns true.
   bool through_spell(const TemplateModel& model, const FollowParams& params, bool adrift,
                      FollowResult& result) noexcept;
@@ -87,6 +97,8 @@ class JumpGate {
   bool in_spell_ = false;       // adrift since steady_state_ (or since the start)
   double settled_s_ = 0.0;    // how long (template time) the estimate has stayed within reach
   double advanced_s_ = 0.0;   // how far (template time) it has moved forward meanwhile
+  int advance_origin_ = -1;   // the state where that count began
+  int advance_furthest_ = -1;  // the furthest state in its take reached since
   int candidate_state_ = -1;  // the far place that currently holds the maximum
   double held_s_ = 0.0;       // how long (template time) it has held it
 };
