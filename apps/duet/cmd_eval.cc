@@ -74,8 +74,9 @@ struct EvalArgs {
   std::optional<float> jump_settle_advance;
   std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
       pause_distance, lost_distance, velocity_cap, limb_ratio, limb_floor, pause_noise_factor,
-      lost_residual, lost_noise_factor, lost_residual_factor, lost_confirm, lost_velocity_cap,
-      emission_noise_factor, emission_noise_allowance, noise_filter_density, noise_filter_allowance;
+      lost_residual, lost_noise_factor, lost_residual_factor, lost_confirm, found_confirm_per_lost,
+      found_confirm_max, lost_velocity_cap, emission_noise_factor, emission_noise_allowance,
+      noise_filter_density, noise_filter_allowance;
   std::optional<double> tempo_time_constant;
   bool fixed_band = false;
   bool no_outlier_gate = false;
@@ -246,6 +247,8 @@ int run_eval(EvalArgs& args) {
   if (args.lost_noise_factor) hmm.lost_noise_factor = *args.lost_noise_factor;
   if (args.lost_residual_factor) hmm.lost_residual_factor = *args.lost_residual_factor;
   if (args.lost_confirm) hmm.lost_confirm_s = *args.lost_confirm;
+  if (args.found_confirm_per_lost) hmm.found_confirm_per_lost_s = *args.found_confirm_per_lost;
+  if (args.found_confirm_max) hmm.found_confirm_max_s = *args.found_confirm_max;
   if (args.lost_velocity_cap) hmm.lost_velocity_cap_per_dim = *args.lost_velocity_cap;
   if (args.pause_reported_lost) hmm.pause_reported_lost = true;
   if (args.tempo_time_constant) hmm.tempo_time_constant_s = *args.tempo_time_constant;
@@ -298,8 +301,12 @@ int run_eval(EvalArgs& args) {
   if (!args.arms_forward_error_cm.empty() && !args.tell_arms_forward) {
     return usage_error("--arms-forward-error-cm: needs --tell-arms-forward");
   }
-  // As `duet follow` and `duet serve` make the follower for these input points, unless asked.
-  if (!args.unexplained_jump_hold) hmm = follow_params_for(features.input_points, hmm);
+  // As `duet follow` and `duet serve` make the follower for these input points; what a tuning
+  // option asked for stays.
+  const FollowParams asked = hmm;
+  hmm = follow_params_for(features.input_points, hmm);
+  if (args.unexplained_jump_hold) hmm.unexplained_jump_hold_s = asked.unexplained_jump_hold_s;
+  if (args.found_confirm_per_lost) hmm.found_confirm_per_lost_s = asked.found_confirm_per_lost_s;
 
   std::string gnuplot;
   if (!args.plots_dir.empty()) {
@@ -414,7 +421,8 @@ int run_eval(EvalArgs& args) {
       "(mass {}, advance {} s) noisy_jump_hold {} s unexplained_jump_hold {} s (over {} x noise) "
       "jump_old_place_mass {} jump_alike_distance {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
-      "lost_residual_factor {} lost_confirm {} s lost_velocity_cap {}/dim{} emission_noise_factor "
+      "lost_residual_factor {} lost_confirm {} s found_confirm {} x lost (at most {} s) "
+      "lost_velocity_cap {}/dim{} emission_noise_factor "
       "{} "
       "emission_noise_allowance {} noise_filter_density {} noise_filter_allowance {}\n\n",
       library->takes().size(), library->model().num_states(), library->frame_rate(),
@@ -427,7 +435,8 @@ int run_eval(EvalArgs& args) {
       hmm.jump_settle_advance_s, hmm.noisy_jump_hold_s, hmm.unexplained_jump_hold_s,
       hmm.unexplained_jump_ratio, hmm.jump_old_place_mass, hmm.jump_alike_distance_per_dim,
       hmm.pause_noise_factor, hmm.lost_residual_per_dim, hmm.lost_noise_factor,
-      hmm.lost_residual_factor, hmm.lost_confirm_s, hmm.lost_velocity_cap_per_dim,
+      hmm.lost_residual_factor, hmm.lost_confirm_s, hmm.found_confirm_per_lost_s,
+      hmm.found_confirm_max_s, hmm.lost_velocity_cap_per_dim,
       hmm.pause_reported_lost ? " pause_reported_lost" : "", hmm.emission_noise_factor,
       hmm.emission_noise_allowance, hmm.noise_filter_density, hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
@@ -676,6 +685,17 @@ Command register_eval(CLI::App& app) {
       ->add_option("--lost-confirm-s", args->lost_confirm,
                    "lost_confirm_s: the input must stay past the HMM's noise-scaled lost distance "
                    "on consecutive frames this long before it is called lost (all HMM variants)")
+      ->check(CLI::Range(0.0, 10.0));
+  tuning
+      ->add_option("--found-confirm-per-lost", args->found_confirm_per_lost,
+                   "found_confirm_per_lost_s: after a spell lost by distance, the input must stay "
+                   "within the lost distance this times the spell's length before it is followed "
+                   "again (at least --lost-confirm-s, at most --found-confirm-max-s; full body "
+                   "only, all HMM variants)")
+      ->check(CLI::Range(0.0, 10.0));
+  tuning
+      ->add_option("--found-confirm-max-s", args->found_confirm_max,
+                   "found_confirm_max_s: the longest --found-confirm-per-lost asks for")
       ->check(CLI::Range(0.0, 10.0));
   tuning
       ->add_option("--lost-velocity-cap-per-dim", args->lost_velocity_cap,

@@ -398,6 +398,8 @@ Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const Templ
       params.lost_noise_factor = options.hmm.lost_noise_factor;
       params.lost_residual_factor = options.hmm.lost_residual_factor;
       params.lost_confirm_s = options.hmm.lost_confirm_s;
+      params.found_confirm_per_lost_s = options.hmm.found_confirm_per_lost_s;
+      params.found_confirm_max_s = options.hmm.found_confirm_max_s;
       params.pause_reported_lost = options.hmm.pause_reported_lost;
       params.confidence_window_frames = options.hmm.confidence_window_frames;
       params.max_steps_per_frame = options.hmm.max_steps_per_frame;

@@ -39,6 +39,7 @@ FollowParams FollowParams::paper() {
   params.calibrate_confidence = false;
   params.lost_residual_per_dim = std::numeric_limits<float>::infinity();
   params.lost_confirm_s = 0.0f;
+  params.found_confirm_per_lost_s = 0.0f;
   params.pause_reported_lost = true;
   return params;
 }
@@ -122,6 +123,14 @@ Status FollowParams::validate(int num_states) const {
   if (!(lost_confirm_s >= 0.0f && lost_confirm_s <= 10.0f)) {
     return params_error("lost_confirm_s must be in [0, 10] s, got " +
                         std::to_string(lost_confirm_s));
+  }
+  if (!(found_confirm_per_lost_s >= 0.0f && found_confirm_per_lost_s <= 10.0f)) {
+    return params_error("found_confirm_per_lost_s must be in [0, 10], got " +
+                        std::to_string(found_confirm_per_lost_s));
+  }
+  if (!(found_confirm_max_s >= 0.0f && found_confirm_max_s <= 10.0f)) {
+    return params_error("found_confirm_max_s must be in [0, 10] s, got " +
+                        std::to_string(found_confirm_max_s));
   }
   if (confidence_window_frames < 0) {
     return params_error("confidence_window_frames must be >= 0, got " +

@@ -23,6 +23,7 @@ void FollowerHistory::reset() noexcept {
   lost_by_distance = false;
   ceiling_lost.reset();
   against_s = 0.0;
+  lost_spell_s = 0.0;
   tempo.reset();
   jump_gate.reset();
   sensor_noise.reset();

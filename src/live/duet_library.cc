@@ -227,7 +227,10 @@ Result<FeatureExtractor> DuetLibrary::make_extractor(std::shared_ptr<const Skele
 }
 
 FollowParams follow_params_for(InputPoints points, FollowParams params) {
-  if (points == InputPoints::kHeadHands) params.unexplained_jump_hold_s = 0.0f;
+  if (points == InputPoints::kHeadHands) {
+    params.unexplained_jump_hold_s = 0.0f;
+    params.found_confirm_per_lost_s = 0.0f;
+  }
   return params;
 }
 

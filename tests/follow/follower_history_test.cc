@@ -39,6 +39,44 @@ TEST(FollowerHistory, LostByDistanceOnlyAfterItHoldsForTheConfirmTime) {
   EXPECT_TRUE(feed(slow, params, true, 1, k30Hz));
 }
 
+TEST(FollowerHistory, AfterALongSpellLostTheInputMustHoldLongerToBeFollowed) {
+  const FollowParams params;  // 0.25 s per second lost, at most 0.5 s
+  ASSERT_FLOAT_EQ(params.found_confirm_per_lost_s, 0.25f);
+  ASSERT_FLOAT_EQ(params.found_confirm_max_s, 0.5f);
+  EXPECT_DOUBLE_EQ(params.found_confirm_s(0.0), params.lost_confirm_s);
+  EXPECT_DOUBLE_EQ(params.found_confirm_s(1.0), 0.25);
+  EXPECT_DOUBLE_EQ(params.found_confirm_s(10.0), 0.5);
+
+  // One second lost (3 frames to turn lost, 60 more): followed again after 0.25 s = 15 frames
+  // within the distance, not after 14.
+  FollowerHistory history;
+  EXPECT_TRUE(feed(history, params, true, 63));
+  EXPECT_TRUE(feed(history, params, false, 14));
+  // A run broken starts over, and the frame past the distance adds to the spell: 61 frames ask
+  // for 0.254 s, 16 frames.
+  EXPECT_TRUE(feed(history, params, true, 1));
+  EXPECT_TRUE(feed(history, params, false, 15));
+  EXPECT_FALSE(feed(history, params, false, 1));
+  // Followed again, the next spell starts from nothing: a short one asks lost_confirm_s only.
+  EXPECT_TRUE(feed(history, params, true, 3));
+  EXPECT_TRUE(feed(history, params, false, 2));
+  EXPECT_FALSE(feed(history, params, false, 1));
+
+  // Half a minute lost asks for found_confirm_max_s: 15 frames at 30 Hz, not 14.
+  FollowerHistory slow;
+  EXPECT_TRUE(feed(slow, params, true, 900, k30Hz));
+  EXPECT_TRUE(feed(slow, params, false, 14, k30Hz));
+  EXPECT_FALSE(feed(slow, params, false, 1, k30Hz));
+
+  // 0 per second lost: lost_confirm_s after any spell.
+  FollowParams at_once = params;
+  at_once.found_confirm_per_lost_s = 0.0f;
+  FollowerHistory quick;
+  EXPECT_TRUE(feed(quick, at_once, true, 600));
+  EXPECT_TRUE(feed(quick, at_once, false, 2));
+  EXPECT_FALSE(feed(quick, at_once, false, 1));
+}
+
 TEST(FollowerHistory, AMissingFrameChangesNothingAndResetForgets) {
   const FollowParams params;
   FollowerHistory history;
@@ -87,6 +125,15 @@ TEST(FollowerHistory, TheConfirmTimeIsChecked) {
     params.lost_confirm_s = bad;
     EXPECT_FALSE(params.validate(10)) << bad;
   }
+  for (const float bad : {-0.01f, 11.0f, std::numeric_limits<float>::quiet_NaN()}) {
+    FollowParams found;
+    found.found_confirm_per_lost_s = bad;
+    EXPECT_FALSE(found.validate(10)) << bad;
+    found = FollowParams{};
+    found.found_confirm_max_s = bad;
+    EXPECT_FALSE(found.validate(10)) << bad;
+  }
+  EXPECT_TRUE(FollowParams{}.validate(10));
 }
 
 }  // namespace

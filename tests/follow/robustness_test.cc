@@ -147,10 +147,17 @@ TEST_F(RobustnessTest, FeaturesFarFromEveryTemplateFrame) {
       EXPECT_FALSE(r.missing);
     }
     expect_valid_alpha(hmm);
-    // Back to the template: found again within a few frames.
+    // Back to the template: the estimate is there within a few frames, and after 5 s lost it is
+    // reported followed once the input has held it for found_confirm_max_s (0.5 s: 30 frames).
     FollowResult r;
     for (int i = 100; i < 106; ++i) r = hmm.step(template_frame(i), kDt);
     EXPECT_EQ(r.state, 105);
+    EXPECT_TRUE(r.lost);
+    for (int i = 106; i < 129; ++i) r = hmm.step(template_frame(i), kDt);
+    EXPECT_EQ(r.state, 128);
+    EXPECT_TRUE(r.lost);
+    for (int i = 129; i < 131; ++i) r = hmm.step(template_frame(i), kDt);
+    EXPECT_EQ(r.state, 130);
     EXPECT_FALSE(r.lost);
   }
 }

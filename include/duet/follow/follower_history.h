@@ -41,16 +41,21 @@ struct FollowerHistory {
   // Whether the input is lost by distance, with hysteresis: it turns lost once past the
   // noise-scaled lost distance (`unexplained`) on consecutive frames for
   // FollowParams::lost_confirm_s of input time (`frame_s`: the frame's template steps over the
-  // template rate), and followed again once within it for as long. A frame with no features
-  // changes nothing.
+  // template rate), and followed again once within it for as long, or after a longer spell lost
+  // for FollowParams::found_confirm_s of the spell's time past the distance. A frame with no
+  // features changes nothing.
   bool confirm_unexplained(const FollowParams& params, bool unexplained, bool missing,
                            double frame_s) noexcept {
     if (missing) return lost_by_distance;
+    if (lost_by_distance && unexplained) lost_spell_s += frame_s;
+    const double confirm_s =
+        lost_by_distance ? params.found_confirm_s(lost_spell_s) : params.lost_confirm_s;
     if (unexplained == lost_by_distance) {
       against_s = 0.0;
-    } else if ((against_s += frame_s) >= params.lost_confirm_s - 1e-6) {
+    } else if ((against_s += frame_s) >= confirm_s - 1e-6) {
       lost_by_distance = unexplained;
       against_s = 0.0;
+      lost_spell_s = 0.0;
     }
     return lost_by_distance;
   }
@@ -82,6 +87,7 @@ struct FollowerHistory {
   bool lost_by_distance = false;   // confirm_unexplained's decision
   CeilingLostReport ceiling_lost;  // report_lost's ceiling test
   double against_s = 0.0;          // input time the frames have disagreed with it, consecutively
+  double lost_spell_s = 0.0;       // input time past the distance since lost by it
   TempoEstimator tempo;
   JumpGate jump_gate;
   SensorNoiseEstimator sensor_noise;

@@ -73,8 +73,9 @@ struct DuetTake {
 // (FollowParams::unexplained_jump_hold_s): they have no limb an optical system could hold where it
 // last saw it, and fit the template less closely, so the hold delayed true jumps (`improv-library`
 // 2.6 points lower on the handshake rig with the arms-forward calibration; docs/evaluation.md,
-// "An arm held where last seen"). `duet follow`, `duet serve` and `duet eval` make their trackers
-// with it.
+// "An arm held where last seen"), nor a longer wait to be found again after a spell lost
+// (FollowParams::found_confirm_per_lost_s: their improvised cases' frames lost although followed
+// doubled). `duet follow`, `duet serve` and `duet eval` make their trackers with it.
 FollowParams follow_params_for(InputPoints points, FollowParams params);
 // The rig offset's parameters for these input points: three points average it over
 // PostureBiasParams::head_hands_time_constant_s (also while the sensor is noisy). FollowSession
