@@ -135,15 +135,15 @@ struct FollowParams {
   // of a clean take lost, nearly all on their own. 0 calls every such frame lost.
   float lost_confirm_s = 0.05f;
   // Followed again after a spell lost by distance: within the lost distance on consecutive frames
-  // for found_confirm_per_lost_s times the spell's length, at most found_confirm_max_s (and at
-  // least lost_confirm_s; found_confirm_s()). Motion no part of the library holds passes through
+  // for found_confirm_per_lost_s times the spell's time past it, at most found_confirm_max_s (and
+  // at least lost_confirm_s; found_confirm_s()). Motion no part of the library holds passes through
   // poses that a dance holds too: a wave's arm coming down is a salsa take's standing start. Half
   // a minute of the Bandai wave was followed on 6.4 % of its frames, in runs of 1-27 frames
   // between seconds lost (93.6 % lost, under issue 11's 95); a dancer found again after a spell
   // holds the dance. 0: lost_confirm_s after any spell. Three points take 0
   // (follow_params_for): their input is lost and found again often within a dance, and waiting
   // doubled their improvised cases' frames lost although followed (docs/evaluation.md, "Found
-  // again after a long spell lost").
+  // again after a spell lost").
   float found_confirm_per_lost_s = 0.25f;
   float found_confirm_max_s = 0.5f;
   double found_confirm_s(double lost_spell_s) const noexcept {
