@@ -52,6 +52,26 @@ FollowResult noisy_maximum_at(const TemplateModel& model, const FollowParams& pa
   return r;
 }
 
+// A follower whose first placement settles after 6 sure template frames (0.1 s) over which the
+// estimate moved 6 frames forward.
+FollowParams settling_over_six_frames() {
+  FollowParams params;
+  params.jump_settle_s = 0.1f;
+  params.jump_settle_advance_s = 0.1f;
+  return params;
+}
+
+// One frame whose sure maximum is `state`, `previous` reported before it; `previous` becomes the
+// state reported.
+FollowResult step_to(JumpGate& gate, const TemplateModel& model, const FollowParams& params,
+                     int& previous, int state) {
+  const std::vector<float> p = posterior(state);
+  FollowResult r = maximum_at(model, p, state);
+  gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+  previous = r.state;
+  return r;
+}
+
 TEST(JumpGate, SmallStepsBackAreJitterLargerOnesAndOtherTakesAreJumps) {
   const TemplateModel model = two_takes();
   FollowParams params;
@@ -298,69 +318,41 @@ TEST(JumpGate, TheFirstPlacementIsRefinedWithoutJumpsUntilItHasSettled) {
 
 TEST(JumpGate, TheFirstPlacementSettlesOnlyOnceTheEstimateMovesForward) {
   const TemplateModel model = two_takes();
-  FollowParams params;
-  params.jump_settle_s = 0.1f;
-  params.jump_settle_advance_s = 0.1f;  // 6 template frames forward
+  const FollowParams params = settling_over_six_frames();
   JumpGate gate;
   // Half a second sure of one standing frame (as a standing start is): time alone does not
   // settle the placement, so a move to another take's look-alike is no jump.
   int previous = 60;
-  for (int k = 0; k < 30; ++k) {
-    const std::vector<float> p = posterior(60);
-    FollowResult r = maximum_at(model, p, 60);
-    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
-    EXPECT_FALSE(r.jumped);
-    previous = r.state;
-  }
+  for (int k = 0; k < 30; ++k) EXPECT_FALSE(step_to(gate, model, params, previous, 60).jumped);
   EXPECT_FALSE(gate.settled(params));
-  std::vector<float> p = posterior(140);
-  FollowResult r = maximum_at(model, p, 140);
-  gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+  FollowResult r = step_to(gate, model, params, previous, 140);
   EXPECT_FALSE(r.jumped);
   EXPECT_EQ(r.state, 140);
-  previous = r.state;
   // Five frames forward are not yet 0.1 s of the take; the sixth settles it.
   for (int k = 1; k <= 6; ++k) {
     EXPECT_FALSE(gate.settled(params)) << k;
-    p = posterior(140 + k);
-    r = maximum_at(model, p, 140 + k);
-    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
-    EXPECT_FALSE(r.jumped);
-    previous = r.state;
+    EXPECT_FALSE(step_to(gate, model, params, previous, 140 + k).jumped);
   }
   EXPECT_TRUE(gate.settled(params));
-  p = posterior(20);
-  r = maximum_at(model, p, 20);
-  gate.apply(model, params, p.data(), 1.0f, previous, false, r);
-  EXPECT_TRUE(r.jumped);
+  EXPECT_TRUE(step_to(gate, model, params, previous, 20).jumped);
 }
 
 TEST(JumpGate, JitterBackAndForthIsNoMoveForward) {
   const TemplateModel model = two_takes();
-  FollowParams params;
-  params.jump_settle_s = 0.1f;
-  params.jump_settle_advance_s = 0.1f;  // 6 template frames forward
+  const FollowParams params = settling_over_six_frames();
   JumpGate gate;
   // A standing start read through a noisy suit: the maximum jitters 3 frames forward and back
-  // about one place for a second. Summed, its forward steps would make 0.75 s; it has gone 3
+  // about one place for a second. Summed, its forward steps would make 0.5 s; it has gone 3
   // frames forward of where it began.
   int previous = 60;
   for (int k = 0; k < 60; ++k) {
-    const int state = 60 + (k / 3) % 2 * 3;
-    const std::vector<float> p = posterior(state);
-    FollowResult r = maximum_at(model, p, state);
-    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
-    EXPECT_FALSE(r.jumped);
-    previous = r.state;
+    EXPECT_FALSE(step_to(gate, model, params, previous, 60 + (k / 3) % 2 * 3).jumped);
   }
   EXPECT_FALSE(gate.settled(params));
   // Three frames past the furthest it had reached make the six from where it began.
   for (int state = 64; state <= 66; ++state) {
     EXPECT_FALSE(gate.settled(params)) << state;
-    const std::vector<float> p = posterior(state);
-    FollowResult r = maximum_at(model, p, state);
-    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
-    previous = r.state;
+    step_to(gate, model, params, previous, state);
   }
   EXPECT_TRUE(gate.settled(params));
 }
