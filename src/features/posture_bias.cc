@@ -88,6 +88,7 @@ void PostureBias::reset() noexcept {
   offset_rms_ = 0.0f;
   learnt_s_ = 0.0;
   lost_s_ = 0.0;
+  found_s_ = 0.0;
 }
 
 void PostureBias::adopt(std::span<const float> offset, double seconds) noexcept {
@@ -104,15 +105,20 @@ void PostureBias::adopt(std::span<const float> offset, double seconds) noexcept 
   offset_rms_ = root_mean_square(sum_squares, offset_.size());
   learnt_s_ = std::max(learnt_s_, std::isfinite(seconds) ? seconds : 0.0);
   lost_s_ = 0.0;
+  found_s_ = 0.0;
 }
 
 void PostureBias::note_lost(bool lost, double dt_s) noexcept {
+  const double frame_s = dt_s > 0.0 && std::isfinite(dt_s) ? dt_s : 0.0;
   if (!lost) {
-    lost_s_ = 0.0;
+    // A run lost is broken only by frames followed for release_found_s in a row.
+    found_s_ += frame_s;
+    if (found_s_ + 1e-9 >= params_.release_found_s) lost_s_ = 0.0;
     return;
   }
-  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) return;
-  lost_s_ += dt_s;
+  found_s_ = 0.0;
+  if (frame_s == 0.0) return;
+  lost_s_ += frame_s;
   if (!(params_.release_after_lost_s > 0.0) || lost_s_ < params_.release_after_lost_s) return;
   if (offset_rms_ > params_.release_offset_rms) reset();
 }

@@ -47,8 +47,12 @@ TEST(PostureBias, AnOffsetHeldThroughFourSecondsLostIsLetGo) {
   PostureBias bias = learnt(0.3f);
   ASSERT_NEAR(bias.offset()[0], 0.3f, 0.01f);
   for (int f = 0; f < 230; ++f) bias.note_lost(true, 1.0 / 60.0);  // 3.8 s
-  bias.note_lost(false, 1.0 / 60.0);  // a frame followed: the count starts again
+  // 0.25 s followed in a row (release_found_s): the count starts again.
+  for (int f = 0; f < 15; ++f) bias.note_lost(false, 1.0 / 60.0);
   for (int f = 0; f < 230; ++f) bias.note_lost(true, 1.0 / 60.0);
+  EXPECT_NEAR(bias.offset()[0], 0.3f, 0.01f);
+  // A flicker of 14 frames followed does not break the run; it adds nothing to it either.
+  for (int f = 0; f < 14; ++f) bias.note_lost(false, 1.0 / 60.0);
   EXPECT_NEAR(bias.offset()[0], 0.3f, 0.01f);
   for (int f = 0; f < 20; ++f) bias.note_lost(true, 1.0 / 60.0);  // past 4 s in a row
   EXPECT_EQ(bias.offset()[0], 0.0f);

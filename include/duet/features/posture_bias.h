@@ -87,6 +87,13 @@ struct PostureBiasParams {
   // under 0.001) are kept. 0: never let go.
   double release_after_lost_s = 4.0;
   float release_offset_rms = 0.01f;
+  // ... lost in a row: a run is broken only by release_found_s of frames followed in a row. Three
+  // points' lost flag flickers back for a frame or two (they keep FollowParams::lost_confirm_s
+  // after any spell), and each flicker started the count again: an offset that left three points
+  // on the handshake rig lost on 27 % of the frames they followed was never let go
+  // (`improv-30hz-noisy@handshake`, 64.8 % within 100 ms; 79.6 % with 0.25 s; docs/evaluation.md,
+  // "Three points let a lost offset go"). 0: any frame followed breaks the run.
+  double release_found_s = 0.25;
   // FollowSession maps the tracker's confidence through YoungOffsetConfidence while the offset is
   // young (young_offset_confidence.h): at a standing start on another rig the follower matched
   // another take's stance at 0.9+ confidence and was right on 30-60 % of those frames.
@@ -115,7 +122,8 @@ class PostureBias {
   // `seconds`; the lost run starts again.
   void adopt(std::span<const float> offset, double seconds) noexcept;
   // One frame's lost flag (FollowResult::lost) dt_s after the previous frame: lets the offset go
-  // after PostureBiasParams::release_after_lost_s lost in a row. Allocates nothing.
+  // after PostureBiasParams::release_after_lost_s lost in a row (broken only by release_found_s
+  // followed). Allocates nothing.
   void note_lost(bool lost, double dt_s) noexcept;
 
   // What correct() subtracts: the running mean, shrunk by its uncertainty.
@@ -137,6 +145,7 @@ class PostureBias {
   float offset_rms_ = 0.0f;    // of offset_
   double learnt_s_ = 0.0;      // weighted seconds learnt since reset
   double lost_s_ = 0.0;        // seconds lost in a row (note_lost)
+  double found_s_ = 0.0;       // seconds followed in a row since (note_lost)
 };
 
 }  // namespace duet
