@@ -68,6 +68,7 @@ struct EvalArgs {
   std::optional<float> noisy_jump_hold;
   std::optional<float> unexplained_jump_hold;
   std::optional<float> unexplained_jump_ratio;
+  std::optional<float> unexplained_jump_hold_after;
   std::optional<float> jump_old_place_mass;
   std::optional<float> jump_alike_distance;
   std::optional<float> jump_settle_mass;
@@ -261,6 +262,9 @@ int run_eval(EvalArgs& args) {
   if (args.noisy_jump_hold) hmm.noisy_jump_hold_s = *args.noisy_jump_hold;
   if (args.unexplained_jump_hold) hmm.unexplained_jump_hold_s = *args.unexplained_jump_hold;
   if (args.unexplained_jump_ratio) hmm.unexplained_jump_ratio = *args.unexplained_jump_ratio;
+  if (args.unexplained_jump_hold_after) {
+    hmm.unexplained_jump_hold_after_s = *args.unexplained_jump_hold_after;
+  }
   if (args.jump_old_place_mass) hmm.jump_old_place_mass = *args.jump_old_place_mass;
   if (args.jump_alike_distance) hmm.jump_alike_distance_per_dim = *args.jump_alike_distance;
   if (args.jump_settle_mass) hmm.jump_settle_mass = *args.jump_settle_mass;
@@ -306,6 +310,9 @@ int run_eval(EvalArgs& args) {
   const FollowParams asked = hmm;
   hmm = follow_params_for(features.input_points, hmm);
   if (args.unexplained_jump_hold) hmm.unexplained_jump_hold_s = asked.unexplained_jump_hold_s;
+  if (args.unexplained_jump_hold_after) {
+    hmm.unexplained_jump_hold_after_s = asked.unexplained_jump_hold_after_s;
+  }
   if (args.found_confirm_per_lost) hmm.found_confirm_per_lost_s = asked.found_confirm_per_lost_s;
 
   std::string gnuplot;
@@ -418,8 +425,8 @@ int run_eval(EvalArgs& args) {
       "{}\nhmm: self {} next {} skip {} leave {} pause_stay {} sigma {} pause_distance {} "
       "lost_distance {} velocity_cap {} limb_outlier {} x (floor {}) tempo {} jump_hold {} s "
       "jump_tolerance {} jump_settle {} s "
-      "(mass {}, advance {} s) noisy_jump_hold {} s unexplained_jump_hold {} s (over {} x noise) "
-      "jump_old_place_mass {} jump_alike_distance {}\n"
+      "(mass {}, advance {} s) noisy_jump_hold {} s unexplained_jump_hold {} s (over {} x noise, "
+      "after {} s followed) jump_old_place_mass {} jump_alike_distance {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
       "lost_residual_factor {} lost_confirm {} s found_confirm {} x lost (at most {} s) "
       "lost_velocity_cap {}/dim{} emission_noise_factor "
@@ -433,10 +440,10 @@ int run_eval(EvalArgs& args) {
       hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
       hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.jump_settle_mass,
       hmm.jump_settle_advance_s, hmm.noisy_jump_hold_s, hmm.unexplained_jump_hold_s,
-      hmm.unexplained_jump_ratio, hmm.jump_old_place_mass, hmm.jump_alike_distance_per_dim,
-      hmm.pause_noise_factor, hmm.lost_residual_per_dim, hmm.lost_noise_factor,
-      hmm.lost_residual_factor, hmm.lost_confirm_s, hmm.found_confirm_per_lost_s,
-      hmm.found_confirm_max_s, hmm.lost_velocity_cap_per_dim,
+      hmm.unexplained_jump_ratio, hmm.unexplained_jump_hold_after_s, hmm.jump_old_place_mass,
+      hmm.jump_alike_distance_per_dim, hmm.pause_noise_factor, hmm.lost_residual_per_dim,
+      hmm.lost_noise_factor, hmm.lost_residual_factor, hmm.lost_confirm_s,
+      hmm.found_confirm_per_lost_s, hmm.found_confirm_max_s, hmm.lost_velocity_cap_per_dim,
       hmm.pause_reported_lost ? " pause_reported_lost" : "", hmm.emission_noise_factor,
       hmm.emission_noise_allowance, hmm.noise_filter_density, hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
@@ -785,6 +792,12 @@ Command register_eval(CLI::App& app) {
       ->add_option("--unexplained-jump-ratio", args->unexplained_jump_ratio,
                    "unexplained_jump_ratio: see --unexplained-jump-hold")
       ->check(CLI::PositiveNumber);
+  tuning
+      ->add_option("--unexplained-jump-hold-after", args->unexplained_jump_hold_after,
+                   "unexplained_jump_hold_after_s: the unexplained jump hold applies only to a "
+                   "move from a place followed this long since the last reported jump (template "
+                   "seconds; 0 for every place)")
+      ->check(number_between(0.0, 60.0));
   tuning
       ->add_option("--jump-old-place-mass", args->jump_old_place_mass,
                    "jump_old_place_mass: a far place is reported only once the old place's "

@@ -147,6 +147,10 @@ Status FollowParams::validate(int num_states) const {
     return params_error("unexplained_jump_hold_s must be in [0, 10] s, got " +
                         std::to_string(unexplained_jump_hold_s));
   }
+  if (!(unexplained_jump_hold_after_s >= 0.0f && unexplained_jump_hold_after_s <= 60.0f)) {
+    return params_error("unexplained_jump_hold_after_s must be in [0, 60] s, got " +
+                        std::to_string(unexplained_jump_hold_after_s));
+  }
   if (!(unexplained_jump_ratio > 0.0f && std::isfinite(unexplained_jump_ratio))) {
     return params_error("unexplained_jump_ratio must be finite and > 0, got " +
                         std::to_string(unexplained_jump_ratio));

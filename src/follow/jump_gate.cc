@@ -8,18 +8,23 @@
 namespace duet {
 
 float JumpGate::hold_s(const FollowParams& params, float sensor_noise_per_dim,
-                       float best_distance_per_dim) noexcept {
+                       float best_distance_per_dim, double followed_s) noexcept {
   const float level = params.noisy_jump_hold_level;
   const bool noise_known = std::isfinite(sensor_noise_per_dim);
   const float ramp =
       noise_known ? std::clamp((sensor_noise_per_dim - 0.5f * level) / (0.5f * level), 0.0f, 1.0f)
                   : 0.0f;
   const float hold = std::max(params.jump_hold_s, ramp * params.noisy_jump_hold_s);
-  // A far place the input fits poorly: a held limb fitting another pose for a moment.
+  // A far place the input fits poorly: a held limb fitting another pose for a moment, or a
+  // look-alike taking the maximum from a place followed for a while. A place just landed on is
+  // still being refined: moves from it are taken at once.
   const float fits_up_to =
       std::max(params.unexplained_jump_ratio * (noise_known ? sensor_noise_per_dim : 0.0f),
                params.lost_residual_per_dim);
-  return best_distance_per_dim > fits_up_to ? std::max(hold, params.unexplained_jump_hold_s) : hold;
+  const bool established = followed_s + 1e-6 >= params.unexplained_jump_hold_after_s;
+  return best_distance_per_dim > fits_up_to && established
+             ? std::max(hold, params.unexplained_jump_hold_s)
+             : hold;
 }
 
 bool JumpGate::looks_alike(const TemplateModel& model, const FollowParams& params, int from,
@@ -61,6 +66,7 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
   if (!through_spell(model, params, adrift, result)) {
     decide(model, params, posterior, total, previous_state, previous_lost, result);
   }
+  if (result.jumped) followed_since_jump_s_ = 0.0;
   if (adrift || result.missing || result.state < 0) {
     steps_since_steady_ += std::max(result.steps, 1);
   } else {
@@ -89,6 +95,7 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
   const int tolerance = previous_lost ? 0 : params.jump_tolerance_frames;
   const int steps = std::max(result.steps, 1);
   const double step_s = static_cast<double>(steps) / model.frame_rate_hz();
+  followed_since_jump_s_ += step_s;
   if (previous_state < 0 || result.missing || result.state < 0 ||
       !model.is_jump(previous_state, result.state, steps, tolerance)) {
     // Within reach of the old place: no jump, whatever the raw maximum's step was.
@@ -107,11 +114,13 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
     // Still finding the first place: take the new one and start settling there.
     result.jumped = false;
     settled_s_ = 0.0;
+    followed_since_jump_s_ = 0.0;
     forget_advance();
     forget_candidate();
     return;
   }
-  const float hold = hold_s(params, result.sensor_noise_per_dim, result.best_distance_per_dim);
+  const float hold = hold_s(params, result.sensor_noise_per_dim, result.best_distance_per_dim,
+                            followed_since_jump_s_);
   if (previous_lost || result.in_pause) {
     result.jumped =
         !looks_alike(model, params, previous_state, result.state);  // nothing to hold on to

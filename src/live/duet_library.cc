@@ -228,7 +228,7 @@ Result<FeatureExtractor> DuetLibrary::make_extractor(std::shared_ptr<const Skele
 
 FollowParams follow_params_for(InputPoints points, FollowParams params) {
   if (points == InputPoints::kHeadHands) {
-    params.unexplained_jump_hold_s = 0.0f;
+    params.unexplained_jump_hold_s = kHeadHandsUnexplainedJumpHoldS;
     params.found_confirm_per_lost_s = 0.0f;
   }
   return params;

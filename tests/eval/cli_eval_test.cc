@@ -252,22 +252,32 @@ TEST(CliEval, ReportsNonDanceInputAsLost) {
   EXPECT_EQ(r.output.find("evaluating"), std::string::npos) << r.output;  // before the run
 }
 
-TEST(CliEval, ThreePointsTakeNoUnexplainedJumpHoldUnlessAsked) {
-  // The hold for a far place the input fits poorly (an arm an optical system holds) is the full
-  // body's; three points are made without it, as `duet follow` and `duet serve` make them.
+TEST(CliEval, ThreePointsHoldOnlyFromAPlaceFollowedAWhileUnlessAsked) {
+  // The hold for a far place the input fits poorly: three points are made with a shorter one than
+  // the full body, as `duet follow` and `duet serve` make them; an option asked for stays.
   const std::string base = "eval " + pair("10") +
                            " --fps 60 --trackers hmm --cases clean --no-partner-metrics "
                            "--non-dance none";
   auto r = run_duet(base);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("unexplained_jump_hold 0.4 s"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("unexplained_jump_hold 0.4 s (over 2.2 x noise, after 2 s followed)"),
+            std::string::npos)
+      << r.output;
   r = run_duet(base + " --input-points head,hands");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("unexplained_jump_hold 0 s"), std::string::npos) << r.output;
-  r = run_duet(base + " --input-points head,hands --unexplained-jump-hold 0.3");
+  EXPECT_NE(r.output.find("unexplained_jump_hold 0.3 s (over 2.2 x noise, after 2 s followed)"),
+            std::string::npos)
+      << r.output;
+  r = run_duet(
+      base +
+      " --input-points head,hands --unexplained-jump-hold 0 --unexplained-jump-hold-after 1");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("unexplained_jump_hold 0.3 s"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("unexplained_jump_hold 0 s (over 2.2 x noise, after 1 s followed)"),
+            std::string::npos)
+      << r.output;
   r = run_duet(base + " --unexplained-jump-ratio 0");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = run_duet(base + " --unexplained-jump-hold-after -1");
   EXPECT_EQ(r.exit_code, 2) << r.output;
 }
 

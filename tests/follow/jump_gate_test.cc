@@ -465,6 +465,7 @@ TEST(JumpGate, AFarPlaceTheInputFitsPoorlyWaitsTheLongerHold) {
   params.unexplained_jump_hold_s = 0.0f;
   EXPECT_EQ(JumpGate::hold_s(params, noise, 10.0f * fits), JumpGate::hold_s(params, noise));
   params.unexplained_jump_hold_s = 0.4f;
+  params.unexplained_jump_hold_after_s = 0.0f;  // from every place (tested below)
   settle_at_once(params);
 
   // An arm held where it was last seen fits take 1 better for a moment, and poorly: the old
@@ -496,6 +497,46 @@ TEST(JumpGate, AFarPlaceTheInputFitsPoorlyWaitsTheLongerHold) {
   EXPECT_TRUE(r.jumped);
 }
 
+TEST(JumpGate, APlaceJustLandedOnIsLeftAtOnceOneFollowedForAWhileWaits) {
+  FollowParams params;
+  settle_at_once(params);
+  params.unexplained_jump_hold_s = 0.3f;                     // 18 frames at 60 Hz
+  params.unexplained_jump_hold_after_s = 0.5f;               // 30 frames
+  const float poorly = 2.0f * params.lost_residual_per_dim;  // clean sensor: over the floor
+  EXPECT_EQ(JumpGate::hold_s(params, 0.0f, poorly, 0.49), 0.0f);
+  EXPECT_EQ(JumpGate::hold_s(params, 0.0f, poorly, 0.5), 0.3f);
+  EXPECT_EQ(JumpGate::hold_s(params, 0.0f, poorly), 0.3f);  // followed time not given
+
+  const TemplateModel model = two_takes();
+  const auto poorly_fitted_step = [&](JumpGate& gate, int& previous, int state) {
+    const std::vector<float> p = posterior(state);
+    FollowResult r = maximum_at(model, p, state);
+    r.best_distance_per_dim = poorly;
+    gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+    previous = r.state;
+    return r;
+  };
+  // A jump to take 1 lands at 110; 10 frames on (0.17 s followed), the maximum moves to 130 (the
+  // landing refined): a jump at once.
+  JumpGate gate;
+  int previous = 20;
+  poorly_fitted_step(gate, previous, 21);
+  ASSERT_TRUE(poorly_fitted_step(gate, previous, 110).jumped);
+  for (int k = 1; k <= 10; ++k) poorly_fitted_step(gate, previous, 110 + k);
+  EXPECT_TRUE(poorly_fitted_step(gate, previous, 130).jumped);
+  // Followed from there for 40 frames (0.67 s), a far maximum waits the hold: 17 frames of it
+  // report the old place, the 18th is the jump.
+  for (int k = 1; k <= 40; ++k) poorly_fitted_step(gate, previous, 130 + k);
+  ASSERT_EQ(previous, 170);
+  for (int k = 0; k < 18; ++k) {
+    const FollowResult r = poorly_fitted_step(gate, previous, 10 + k);
+    EXPECT_EQ(r.jumped, k == 17) << k;
+    if (k < 17) {
+      EXPECT_EQ(model.take_of(r.state), 1) << k;
+    }
+  }
+}
+
 TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
   FollowParams params;
   params.jump_settle_s = -0.1f;
@@ -518,6 +559,12 @@ TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
   params.unexplained_jump_ratio = std::numeric_limits<float>::infinity();
   EXPECT_FALSE(params.validate(200));
   params.unexplained_jump_ratio = 2.2f;
+  params.unexplained_jump_hold_after_s = -1.0f;
+  EXPECT_FALSE(params.validate(200));
+  params.unexplained_jump_hold_after_s = std::nanf("");
+  EXPECT_FALSE(params.validate(200));
+  params.unexplained_jump_hold_after_s = 2.0f;
+  EXPECT_TRUE(params.validate(200));
   params.jump_old_place_mass = 1.5f;
   EXPECT_FALSE(params.validate(200));
   params.jump_old_place_mass = std::nanf("");

@@ -43,13 +43,16 @@ TEST(DuetLibrary, ConcatenatesTakesAndSwapsRoles) {
   EXPECT_TRUE(a.translations_ls(100)[0].isApprox(b.translations_ls(100)[0]));
 }
 
-TEST(DuetLibrary, ThreePointLibrariesAreFollowedWithoutTheUnexplainedJumpHold) {
+TEST(DuetLibrary, ThreePointLibrariesHoldOnlyFromAPlaceFollowedAWhile) {
   const FollowParams defaults;
   ASSERT_GT(defaults.unexplained_jump_hold_s, 0.0f);
-  EXPECT_EQ(follow_params_for(InputPoints::kFullBody, defaults).unexplained_jump_hold_s,
-            defaults.unexplained_jump_hold_s);
+  const FollowParams body = follow_params_for(InputPoints::kFullBody, defaults);
+  EXPECT_EQ(body.unexplained_jump_hold_s, defaults.unexplained_jump_hold_s);
+  EXPECT_EQ(body.unexplained_jump_hold_after_s, defaults.unexplained_jump_hold_after_s);
   const FollowParams points = follow_params_for(InputPoints::kHeadHands, defaults);
-  EXPECT_EQ(points.unexplained_jump_hold_s, 0.0f);
+  EXPECT_EQ(points.unexplained_jump_hold_s, kHeadHandsUnexplainedJumpHoldS);
+  EXPECT_EQ(points.unexplained_jump_hold_after_s, defaults.unexplained_jump_hold_after_s);
+  EXPECT_GT(points.unexplained_jump_hold_after_s, 0.0f);
   EXPECT_EQ(points.noisy_jump_hold_s, defaults.noisy_jump_hold_s);  // nothing else changes
   EXPECT_TRUE(points.validate(100));
 }

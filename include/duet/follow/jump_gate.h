@@ -22,6 +22,8 @@
 // inertial suit's, whose standing start sat on other takes' standing frames).
 #pragma once
 
+#include <limits>
+
 #include "duet/follow/follow_params.h"
 #include "duet/follow/template_model.h"
 #include "duet/follow/tracker.h"
@@ -34,6 +36,7 @@ class JumpGate {
   void reset() noexcept {
     forget_candidate();
     settled_s_ = 0.0;
+    followed_since_jump_s_ = 0.0;
     forget_advance();
     steady_state_ = -1;
     steps_since_steady_ = 0;
@@ -61,9 +64,12 @@ class JumpGate {
     return settled_s_ + 1e-6 >= params.jump_settle_s;
   }
   // The hold (template seconds) at this sensor noise (FollowResult::sensor_noise_per_dim) for a
-  // far place whose best distance per dimension is best_distance_per_dim (0: one that fits).
+  // far place whose best distance per dimension is best_distance_per_dim (0: one that fits),
+  // leaving a place followed for followed_s (template seconds) since the last reported jump or
+  // the first placement (FollowParams::unexplained_jump_hold_after_s).
   static float hold_s(const FollowParams& params, float sensor_noise_per_dim,
-                      float best_distance_per_dim = 0.0f) noexcept;
+                      float best_distance_per_dim = 0.0f,
+                      double followed_s = std::numeric_limits<double>::infinity()) noexcept;
 
  private:
   void forget_candidate() noexcept {
@@ -101,6 +107,9 @@ class JumpGate {
   int advance_furthest_ = -1;  // the furthest state in its take reached since
   int candidate_state_ = -1;  // the far place that currently holds the maximum
   double held_s_ = 0.0;       // how long (template time) it has held it
+  // How long (template time) the estimate has been followed since the last reported jump or the
+  // first placement (spells adrift not counted).
+  double followed_since_jump_s_ = 0.0;
 };
 
 }  // namespace duet

@@ -69,13 +69,16 @@ struct DuetTake {
 };
 
 // The follower's parameters for a library of these input points (FeatureSpec::input_points).
-// Three points (a headset and two controllers) take no unexplained-jump hold
-// (FollowParams::unexplained_jump_hold_s): they have no limb an optical system could hold where it
-// last saw it, and fit the template less closely, so the hold delayed true jumps (`improv-library`
-// 2.6 points lower on the handshake rig with the arms-forward calibration; docs/evaluation.md,
-// "An arm held where last seen"), nor a longer wait to be found again after a spell lost
+// Three points (a headset and two controllers) hold a far place the input fits poorly
+// (FollowParams::unexplained_jump_hold_s) for kHeadHandsUnexplainedJumpHoldS, not the body's 0.4
+// s: they fit the template less closely than a body, so on another rig nearly every far place is
+// one the input fits poorly, true jumps too; from places followed for a while
+// (FollowParams::unexplained_jump_hold_after_s) the hold halves the look-alike excursions there
+// (docs/evaluation.md, "Three points hold a look-alike"; 0.4 s cost `improv` more).
+// Nor do they take a longer wait to be found again after a spell lost
 // (FollowParams::found_confirm_per_lost_s: their improvised cases' frames lost although followed
 // doubled). `duet follow`, `duet serve` and `duet eval` make their trackers with it.
+inline constexpr float kHeadHandsUnexplainedJumpHoldS = 0.3f;
 FollowParams follow_params_for(InputPoints points, FollowParams params);
 // The rig offset's parameters for these input points: three points average it over
 // PostureBiasParams::head_hands_time_constant_s (also while the sensor is noisy). FollowSession
