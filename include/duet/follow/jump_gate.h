@@ -6,7 +6,8 @@
 // not a jump. A move out of the band's reach is reported only once the new place has held the
 // maximum for the hold in template time (a bounded decision delay; until then the best state near
 // the old place is reported): FollowParams::jump_hold_s, or under a noisy sensor the hold that
-// grows with the estimated noise (noisy_jump_hold_s) or, for a far place the input fits poorly,
+// grows with the estimated noise (noisy_jump_hold_s) or, for a far place the input fits poorly
+// taking the maximum from a place followed unexplained_jump_hold_after_s since the last jump,
 // unexplained_jump_hold_s, and once the old place's reach holds at most
 // jump_old_place_mass of the posterior (a look-alike's brief maximum leaves the old place its
 // evidence; a real jump does not).
