@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace duet {
@@ -538,47 +539,41 @@ TEST(JumpGate, APlaceJustLandedOnIsLeftAtOnceOneFollowedForAWhileWaits) {
 }
 
 TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
-  FollowParams params;
-  params.jump_settle_s = -0.1f;
-  EXPECT_FALSE(params.validate(200));
-  params.jump_settle_s = std::nanf("");
-  EXPECT_FALSE(params.validate(200));
-  params.jump_settle_s = 0.0f;
-  EXPECT_TRUE(params.validate(200));
-  params.noisy_jump_hold_s = -1.0f;
-  EXPECT_FALSE(params.validate(200));
-  params.noisy_jump_hold_s = 0.04f;
-  params.noisy_jump_hold_level = 0.0f;
-  EXPECT_FALSE(params.validate(200));
-  params.noisy_jump_hold_level = 0.006f;
-  params.unexplained_jump_hold_s = 11.0f;
-  EXPECT_FALSE(params.validate(200));
-  params.unexplained_jump_hold_s = 0.4f;
-  params.unexplained_jump_ratio = 0.0f;
-  EXPECT_FALSE(params.validate(200));
-  params.unexplained_jump_ratio = std::numeric_limits<float>::infinity();
-  EXPECT_FALSE(params.validate(200));
-  params.unexplained_jump_ratio = 2.2f;
-  params.unexplained_jump_hold_after_s = -1.0f;
-  EXPECT_FALSE(params.validate(200));
-  params.unexplained_jump_hold_after_s = std::nanf("");
-  EXPECT_FALSE(params.validate(200));
-  params.unexplained_jump_hold_after_s = 2.0f;
-  EXPECT_TRUE(params.validate(200));
-  params.jump_old_place_mass = 1.5f;
-  EXPECT_FALSE(params.validate(200));
-  params.jump_old_place_mass = std::nanf("");
-  EXPECT_FALSE(params.validate(200));
-  params.jump_old_place_mass = 0.05f;
-  params.jump_settle_mass = -0.5f;
-  EXPECT_FALSE(params.validate(200));
-  params.jump_settle_mass = 0.99f;
-  params.jump_settle_advance_s = -1.0f;
-  EXPECT_FALSE(params.validate(200));
-  params.jump_settle_advance_s = std::nanf("");
-  EXPECT_FALSE(params.validate(200));
-  params.jump_settle_advance_s = 0.5f;
-  EXPECT_TRUE(params.validate(200));
+  EXPECT_TRUE(FollowParams{}.validate(200));
+  const float nan = std::nanf("");
+  // Each field set out of its range on the defaults, the rest left valid.
+  const std::vector<std::pair<const char*, void (*)(FollowParams&, float)>> fields = {
+      {"jump_settle_s", [](FollowParams& p, float v) { p.jump_settle_s = v; }},
+      {"noisy_jump_hold_s", [](FollowParams& p, float v) { p.noisy_jump_hold_s = v; }},
+      {"unexplained_jump_hold_s", [](FollowParams& p, float v) { p.unexplained_jump_hold_s = v; }},
+      {"unexplained_jump_hold_after_s",
+       [](FollowParams& p, float v) { p.unexplained_jump_hold_after_s = v; }},
+      {"jump_settle_advance_s", [](FollowParams& p, float v) { p.jump_settle_advance_s = v; }},
+  };
+  for (const auto& [name, set] : fields) {
+    for (const float bad : {-1.0f, nan, 1000.0f}) {
+      FollowParams params;
+      set(params, bad);
+      EXPECT_FALSE(params.validate(200)) << name << " = " << bad;
+    }
+    FollowParams params;
+    set(params, 0.0f);
+    EXPECT_TRUE(params.validate(200)) << name << " = 0";
+  }
+  const std::vector<std::pair<const char*, void (*)(FollowParams&)>> others = {
+      {"noisy_jump_hold_level 0", [](FollowParams& p) { p.noisy_jump_hold_level = 0.0f; }},
+      {"unexplained_jump_ratio 0", [](FollowParams& p) { p.unexplained_jump_ratio = 0.0f; }},
+      {"unexplained_jump_ratio inf",
+       [](FollowParams& p) { p.unexplained_jump_ratio = std::numeric_limits<float>::infinity(); }},
+      {"jump_old_place_mass 1.5", [](FollowParams& p) { p.jump_old_place_mass = 1.5f; }},
+      {"jump_old_place_mass nan", [](FollowParams& p) { p.jump_old_place_mass = std::nanf(""); }},
+      {"jump_settle_mass -0.5", [](FollowParams& p) { p.jump_settle_mass = -0.5f; }},
+  };
+  for (const auto& [what, set] : others) {
+    FollowParams params;
+    set(params);
+    EXPECT_FALSE(params.validate(200)) << what;
+  }
 }
 
 }  // namespace
