@@ -281,6 +281,11 @@ int run_follow(const FollowArgs& args) {
       fmt::print(stderr, "duet follow: note: {}\n", *note);
     }
   }
+  if (points.value() == InputPoints::kHeadHands && !calibration) {
+    if (std::optional<std::string> note = calibration_note(results, user.frame_rate())) {
+      fmt::print(stderr, "duet follow: note: {}\n", *note);
+    }
+  }
   const float median_tempo = median_followed_tempo(results);
   if (summary.lost_fraction() <= kMostlyLostFraction) {
     // Followed, but perhaps in slow or fast motion: the rate is the one cause worth a warning.

@@ -56,6 +56,8 @@ TEST(CliHeadHands, ConvertThenFollowTheRecording) {
   }
   EXPECT_GT(frames, 2000);
   EXPECT_GE(right, frames * 99 / 100);
+  // The library's own body: no calibration asked for.
+  EXPECT_EQ(followed.output.find("--calibration"), std::string::npos) << followed.output;
   std::filesystem::remove(csv);
   std::filesystem::remove(trace);
 }
@@ -298,11 +300,17 @@ TEST(CliHeadHands, ACalibrationFollowsAnotherBodyAsTheLibrarysOwn) {
       run_duet("follow --library " + kSalsaLibrary + " --input " + csv + " --head-height " +
                fmt::format("{:.3f}", head_m) + " --trace " + untold_trace);
   ASSERT_EQ(untold.exit_code, 0) << untold.output;
+  // Followed without the calibration, the offset the follower learnt says another body.
+  EXPECT_NE(untold.output.find("note: the hands were held elsewhere against the head"),
+            std::string::npos)
+      << untold.output;
+  EXPECT_NE(untold.output.find("--calibration POSE.csv"), std::string::npos) << untold.output;
   CommandResult told = run_duet("follow --library " + kSalsaLibrary + " --input " + csv +
                                 " --calibration " + pose + " --trace " + told_trace);
   ASSERT_EQ(told.exit_code, 0) << told.output;
   EXPECT_NE(told.output.find(fmt::format("head {:.2f} m high standing", head_m)), std::string::npos)
       << told.output;
+  EXPECT_EQ(told.output.find("note:"), std::string::npos) << told.output;
   const double untold_share = share_on_take(untold_trace, 8);  // 60_10
   const double told_share = share_on_take(told_trace, 8);
   EXPECT_GT(told_share, 0.98) << "untold " << untold_share;
