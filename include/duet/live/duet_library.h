@@ -74,7 +74,8 @@ struct DuetTake {
 // s: they fit the template less closely than a body, so on another rig nearly every far place is
 // one the input fits poorly, true jumps too; from places followed for a while
 // (FollowParams::unexplained_jump_hold_after_s) the hold halves the look-alike excursions there
-// (docs/evaluation.md, "Three points hold a look-alike"; 0.4 s cost `improv` more).
+// (docs/evaluation.md, "Three points hold a look-alike"; 0.4 s removed 7 more of 187 at the same
+// accuracy: the shorter decision delay is kept).
 // Nor do they take a longer wait to be found again after a spell lost
 // (FollowParams::found_confirm_per_lost_s: their improvised cases' frames lost although followed
 // doubled). `duet follow`, `duet serve` and `duet eval` make their trackers with it.
