@@ -9,7 +9,8 @@ namespace duet::app {
 void add_motion_file_options(CLI::App& app, MotionFileOptions& options, const std::string& prefix) {
   app.add_option("--" + prefix + "fps", options.fps,
                  "Frame rate of the file(s), overriding the header (the CMU salsa BVH headers "
-                 "say 120; the takes are 60 Hz)")
+                 "say 120; the takes are 60 Hz); for a three-point CSV, the even grid its "
+                 "time_s samples are resampled onto (its times stay)")
       ->check(fps_check());
   app.add_option("--" + prefix + "scale", options.scale,
                  "Metres per file unit (default: known per skeleton convention: salsa DAZ BVH "
