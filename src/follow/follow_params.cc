@@ -120,36 +120,30 @@ Status FollowParams::validate(int num_states) const {
     return params_error("lost_residual_per_dim must be >= 0, got " +
                         std::to_string(lost_residual_per_dim));
   }
-  if (!(lost_confirm_s >= 0.0f && lost_confirm_s <= 10.0f)) {
-    return params_error("lost_confirm_s must be in [0, 10] s, got " +
-                        std::to_string(lost_confirm_s));
-  }
-  if (!(found_confirm_per_lost_s >= 0.0f && found_confirm_per_lost_s <= 10.0f)) {
-    return params_error("found_confirm_per_lost_s must be in [0, 10], got " +
-                        std::to_string(found_confirm_per_lost_s));
-  }
-  if (!(found_confirm_max_s >= 0.0f && found_confirm_max_s <= 10.0f)) {
-    return params_error("found_confirm_max_s must be in [0, 10] s, got " +
-                        std::to_string(found_confirm_max_s));
+  // Times (and one factor of a time) bounded to [0, max].
+  const struct {
+    const char* name;
+    float value;
+    int max;
+    const char* unit;
+  } bounded[] = {{"lost_confirm_s", lost_confirm_s, 10, " s"},
+                 {"found_confirm_per_lost_s", found_confirm_per_lost_s, 10, ""},
+                 {"found_confirm_max_s", found_confirm_max_s, 10, " s"},
+                 {"jump_hold_s", jump_hold_s, 10, " s"},
+                 {"noisy_jump_hold_s", noisy_jump_hold_s, 10, " s"},
+                 {"unexplained_jump_hold_s", unexplained_jump_hold_s, 10, " s"},
+                 {"unexplained_jump_hold_after_s", unexplained_jump_hold_after_s, 60, " s"},
+                 {"jump_settle_s", jump_settle_s, 10, " s"},
+                 {"jump_settle_advance_s", jump_settle_advance_s, 10, " s"}};
+  for (const auto& b : bounded) {
+    if (!(b.value >= 0.0f && b.value <= static_cast<float>(b.max))) {
+      return params_error(std::string(b.name) + " must be in [0, " + std::to_string(b.max) + "]" +
+                          b.unit + ", got " + std::to_string(b.value));
+    }
   }
   if (confidence_window_frames < 0) {
     return params_error("confidence_window_frames must be >= 0, got " +
                         std::to_string(confidence_window_frames));
-  }
-  if (!(jump_hold_s >= 0.0f && jump_hold_s <= 10.0f)) {
-    return params_error("jump_hold_s must be in [0, 10] s, got " + std::to_string(jump_hold_s));
-  }
-  if (!(noisy_jump_hold_s >= 0.0f && noisy_jump_hold_s <= 10.0f)) {
-    return params_error("noisy_jump_hold_s must be in [0, 10] s, got " +
-                        std::to_string(noisy_jump_hold_s));
-  }
-  if (!(unexplained_jump_hold_s >= 0.0f && unexplained_jump_hold_s <= 10.0f)) {
-    return params_error("unexplained_jump_hold_s must be in [0, 10] s, got " +
-                        std::to_string(unexplained_jump_hold_s));
-  }
-  if (!(unexplained_jump_hold_after_s >= 0.0f && unexplained_jump_hold_after_s <= 60.0f)) {
-    return params_error("unexplained_jump_hold_after_s must be in [0, 60] s, got " +
-                        std::to_string(unexplained_jump_hold_after_s));
   }
   if (!(unexplained_jump_ratio > 0.0f && std::isfinite(unexplained_jump_ratio))) {
     return params_error("unexplained_jump_ratio must be finite and > 0, got " +
@@ -174,13 +168,6 @@ Status FollowParams::validate(int num_states) const {
   if (!(outlier_pause_fraction >= 0.0f && std::isfinite(outlier_pause_fraction))) {
     return params_error("outlier_pause_fraction must be finite and >= 0, got " +
                         std::to_string(outlier_pause_fraction));
-  }
-  if (!(jump_settle_s >= 0.0f && jump_settle_s <= 10.0f)) {
-    return params_error("jump_settle_s must be in [0, 10] s, got " + std::to_string(jump_settle_s));
-  }
-  if (!(jump_settle_advance_s >= 0.0f && jump_settle_advance_s <= 10.0f)) {
-    return params_error("jump_settle_advance_s must be in [0, 10] s, got " +
-                        std::to_string(jump_settle_advance_s));
   }
   if (jump_tolerance_frames < 0 || jump_tolerance_frames > 1000) {
     return params_error("jump_tolerance_frames must be in [0, 1000], got " +

@@ -560,6 +560,22 @@ TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
     set(params, 0.0f);
     EXPECT_TRUE(params.validate(200)) << name << " = 0";
   }
+  // The message names the field, its range and unit, and the value.
+  FollowParams after;
+  after.unexplained_jump_hold_after_s = 61.0f;
+  const Status too_long = after.validate(200);
+  ASSERT_FALSE(too_long);
+  EXPECT_NE(
+      too_long.error().message.find("unexplained_jump_hold_after_s must be in [0, 60] s, got 61"),
+      std::string::npos)
+      << too_long.error().message;
+  FollowParams factor;
+  factor.found_confirm_per_lost_s = 11.0f;
+  const Status too_large = factor.validate(200);
+  ASSERT_FALSE(too_large);
+  EXPECT_NE(too_large.error().message.find("found_confirm_per_lost_s must be in [0, 10], got 11"),
+            std::string::npos)
+      << too_large.error().message;
   const std::vector<std::pair<const char*, void (*)(FollowParams&)>> others = {
       {"noisy_jump_hold_level 0", [](FollowParams& p) { p.noisy_jump_hold_level = 0.0f; }},
       {"unexplained_jump_ratio 0", [](FollowParams& p) { p.unexplained_jump_ratio = 0.0f; }},
