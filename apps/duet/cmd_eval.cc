@@ -21,6 +21,7 @@
 #include "eval_non_dance.h"
 #include "eval_recorded.h"
 #include "eval_rigs.h"
+#include "eval_tuning.h"
 #include "input_points.h"
 #include "library_options.h"
 #include "motion_options.h"
@@ -62,27 +63,7 @@ struct EvalArgs {
   bool tell_arms_forward = false;             // the performer's wrists with arms held forward
   std::vector<double> arms_forward_error_cm;  // OUT,UP,FORWARD added to each wrist; empty: none
   // Tuning of the "hmm" tracker (FollowParams fields); unset keeps the follower's defaults.
-  std::optional<float> jump_hold;
-  std::optional<int> jump_tolerance;
-  std::optional<float> jump_settle;
-  std::optional<float> noisy_jump_hold;
-  std::optional<float> unexplained_jump_hold;
-  std::optional<float> unexplained_jump_ratio;
-  std::optional<float> unexplained_jump_hold_after;
-  std::optional<float> jump_old_place_mass;
-  std::optional<float> jump_alike_distance;
-  std::optional<float> jump_settle_mass;
-  std::optional<float> jump_settle_advance;
-  std::optional<float> sigma, self_prob, next_prob, skip_prob, leave_prob, pause_stay,
-      pause_distance, lost_distance, velocity_cap, limb_ratio, limb_floor, pause_noise_factor,
-      lost_residual, lost_noise_factor, lost_residual_factor, lost_confirm, found_confirm_per_lost,
-      found_confirm_max, lost_velocity_cap, emission_noise_factor, emission_noise_allowance,
-      noise_filter_density, noise_filter_allowance;
-  std::optional<double> tempo_time_constant;
-  bool fixed_band = false;
-  bool no_outlier_gate = false;
-  bool pause_reported_lost = false;
-  std::optional<float> outlier_pause_fraction;
+  FollowTuning tuning;
   std::optional<int> dtw_back, dtw_ahead;
   // Feature weights (FeatureSpec); unset keeps the defaults.
   std::optional<double> posture_weight, head_hands_posture_weight, root_velocity_weight,
@@ -225,51 +206,6 @@ int run_eval(EvalArgs& args) {
   options.trace_case = args.plots_dir.empty() ? "" : args.trace_case;
   options.keep_frames = !args.frames_csv_path.empty();
 
-  FollowParams& hmm = options.hmm;
-  if (args.sigma) hmm.emission_sigma = *args.sigma;
-  if (args.self_prob) hmm.self_prob = *args.self_prob;
-  if (args.next_prob) hmm.next_prob = *args.next_prob;
-  if (args.skip_prob) hmm.skip_prob = *args.skip_prob;
-  if (args.leave_prob) hmm.leave_prob = *args.leave_prob;
-  if (args.pause_stay) hmm.pause_stay_prob = *args.pause_stay;
-  if (args.pause_distance) hmm.pause_distance_per_dim = *args.pause_distance;
-  if (args.lost_distance) hmm.lost_distance_per_dim = *args.lost_distance;
-  if (args.velocity_cap) hmm.velocity_distance_cap = *args.velocity_cap;
-  if (args.limb_ratio) hmm.limb_outlier_ratio = *args.limb_ratio;
-  if (args.limb_floor) hmm.limb_outlier_floor = *args.limb_floor;
-  if (args.pause_noise_factor) hmm.pause_noise_factor = *args.pause_noise_factor;
-  if (args.emission_noise_factor) hmm.emission_noise_factor = *args.emission_noise_factor;
-  if (args.noise_filter_density) hmm.noise_filter_density = *args.noise_filter_density;
-  if (args.emission_noise_allowance) {
-    hmm.emission_noise_allowance = *args.emission_noise_allowance;
-  }
-  if (args.noise_filter_allowance) hmm.noise_filter_allowance = *args.noise_filter_allowance;
-  if (args.lost_residual) hmm.lost_residual_per_dim = *args.lost_residual;
-  if (args.lost_noise_factor) hmm.lost_noise_factor = *args.lost_noise_factor;
-  if (args.lost_residual_factor) hmm.lost_residual_factor = *args.lost_residual_factor;
-  if (args.lost_confirm) hmm.lost_confirm_s = *args.lost_confirm;
-  if (args.found_confirm_per_lost) hmm.found_confirm_per_lost_s = *args.found_confirm_per_lost;
-  if (args.found_confirm_max) hmm.found_confirm_max_s = *args.found_confirm_max;
-  if (args.lost_velocity_cap) hmm.lost_velocity_cap_per_dim = *args.lost_velocity_cap;
-  if (args.pause_reported_lost) hmm.pause_reported_lost = true;
-  if (args.tempo_time_constant) hmm.tempo_time_constant_s = *args.tempo_time_constant;
-  if (args.fixed_band) hmm.tempo_adaptive = false;
-  if (args.no_outlier_gate) hmm.gate_outliers = false;
-  if (args.outlier_pause_fraction) hmm.outlier_pause_fraction = *args.outlier_pause_fraction;
-  if (args.jump_hold) hmm.jump_hold_s = *args.jump_hold;
-  if (args.jump_tolerance) hmm.jump_tolerance_frames = *args.jump_tolerance;
-  if (args.jump_settle) hmm.jump_settle_s = *args.jump_settle;
-  if (args.noisy_jump_hold) hmm.noisy_jump_hold_s = *args.noisy_jump_hold;
-  if (args.unexplained_jump_hold) hmm.unexplained_jump_hold_s = *args.unexplained_jump_hold;
-  if (args.unexplained_jump_ratio) hmm.unexplained_jump_ratio = *args.unexplained_jump_ratio;
-  if (args.unexplained_jump_hold_after) {
-    hmm.unexplained_jump_hold_after_s = *args.unexplained_jump_hold_after;
-  }
-  if (args.jump_old_place_mass) hmm.jump_old_place_mass = *args.jump_old_place_mass;
-  if (args.jump_alike_distance) hmm.jump_alike_distance_per_dim = *args.jump_alike_distance;
-  if (args.jump_settle_mass) hmm.jump_settle_mass = *args.jump_settle_mass;
-  if (args.jump_settle_advance) hmm.jump_settle_advance_s = *args.jump_settle_advance;
-  if (Status s = hmm.validate(1); !s) return usage_error(s.error().message);
   if (args.dtw_back) options.dtw.window_back = *args.dtw_back;
   if (args.dtw_ahead) options.dtw.window_ahead = *args.dtw_ahead;
 
@@ -307,13 +243,10 @@ int run_eval(EvalArgs& args) {
   }
   // As `duet follow` and `duet serve` make the follower for these input points; what a tuning
   // option asked for stays.
-  const FollowParams asked = hmm;
+  FollowParams& hmm = options.hmm;
   hmm = follow_params_for(features.input_points, hmm);
-  if (args.unexplained_jump_hold) hmm.unexplained_jump_hold_s = asked.unexplained_jump_hold_s;
-  if (args.unexplained_jump_hold_after) {
-    hmm.unexplained_jump_hold_after_s = asked.unexplained_jump_hold_after_s;
-  }
-  if (args.found_confirm_per_lost) hmm.found_confirm_per_lost_s = asked.found_confirm_per_lost_s;
+  args.tuning.apply(hmm);
+  if (Status s = hmm.validate(1); !s) return usage_error(s.error().message);
 
   std::string gnuplot;
   if (!args.plots_dir.empty()) {
@@ -657,174 +590,7 @@ Command register_eval(CLI::App& app) {
 
   auto* tuning = app.add_option_group(
       "tuning (FollowParams of the hmm trackers; FeatureSpec weights feed every tracker)");
-  tuning->add_option("--sigma", args->sigma, "Emission sigma (all HMM variants)")
-      ->check(positive_check());
-  tuning->add_option("--self", args->self_prob, "self_prob")->check(number_between(0.0, 1.0));
-  tuning->add_option("--next", args->next_prob, "next_prob")->check(number_between(0.0, 1.0));
-  tuning->add_option("--skip", args->skip_prob, "skip_prob")->check(number_between(0.0, 1.0));
-  tuning->add_option("--leave", args->leave_prob, "leave_prob")->check(number_between(0.0, 1.0));
-  tuning->add_option("--pause-stay", args->pause_stay, "pause_stay_prob (A_NN)")
-      ->check(number_between(0.0, 1.0));
-  tuning
-      ->add_option("--pause-distance", args->pause_distance,
-                   "pause_distance_per_dim (all HMM variants)")
-      ->check(non_negative_check());
-  tuning
-      ->add_option("--lost-distance", args->lost_distance,
-                   "lost_distance_per_dim (all trackers; the HMM's ceiling)")
-      ->check(non_negative_check());
-  tuning
-      ->add_option("--lost-residual", args->lost_residual,
-                   "lost_residual_per_dim: the HMM's lost distance on a noiseless sensor (all HMM "
-                   "variants; above --lost-distance, that fixed ceiling alone)")
-      ->check(non_negative_check());
-  tuning
-      ->add_option("--lost-noise-factor", args->lost_noise_factor,
-                   "lost_noise_factor: what the estimated sensor noise adds to the HMM's lost "
-                   "distance, per unit of noise (all HMM variants)")
-      ->check(non_negative_check());
-  tuning
-      ->add_option("--lost-residual-factor", args->lost_residual_factor,
-                   "lost_residual_factor: the HMM's lost distance is at least this times the "
-                   "average best distance of the frames it plainly follows (all HMM variants)")
-      ->check(non_negative_check());
-  tuning
-      ->add_option("--lost-confirm-s", args->lost_confirm,
-                   "lost_confirm_s: the input must stay past the HMM's noise-scaled lost distance "
-                   "on consecutive frames this long before it is called lost (all HMM variants)")
-      ->check(CLI::Range(0.0, 10.0));
-  tuning
-      ->add_option("--found-confirm-per-lost", args->found_confirm_per_lost,
-                   "found_confirm_per_lost_s: after a spell lost by distance, the input must stay "
-                   "within the lost distance this times the spell's length before it is followed "
-                   "again (at least --lost-confirm-s, at most --found-confirm-max-s; full body "
-                   "only, all HMM variants)")
-      ->check(CLI::Range(0.0, 10.0));
-  tuning
-      ->add_option("--found-confirm-max-s", args->found_confirm_max,
-                   "found_confirm_max_s: the longest --found-confirm-per-lost asks for")
-      ->check(CLI::Range(0.0, 10.0));
-  tuning
-      ->add_option("--lost-velocity-cap-per-dim", args->lost_velocity_cap,
-                   "lost_velocity_cap_per_dim: most the velocity blocks add to the lost test's "
-                   "distance, per dimension of the model (and at most --velocity-cap; inf: "
-                   "the emission's); all HMM variants")
-      ->check(cap_check());
-  tuning->add_flag("--pause-reported-lost", args->pause_reported_lost,
-                   "pause_reported_lost: report frames whose posterior the pause state holds as "
-                   "lost although a template frame explains them (the paper preset's reading; "
-                   "all HMM variants)");
-  tuning
-      ->add_option("--emission-noise-factor", args->emission_noise_factor,
-                   "emission_noise_factor: what the estimated sensor noise adds to the emission's "
-                   "variance per dimension, per unit of noise (all HMM variants)")
-      ->check(non_negative_check());
-  tuning
-      ->add_option("--emission-noise-allowance", args->emission_noise_allowance,
-                   "emission_noise_allowance: estimated sensor noise that does not widen the "
-                   "emission (all HMM variants)")
-      ->check(non_negative_check());
-  tuning
-      ->add_option("--noise-filter-allowance", args->noise_filter_allowance,
-                   "noise_filter_allowance: estimated sensor noise that the input's smoothing "
-                   "lets through (all HMM variants)")
-      ->check(non_negative_check());
-  tuning
-      ->add_option("--noise-filter-density", args->noise_filter_density,
-                   "noise_filter_density: the dance's acceleration density the Kalman filter "
-                   "of the input's posture features assumes; lower smooths more, 0 for none "
-                   "(all HMM variants)")
-      ->check(non_negative_check());
-  tuning
-      ->add_option("--pause-noise-factor", args->pause_noise_factor,
-                   "pause_noise_factor: what the estimated sensor noise adds to the pause "
-                   "state's level, per unit of noise (all HMM variants)")
-      ->check(non_negative_check());
-  tuning
-      ->add_option("--velocity-cap", args->velocity_cap,
-                   "velocity_distance_cap: most the velocity blocks add to a squared distance "
-                   "(all HMM variants; inf for none)")
-      ->check(cap_check());
-  tuning
-      ->add_option("--limb-outlier-ratio", args->limb_ratio,
-                   "limb_outlier_ratio: the farthest limb adds at most this times the second "
-                   "farthest to a squared distance (all HMM variants; inf for none)")
-      ->check(cap_check());
-  tuning
-      ->add_option("--limb-outlier-floor", args->limb_floor,
-                   "limb_outlier_floor: ... but never less than this (all HMM variants)")
-      ->check(non_negative_check());
-  tuning
-      ->add_option("--tempo-time-constant", args->tempo_time_constant,
-                   "tempo_time_constant_s of the tempo-centred band (all HMM variants)")
-      ->check(positive_check());
-  tuning->add_flag("--fixed-band", args->fixed_band,
-                   "Keep the band fixed at the template's tempo (tempo_adaptive = false)");
-  tuning->add_flag("--no-outlier-gate", args->no_outlier_gate,
-                   "gate_outliers = false: a frame that would hand the pause state the majority "
-                   "right after a followed frame is evidence like any other");
-  tuning
-      ->add_option("--outlier-pause-fraction", args->outlier_pause_fraction,
-                   "outlier_pause_fraction: the outlier gate sets a frame aside only when its best "
-                   "distance is beyond this share of the pause level")
-      ->check(non_negative_check());
-  tuning
-      ->add_option("--jump-hold", args->jump_hold,
-                   "jump_hold_s: how long a far place must hold the posterior's maximum before "
-                   "it is reported as a jump (template seconds; 0 for at once)")
-      ->check(number_between(0.0, 10.0));
-  tuning
-      ->add_option("--jump-tolerance", args->jump_tolerance,
-                   "jump_tolerance_frames: a move back by up to this many frames is no jump")
-      ->check(CLI::Range(0, 1000));
-  tuning
-      ->add_option("--noisy-jump-hold", args->noisy_jump_hold,
-                   "noisy_jump_hold_s: the jump hold under a noisy sensor, reached at "
-                   "noisy_jump_hold_level of estimated noise (template seconds; 0 for none)")
-      ->check(number_between(0.0, 10.0));
-  tuning
-      ->add_option("--unexplained-jump-hold", args->unexplained_jump_hold,
-                   "unexplained_jump_hold_s: the jump hold for a far place the input fits "
-                   "poorly, its best distance over --unexplained-jump-ratio x the sensor's noise "
-                   "and over the lost residual (template seconds; 0 for none)")
-      ->check(number_between(0.0, 10.0));
-  tuning
-      ->add_option("--unexplained-jump-ratio", args->unexplained_jump_ratio,
-                   "unexplained_jump_ratio: see --unexplained-jump-hold")
-      ->check(CLI::PositiveNumber);
-  tuning
-      ->add_option("--unexplained-jump-hold-after", args->unexplained_jump_hold_after,
-                   "unexplained_jump_hold_after_s: the unexplained jump hold applies only to a "
-                   "move from a place followed this long since the last reported jump (template "
-                   "seconds; 0 for every place)")
-      ->check(number_between(0.0, 60.0));
-  tuning
-      ->add_option("--jump-old-place-mass", args->jump_old_place_mass,
-                   "jump_old_place_mass: a far place is reported only once the old place's "
-                   "reach holds at most this share of the posterior (1 for no such test)")
-      ->check(number_between(0.0, 1.0));
-  tuning
-      ->add_option("--jump-alike-distance", args->jump_alike_distance,
-                   "jump_alike_distance_per_dim: a far move between places whose template rows "
-                   "are within this distance per dimension is no jump (0 for none)")
-      ->check(CLI::NonNegativeNumber);
-  tuning
-      ->add_option("--jump-settle", args->jump_settle,
-                   "jump_settle_s: after the start, moves of the estimate are the first placement "
-                   "being refined, not jumps, until it has held one place this long (template "
-                   "seconds; 0 for none)")
-      ->check(number_between(0.0, 10.0));
-  tuning
-      ->add_option("--jump-settle-mass", args->jump_settle_mass,
-                   "jump_settle_mass: only frames with at least this window mass count towards "
-                   "settling the first placement (0 for every frame)")
-      ->check(number_between(0.0, 1.0));
-  tuning
-      ->add_option("--jump-settle-advance", args->jump_settle_advance,
-                   "jump_settle_advance_s: ... and only once the estimate has also moved forward "
-                   "through its take this far (template seconds; 0 for none): a standing start "
-                   "looks like every take's standing moments")
-      ->check(number_between(0.0, 10.0));
+  args->tuning.add_options(*tuning);
   tuning->add_option("--dtw-back", args->dtw_back, "online DTW window behind the estimate")
       ->check(non_negative_check());
   tuning->add_option("--dtw-ahead", args->dtw_ahead, "online DTW window ahead of the estimate")
