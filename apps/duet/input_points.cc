@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "duet/io/motion_argument.h"
+#include "duet/live/calibration_advice.h"
 #include "duet/live/follow_session.h"
-#include "duet/math/median.h"
 #include "duet/motion/head_hands.h"
 #include "number_checks.h"
 
@@ -108,15 +108,10 @@ std::optional<std::string> head_height_note(const Clip& points, const JointRoles
 
 std::optional<std::string> calibration_note(std::span<const FollowResult> results,
                                             double frame_rate_hz) {
-  std::vector<double> offsets;
-  for (const FollowResult& r : results) {
-    if (!r.missing && r.rig_offset_learnt_s >= kSettledOffsetS && std::isfinite(r.rig_offset)) {
-      offsets.push_back(r.rig_offset);
-    }
-  }
-  if (static_cast<double>(offsets.size()) < frame_rate_hz) return std::nullopt;
-  const double offset = upper_median(std::move(offsets));
-  if (offset < kOtherBodyOffset) return std::nullopt;
+  CalibrationAdvice advice;
+  for (const FollowResult& r : results) advice.observe(r, 1.0 / frame_rate_hz);
+  const std::optional<float> offset = advice.other_body_offset();
+  if (!offset) return std::nullopt;
   return fmt::format(
       "the hands were held elsewhere against the head than the library's dancers hold them (a "
       "learnt offset of {:.3f}; the library's own body under 0.02): the follower learns it as "
@@ -124,7 +119,7 @@ std::optional<std::string> calibration_note(std::span<const FollowResult> result
       "points fewer frames within 100 ms, nearly all in the first 5 s). --calibration POSE.csv, "
       "a second of you standing straight with both arms held straight forward, gives it from the "
       "first frame",
-      offset);
+      *offset);
 }
 
 Status check_head_height_applies(double metres, InputPoints points) {

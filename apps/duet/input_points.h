@@ -57,17 +57,11 @@ std::optional<std::string> head_height_note(const Clip& points, const JointRoles
 // Errors when --head-height is given (metres > 0) for a follower that does not see three points.
 Status check_head_height_applies(double metres, InputPoints points);
 // Three points followed without --calibration: when the rig's posture offset the follower learnt
-// (FollowResult::rig_offset, median over the frames it had been learnt for kSettledOffsetS) is
-// the size another body's puts there (kOtherBodyOffset), a note saying that --calibration would
-// give it from the first frame; else nullopt (also for fewer than a second of such frames).
+// is another body's (CalibrationAdvice, duet/live/calibration_advice.h), a note saying that
+// --calibration would give it from the first frame; else nullopt (also for under a second of
+// frames whose offset had been learnt a while).
 std::optional<std::string> calibration_note(std::span<const FollowResult> results,
                                             double frame_rate_hz);
-// Measured on three points (docs/evaluation.md, "Three points hold a look-alike"): the learnt
-// offset's median is 0.006-0.02 on the library's own rig, 0.026-0.035 on a proportioned and the
-// Bandai rig (followed as well as the library's), 0.09-0.11 on the CMU ASF and handshake rigs,
-// where the calibration gained 7-17 points within 100 ms.
-inline constexpr double kSettledOffsetS = 4.0;
-inline constexpr float kOtherBodyOffset = 0.06f;
 // --calibration FILE: a recording of the user standing straight with both arms held straight
 // forward (arms_forward.h): the body's calibration for three points.
 CLI::Option* add_calibration_option(CLI::App& app, std::string& path);
