@@ -15,10 +15,12 @@
 #include "duet/io/atomic_write.h"
 #include "duet/io/motion_file.h"
 #include "duet/io/points_csv.h"
+#include "duet/live/calibration_advice.h"
 #include "duet/live/source_neuron.h"
 #include "duet/live/source_pose.h"
 #include "duet/live/source_replay.h"
 #include "duet/live/source_vmc.h"
+#include "duet/motion/head_hands.h"
 #include "duet/net/neuron_receiver.h"
 #include "duet/net/osc_output.h"
 #include "duet/net/thread_priority.h"
@@ -292,6 +294,7 @@ struct LiveServer::Impl {
   void process(const SourceFrame& input) {
     const LiveOutput& out = loop->step(input);
     const std::int64_t step_us = microseconds(SteadyClock::now() - input.arrival);
+    note_calibration_advice(out);
     if (recorder) recorder->push(input, out);
     std::shared_ptr<std::string> text = pool.acquire();
     format_frame(out, loop->params(), step_us, *text, frames);  // seq: since the start
@@ -329,6 +332,7 @@ struct LiveServer::Impl {
         // The follower starts over and the corrections go back to how the server started.
         loop->set_params(initial_params);
         loop->reset();
+        forget_calibration_advice();
         return;
       case ClientMessage::Type::kRole:
         request_role(message.role);
@@ -399,6 +403,7 @@ struct LiveServer::Impl {
     }
     if (message.forget_arms_forward) {
       (void)loop->set_arms_forward(std::nullopt);
+      forget_calibration_advice();
       log("the body calibration is forgotten: the hands are taken as they come");
       return;
     }
@@ -421,6 +426,7 @@ struct LiveServer::Impl {
       reject(id, s.error().message);
       return;
     }
+    forget_calibration_advice();
     const ArmsForward& held = arms.value();
     log(fmt::format(
         "arms held forward: the wrists {:.2f} head heights apart, {:.2f} in front of "
@@ -568,12 +574,48 @@ struct LiveServer::Impl {
     (void)other_loop->set_head_height(loop->head_height_m());
     (void)other_loop->set_arms_forward(loop->arms_forward());
     other_loop->reset();
+    forget_calibration_advice();
     std::swap(loop, other_loop);
     std::swap(hello, other_hello);
     std::swap(recorder, other_recorder);
     last_switch = SteadyClock::now();
     server.broadcast(hello);
     log(fmt::format("the user now dances the {}", dancer_role_name(loop->role())));
+  }
+
+  // ---- Whether three points need a body calibration (calibration_advice.h) ----
+
+  // Counts the frame's learnt offset while the user is three points without a body calibration.
+  void note_calibration_advice(const LiveOutput& out) {
+    const bool counts = is_head_hands_input(source->source_skeleton().roles) &&
+                        !loop->arms_forward() && advice_time_s;
+    if (counts) calibration_advice.observe(out.follow, out.time_s - *advice_time_s);
+    advice_time_s = out.time_s;
+  }
+
+  void forget_calibration_advice() {
+    calibration_advice.reset();
+    advice_time_s.reset();
+    calibration_advised = false;
+  }
+
+  // The learnt offset while it is another body's (for `stats`), logged the first time.
+  std::optional<float> calibration_advice_now() {
+    const std::optional<float> offset = calibration_advice.other_body_offset();
+    if (offset && !calibration_advised) {
+      calibration_advised = true;
+      log(fmt::format(
+          "the hands are held elsewhere against the head than the library's dancers hold them (a "
+          "learnt offset of {:.3f}; the library's own body under 0.02): until the follower has "
+          "learnt it, it places the user less surely. A body calibration gives it at once: {}",
+          *offset,
+          device_offsets_or_null() != nullptr
+              ? "in the viewer, stand straight with both arms held straight forward and hold both "
+                "grips for a second"
+              : "duet serve --calibration POSE.csv (a second of the user standing straight with "
+                "both arms held straight forward)"));
+    }
+    return offset;
   }
 
   // ---- Statistics ----
@@ -614,6 +656,7 @@ struct LiveServer::Impl {
         s.record_lost += (*r)->frames_lost();
       }
     }
+    s.calibration_offset = calibration_advice_now();
     server.broadcast(std::make_shared<const std::string>(make_stats(s)));
     broadcast_replay_state();  // clients that connected since the last change learn it here
     send.clear();
@@ -690,6 +733,9 @@ struct LiveServer::Impl {
   long long frames = 0;
   long long rejected = 0;
   bool source_end_reported = false;
+  CalibrationAdvice calibration_advice;
+  std::optional<double> advice_time_s;  // the previous frame's time, for the advice's durations
+  bool calibration_advised = false;     // logged once until it is forgotten
   LatencyHistogram loop_window, loop_log, loop_total;
   LatencyHistogram send_log, send_total;
   SteadyClock::time_point last_stats{}, last_log{};

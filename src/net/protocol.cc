@@ -247,7 +247,7 @@ void format_frame(const LiveOutput& output, const PartnerParams& params, std::in
 }
 
 std::string make_stats(const StatsSnapshot& s) {
-  const json stats = {
+  json stats = {
       {"type", "stats"},
       {"frames", s.frames},
       {"clients", s.clients},
@@ -263,6 +263,10 @@ std::string make_stats(const StatsSnapshot& s) {
         {"dropped", s.source.dropped}}},
       {"recording", {{"frames", s.recorded}, {"lost", s.record_lost}}},
   };
+  if (s.calibration_offset) {
+    stats["advice"] = {
+        {"calibrate", {{"rig_offset", std::round(*s.calibration_offset * 1000.0) / 1000.0}}}};
+  }
   return stats.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 

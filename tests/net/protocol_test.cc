@@ -157,6 +157,10 @@ TEST(Protocol, StatsAndErrors) {
   EXPECT_EQ(stats["type"], "stats");
   EXPECT_EQ(stats["frames"], 7200);
   EXPECT_EQ(stats["latency_us"]["p99"], 700);
+  EXPECT_FALSE(stats.contains("advice"));  // nothing to advise
+  s.calibration_offset = 0.0943f;
+  const json advised = json::parse(make_stats(s));
+  EXPECT_DOUBLE_EQ(advised["advice"]["calibrate"]["rig_offset"].get<double>(), 0.094);
   const json error = json::parse(make_error("unknown correction 'foo'"));
   EXPECT_EQ(error["type"], "error");
   EXPECT_EQ(error["reason"], "unknown correction 'foo'");

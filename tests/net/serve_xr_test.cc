@@ -14,6 +14,7 @@
 #include "duet/io/points_csv.h"
 #include "duet/motion/arms_forward.h"
 #include "duet/motion/head_hands.h"
+#include "duet/motion/retarget.h"
 #include "serve_support.h"
 
 namespace duet::test {
@@ -218,6 +219,77 @@ TEST(ServeXr, ReplaysAThreePointRecording) {
   EXPECT_EQ((*last)["follower"]["take"], 6) << server.log();
   EXPECT_NEAR((*last)["follower"]["template_frame"].get<int>(), 239, 6);
   EXPECT_EQ(server.wait_exit(), 0) << server.log();
+}
+
+// Three points' first hour (CalibrationAdvice): the server tells a body whose hands sit elsewhere
+// against its head than the library's dancers' that a body calibration would place it at once,
+// in its log and in `stats`; the library's own body is told nothing. The headset's poses carry
+// their own times (60 Hz) and are sent as fast as the server answers.
+std::optional<Json> advice_for_headset(const Clip& body, const JointRoles& roles,
+                                       const fs::path& dir, std::string& log) {
+  Performance performance;
+  performance.motion = body;
+  performance.roles = roles;
+  PointNoiseOptions devices;
+  devices.offsets = typical_headset_offsets();
+  Result<Performance> points = with_head_hands(std::move(performance), devices);
+  if (!points) {
+    log = points.error().message;
+    return std::nullopt;
+  }
+  const Clip& clip = points.value().motion;
+  ServeProcess server;
+  std::vector<std::string> args = library_args();
+  args.insert(args.end(), {"--source", "xr", "--no-record"});
+  if (!server.start(args, dir / "serve.log")) {
+    log = server.log();
+    return std::nullopt;
+  }
+  WsClient dancer;
+  std::optional<Json> advice;
+  if (dancer.connect(server.port()) && dancer.read_type("hello")) {
+    for (int f = 0; f < clip.frame_count(); ++f) {
+      const Json pose = {{"type", "xr_pose"},
+                         {"time_s", f / clip.frame_rate()},
+                         {"head", point(clip, f, kPointsHead)},
+                         {"left", point(clip, f, kPointsLeftHand)},
+                         {"right", point(clip, f, kPointsRightHand)}};
+      if (!dancer.write(pose.dump()) || !dancer.read_type("frame")) break;
+    }
+    // The next two stats messages (once a second) count every pose sent.
+    for (int k = 0; k < 2; ++k) {
+      const std::optional<Json> stats = dancer.read_type("stats");
+      if (stats && stats->contains("advice")) advice = (*stats)["advice"];
+    }
+  }
+  server.stop();
+  log = server.log();
+  return advice;
+}
+
+TEST(ServeXr, AnotherBodysThreePointsAreAdvisedACalibration) {
+  TempDir dir("duet-serve-xr-advice-test");
+  MotionLoadOptions load;
+  load.frame_rate = 60.0;
+  Result<LoadedMotion> take = load_motion({salsa("60", "10")}, load);
+  ASSERT_TRUE(take);
+  // The same dance on the CMU handshake rig (wider shoulders, the head further forward).
+  Result<LoadedMotion> rig =
+      load_motion({std::string(DUET_DATA_DIR) + "/cmu-handshake/18_01.bvh"}, MotionLoadOptions{});
+  ASSERT_TRUE(rig);
+  Result<Clip> other_body = retarget_clip(take.value().clip, take.value().roles,
+                                          rig.value().clip.skeleton_ptr(), rig.value().roles);
+  ASSERT_TRUE(other_body) << other_body.error().message;
+  std::string log;
+  const std::optional<Json> advice =
+      advice_for_headset(other_body.value(), rig.value().roles, dir.path, log);
+  ASSERT_TRUE(advice) << log;
+  EXPECT_GE((*advice)["calibrate"]["rig_offset"].get<double>(), 0.06) << *advice;
+  EXPECT_NE(log.find("the hands are held elsewhere against the head"), std::string::npos) << log;
+  EXPECT_NE(log.find("hold both grips for a second"), std::string::npos) << log;
+
+  EXPECT_FALSE(advice_for_headset(take.value().clip, take.value().roles, dir.path, log)) << log;
+  EXPECT_EQ(log.find("the hands are held elsewhere"), std::string::npos) << log;
 }
 
 }  // namespace

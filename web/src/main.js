@@ -4,13 +4,15 @@
 // Data flow: socket message -> state (latest frame kept, never queued) -> render loop applies
 // the latest frame once per displayed frame -> three.js scene, timeline canvas, status line.
 import * as THREE from 'three';
-import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
-import { Connection, defaultSocketUrl } from './connection.js';
-import { StickFigure, kRoleColors } from './dancers.js';
-import { Timeline } from './timeline.js';
-import { VRSession, installXREmulator, placeRigAtHead } from './xr.js';
-import { XRPoseSender } from './xr_pose.js';
-import { HeightCalibration } from './height_calibration.js';
+import {OrbitControls} from 'three/examples/jsm/controls/OrbitControls.js';
+
+import {adviceText} from './advice.js';
+import {Connection, defaultSocketUrl} from './connection.js';
+import {kRoleColors, StickFigure} from './dancers.js';
+import {HeightCalibration} from './height_calibration.js';
+import {Timeline} from './timeline.js';
+import {installXREmulator, placeRigAtHead, VRSession} from './xr.js';
+import {XRPoseSender} from './xr_pose.js';
 
 const kCorrections = ['align', 'contact', 'smooth', 'footlock', 'blend'];
 const kPendingToggle_s = 1.5; // how long a clicked switch waits for the server to confirm it
@@ -69,6 +71,7 @@ async function main() {
     fps: el('status-fps'),
     latency: el('status-latency'),
     error: el('status-error'),
+    advice: el('status-advice'),
     role: el('role'),
     reset: el('reset'),
     view: el('view'),
@@ -528,6 +531,14 @@ async function main() {
     else if (frame_us !== undefined) parts.push(`latency ${ms(frame_us)} ms`);
     if (s) parts.push(`${s.clients} clients, ${s.dropped} dropped`);
     ui.latency.textContent = parts.join(', ');
+    showAdvice(s?.advice);
+  }
+
+  // What the server advises (`stats`.advice): a body calibration, in words (advice.js).
+  function showAdvice(advice) {
+    const text = adviceText(advice, headsetIsSource());
+    if (ui.advice.textContent !== text) ui.advice.textContent = text;
+    ui.advice.hidden = !text;
   }
 
   let last_ms = performance.now();

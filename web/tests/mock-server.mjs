@@ -203,6 +203,7 @@ export async function startMockServer({ port = 0, host = '127.0.0.1', distDir = 
     dropped: 0,
     rejected: 0,
     latencies_us: [],
+    advice: null, // what `stats` advises (a test sets it), e.g. { calibrate: { rig_offset: 0.094 } }
     // The "file" the mock replays: its clock drives the dance; paused, no frames come.
     clock_s: 0,
     replay: { paused: false, speed: 1, position_s: 0, duration_s: 60, loop: true, preview: false },
@@ -388,6 +389,7 @@ export async function startMockServer({ port = 0, host = '127.0.0.1', distDir = 
       dropped: state.dropped,
       rejected: state.rejected,
       latency_us: { p50: percentile(sorted, 0.5), p99: percentile(sorted, 0.99), max: sorted.at(-1) ?? 0 },
+      ...(state.advice ? { advice: state.advice } : {}),
     };
     for (const ws of wss.clients) {
       sendJson(ws, stats);

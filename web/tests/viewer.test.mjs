@@ -314,6 +314,18 @@ describe(`duet viewer (${against})`, () => {
     await waitUntil(page, 'frames after the error', (k) => window.duetViewer.framesReceived > k + 10, frames, 5);
   });
 
+  test('the server\'s advice to calibrate is shown while it lasts', { skip: real_url ? 'the mock server sets the advice' : false }, async () => {
+    requireFrames();
+    assert.equal(await page.isHidden('#status-advice'), true, 'no advice before the server gives one');
+    mock.state.advice = { calibrate: { rig_offset: 0.094 } };
+    await waitUntil(page, 'the advice shown', () => !document.getElementById('status-advice').hidden, undefined, 5);
+    const text = await page.textContent('#status-advice');
+    assert.match(text, /learnt offset 0\.094/);
+    assert.match(text, /arms held straight forward/);
+    mock.state.advice = null;
+    await waitUntil(page, 'the advice gone', () => document.getElementById('status-advice').hidden, undefined, 5);
+  });
+
   test('role switch and reset send their messages; colours follow the dance role', async () => {
     requireFrames();
     const start_role = await page.evaluate(() => window.duetViewer.role);

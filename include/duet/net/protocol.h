@@ -59,6 +59,9 @@ struct StatsSnapshot {
   SourceStats source;
   long long recorded = 0;
   long long record_lost = 0;
+  // Three points without a body calibration whose learnt posture offset is another body's
+  // (CalibrationAdvice): that offset, sent as "advice"; nullopt: nothing to advise.
+  std::optional<float> calibration_offset;
 };
 std::string make_stats(const StatsSnapshot& stats);
 
