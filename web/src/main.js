@@ -4,15 +4,15 @@
 // Data flow: socket message -> state (latest frame kept, never queued) -> render loop applies
 // the latest frame once per displayed frame -> three.js scene, timeline canvas, status line.
 import * as THREE from 'three';
-import {OrbitControls} from 'three/examples/jsm/controls/OrbitControls.js';
-
-import {adviceText} from './advice.js';
-import {Connection, defaultSocketUrl} from './connection.js';
-import {kRoleColors, StickFigure} from './dancers.js';
-import {HeightCalibration} from './height_calibration.js';
-import {Timeline} from './timeline.js';
-import {installXREmulator, placeRigAtHead, VRSession} from './xr.js';
-import {XRPoseSender} from './xr_pose.js';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { Connection, defaultSocketUrl } from './connection.js';
+import { StickFigure, kRoleColors } from './dancers.js';
+import { Timeline } from './timeline.js';
+import { VRSession, installXREmulator, placeRigAtHead } from './xr.js';
+import { XRPoseSender } from './xr_pose.js';
+import { HeightCalibration } from './height_calibration.js';
+import { adviceText } from './advice.js';
+import { AdviceHud } from './advice_hud.js';
 
 const kCorrections = ['align', 'contact', 'smooth', 'footlock', 'blend'];
 const kPendingToggle_s = 1.5; // how long a clicked switch waits for the server to confirm it
@@ -534,11 +534,14 @@ async function main() {
     showAdvice(s?.advice);
   }
 
-  // What the server advises (`stats`.advice): a body calibration, in words (advice.js).
+  // What the server advises (`stats`.advice): a body calibration, in words (advice.js), in the
+  // status panel and, in VR, on a panel below the line of sight (advice_hud.js).
+  const advice_hud = new AdviceHud(camera);
   function showAdvice(advice) {
     const text = adviceText(advice, headsetIsSource());
     if (ui.advice.textContent !== text) ui.advice.textContent = text;
     ui.advice.hidden = !text;
+    advice_hud.show(text, renderer.xr.isPresenting);
   }
 
   let last_ms = performance.now();
@@ -592,6 +595,8 @@ async function main() {
     get hello() { return state.hello; },
     get role() { return state.role; },
     get lastStats() { return state.lastStats; },
+    /** The advice's panel in VR: its text and whether it is shown. */
+    get adviceHud() { return { text: advice_hud.text, visible: advice_hud.visible }; },
     get errors() { return state.errors.slice(); },
     get seqGaps() { return state.seqGaps; },
     get cameraMode() { return state.cameraMode; },

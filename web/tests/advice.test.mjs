@@ -24,3 +24,13 @@ test('an offset that is not a number is left out, not shown as NaN', () => {
   assert.doesNotMatch(text, /NaN|offset x/);
   assert.match(text, /Calibrate:/);
 });
+
+test('the VR panel wraps the advice into lines that fit', async () => {
+  const { wrapLines } = await import('../src/advice_hud.js');
+  const measure = (s) => s.length; // one unit a character
+  assert.deepEqual(wrapLines('stand straight with both arms forward', 15, measure),
+    ['stand straight', 'with both arms', 'forward']);
+  assert.deepEqual(wrapLines('', 10, measure), []);
+  // A word longer than the line stands on its own line, whole.
+  assert.deepEqual(wrapLines('a calibration b', 5, measure), ['a', 'calibration', 'b']);
+});

@@ -322,6 +322,10 @@ describe(`duet viewer (${against})`, () => {
     const text = await page.textContent('#status-advice');
     assert.match(text, /learnt offset 0\.094/);
     assert.match(text, /arms held straight forward/);
+    // The VR panel holds the same words, hidden outside VR.
+    const hud = await page.evaluate(() => window.duetViewer.adviceHud);
+    assert.equal(hud.text, text);
+    assert.equal(hud.visible, false);
     mock.state.advice = null;
     await waitUntil(page, 'the advice gone', () => document.getElementById('status-advice').hidden, undefined, 5);
   });
@@ -552,6 +556,14 @@ describe(`duet viewer (${against})`, () => {
       assert.ok(Math.hypot(cam[0] - head[0], cam[2] - head[2]) < 0.3, `VR camera ${cam} is far from the head ${head}`);
       mkdirSync(kResults, { recursive: true });
       await vr_page.screenshot({ path: path.join(kResults, 'vr.png') });
+      if (mock) {
+        // Advice in VR: the panel below the line of sight shows it while it lasts.
+        mock.state.advice = { calibrate: { rig_offset: 0.094 } };
+        await waitUntil(vr_page, 'the advice panel in VR', () => window.duetViewer.adviceHud.visible, null, 5);
+        await vr_page.screenshot({ path: path.join(kResults, 'vr-advice.png') });
+        mock.state.advice = null;
+        await waitUntil(vr_page, 'the advice panel gone', () => !window.duetViewer.adviceHud.visible, null, 5);
+      }
       await vr_page.click('#vr'); // "Exit VR", kept above the emulator's canvas
       await waitUntil(vr_page, 'the session to end', () => !window.duetViewer.xrPresenting, null, 10);
       assert.equal(await vr_page.evaluate(() => window.duetViewer.cameraMode), 'orbit');

@@ -203,6 +203,9 @@ test('a headset playing a three-point recording is followed, the partner in fron
     await new Promise((r) => setTimeout(r, 300)); // an error reply would be back by now
     const errors = await page.evaluate(() => window.duetViewer.errors);
     assert.deepEqual(errors, [], 'the server rejected messages');
+    // The recording is the library's own body: nothing to advise, in VR or out of it.
+    const hud = await page.evaluate(() => window.duetViewer.adviceHud);
+    assert.deepEqual(hud, { text: '', visible: false }, 'a calibration advised for the library\'s own body');
 
     // Each server frame against the recording frame its pose came from (by the pose's time).
     const sent = new Map(drive.log.map(([time_s, k]) => [Math.round(time_s * 1e4), k]));
