@@ -587,8 +587,7 @@ struct LiveServer::Impl {
 
   // Counts the frame's learnt offset while the user is three points without a body calibration.
   void note_calibration_advice(const LiveOutput& out) {
-    const bool counts = is_head_hands_input(source->source_skeleton().roles) &&
-                        !loop->arms_forward() && advice_time_s;
+    const bool counts = three_point_source && !loop->arms_forward() && advice_time_s;
     if (counts) calibration_advice.observe(out.follow, out.time_s - *advice_time_s);
     advice_time_s = out.time_s;
   }
@@ -717,6 +716,8 @@ struct LiveServer::Impl {
   std::unique_ptr<LiveLoop> other_loop;
   std::shared_ptr<const std::string> other_hello;
   std::string source_description = source->describe();
+  // The user is three points (a headset, or a three-point replay): CalibrationAdvice applies.
+  const bool three_point_source = is_head_hands_input(source->source_skeleton().roles);
   // What the headset source takes out of each xr_pose (for hello); null for other sources.
   const DevicePointOffsets* device_offsets_or_null() const {
     return pose && spec.kind == SourceKind::kXr ? &pose->device_offsets() : nullptr;
