@@ -25,6 +25,13 @@ std::vector<std::string> library_args() {
           "--data-dir", DUET_DATA_DIR};
 }
 
+// Take 60_<trial> of the salsa BVHs at their real 60 Hz (the headers say 120).
+Result<LoadedMotion> salsa_take(const std::string& trial) {
+  MotionLoadOptions load;
+  load.frame_rate = 60.0;
+  return load_motion({salsa("60", trial)}, load);
+}
+
 Json point(const Clip& clip, int frame, int joint) {
   const Vec3& p = clip.translations_ls(frame)[static_cast<std::size_t>(joint)];
   const Quat& q = clip.rotations_ls(frame)[static_cast<std::size_t>(joint)];
@@ -38,9 +45,7 @@ TEST(ServeXr, AHeadsetIsFollowedAndThePartnerStandsInFront) {
   args.insert(args.end(), {"--source", "xr", "--record", (dir.path / "rec").string()});
   ASSERT_TRUE(server.start(args, dir.path / "serve.log")) << server.log();
 
-  MotionLoadOptions load;
-  load.frame_rate = 60.0;
-  Result<LoadedMotion> motion = load_motion({salsa("60", "07")}, load);
+  Result<LoadedMotion> motion = salsa_take("07");
   ASSERT_TRUE(motion) << motion.error().message;
   Performance performance;
   performance.motion = motion.value().clip;
@@ -175,9 +180,7 @@ TEST(ServeXr, AHeadsetIsFollowedAndThePartnerStandsInFront) {
 
 TEST(ServeXr, ReplaysAThreePointRecording) {
   TempDir dir("duet-serve-xr-replay-test");
-  MotionLoadOptions load;
-  load.frame_rate = 60.0;
-  Result<LoadedMotion> motion = load_motion({salsa("60", "07")}, load);
+  Result<LoadedMotion> motion = salsa_take("07");
   ASSERT_TRUE(motion);
   Result<Clip> points = head_hands_clip(motion.value().clip, motion.value().roles);
   ASSERT_TRUE(points);
@@ -269,9 +272,7 @@ std::optional<Json> advice_for_headset(const Clip& body, const JointRoles& roles
 
 TEST(ServeXr, AnotherBodysThreePointsAreAdvisedACalibration) {
   TempDir dir("duet-serve-xr-advice-test");
-  MotionLoadOptions load;
-  load.frame_rate = 60.0;
-  Result<LoadedMotion> take = load_motion({salsa("60", "10")}, load);
+  Result<LoadedMotion> take = salsa_take("10");
   ASSERT_TRUE(take);
   // The same dance on the CMU handshake rig (wider shoulders, the head further forward).
   Result<LoadedMotion> rig =
