@@ -1,4 +1,5 @@
 // duet eval --pair LEADER PARTNER [...] [--takes 0,2] [--cases ...] [--noise-sweep] [--suit-sweep]
+//           [--body-sweep]
 //           [--trackers ...] [--csv F] [--plots DIR] [--no-partner-metrics] [--partner-csv F]
 //           [tuning options]
 // Synthetic performances with ground truth from the real takes, followed by the HMM and the
@@ -49,6 +50,7 @@ struct EvalArgs {
   bool beam = false;
   bool noise_sweep = false;
   bool suit_sweep = false;
+  bool body_sweep = false;
   std::vector<std::string> recorded;  // TAKE=FILE
   MotionFileOptions recorded_motion;
   std::string partner_csv_path;
@@ -159,14 +161,18 @@ int run_eval(EvalArgs& args) {
   const std::vector<EvalCase> standard = standard_cases(args.settings);
   EvalOptions options;
   std::string error;
-  // --noise-sweep, --suit-sweep or --recorded alone runs only those; with --cases, after them.
-  if (args.cases.empty() && !args.noise_sweep && !args.suit_sweep && args.recorded.empty()) {
+  // A sweep or --recorded alone runs only those; with --cases, after them.
+  if (args.cases.empty() && !args.noise_sweep && !args.suit_sweep && !args.body_sweep &&
+      args.recorded.empty()) {
     args.cases = {"all"};
   }
   if (!select_cases(args.cases, standard, options.cases, error)) return usage_error(error);
   if (args.noise_sweep) std::ranges::move(noise_sweep_cases(), std::back_inserter(options.cases));
   if (args.suit_sweep) {
     std::ranges::move(suit_sweep_cases(args.settings), std::back_inserter(options.cases));
+  }
+  if (args.body_sweep) {
+    std::ranges::move(body_sweep_cases(args.settings), std::back_inserter(options.cases));
   }
   if (args.trackers.empty()) {
     options.trackers = all_tracker_kinds();
@@ -480,6 +486,9 @@ Command register_eval(CLI::App& app) {
                "Also run suit-sweep-0, -2, ... -10: an inertial suit (suit-drift) with 0 to 10 "
                "degrees of calibration error and as much drift per joint, with the noise; "
                "alone (without --cases) only these");
+  app.add_flag("--body-sweep", args->body_sweep,
+               "Also run body-sweep-80, -90, ... -120: improv-pause with the noise, danced by a "
+               "body 0.8x to 1.2x the template dancer's; alone (without --cases) only these");
   app.add_option("--recorded", args->recorded,
                  "A recording of one of the library's takes danced again, scored like the cases "
                  "(its frame i is the take's moment i / rate), as TAKE=FILE: TAKE a take's name "

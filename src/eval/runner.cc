@@ -183,6 +183,23 @@ std::vector<EvalCase> suit_sweep_cases(const CaseSettings& settings) {
   return cases;
 }
 
+std::vector<EvalCase> body_sweep_cases(const CaseSettings& settings) {
+  std::vector<EvalCase> cases;
+  for (int percent = 80; percent <= 120; percent += 10) {
+    EvalCase c;
+    c.name = fmt::format("body-sweep-{}", percent);
+    c.description = fmt::format("improv-pause danced by a {:g}x body (noise {:g} deg, {:g} cm)",
+                                percent / 100.0, settings.noise_rotation_deg,
+                                settings.noise_position_m * 100.0);
+    c.recipe.improvise = true;
+    c.recipe.improvise_options.pause_prob = 1.0;
+    c.recipe.noise = {settings.noise_rotation_deg, settings.noise_position_m, 0};
+    c.recipe.body_scale = percent / 100.0;
+    cases.push_back(std::move(c));
+  }
+  return cases;
+}
+
 std::vector<EvalCase> cases_on_rigs(const std::vector<EvalCase>& cases,
                                     const std::vector<EvalRig>& rigs) {
   std::vector<EvalCase> out;

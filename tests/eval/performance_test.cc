@@ -586,6 +586,18 @@ TEST(EvalCases, HarshCaseAndNoiseSweepHaveIssue11sMagnitudes) {
     EXPECT_FALSE(c.recipe.improvise);
   }
 
+  // The body sweep: improv-pause with the settings' noise, danced by a 0.8x to 1.2x body.
+  const std::vector<EvalCase> bodies = body_sweep_cases(noisier);
+  ASSERT_EQ(bodies.size(), 5u);
+  for (int i = 0; i < 5; ++i) {
+    const EvalCase& c = bodies[static_cast<std::size_t>(i)];
+    EXPECT_EQ(c.name, "body-sweep-" + std::to_string(80 + 10 * i));
+    EXPECT_DOUBLE_EQ(c.recipe.body_scale, 0.8 + 0.1 * i);
+    EXPECT_DOUBLE_EQ(c.recipe.noise.rotation_deg, 4.0);
+    EXPECT_TRUE(c.recipe.improvise);
+    EXPECT_DOUBLE_EQ(c.recipe.improvise_options.pause_prob, 1.0);
+  }
+
   // The inertial suit: the default noise plus its calibration error and drift.
   const auto suit = std::ranges::find(cases, std::string("suit-drift"), &EvalCase::name);
   ASSERT_NE(suit, cases.end());

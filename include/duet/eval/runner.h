@@ -78,6 +78,11 @@ std::vector<EvalCase> noise_sweep_cases();
 // drift per joint: how far off a suit may be before the follower loses the dance.
 std::vector<EvalCase> suit_sweep_cases(const CaseSettings& settings = {});
 
+// The body sweep (`duet eval --body-sweep`): body-sweep-80, -90, ... -120, improv-pause at the
+// take's rate with the settings' noise, danced by a body 0.8x to 1.2x the template dancer's
+// (skeleton and root path scaled): issue 10's users of other sizes, jumps and held hands included.
+std::vector<EvalCase> body_sweep_cases(const CaseSettings& settings = {});
+
 enum class TrackerKind {
   kHmm,               // the jump HMM with EvalOptions::hmm (the defaults unless tuned)
   kHmmPaper,          // FollowParams::paper() transitions, emission settings from EvalOptions::hmm
