@@ -135,6 +135,10 @@ const std::vector<FloatRow>& float_rows() {
        "take this far (template seconds; 0 for none): a standing start looks like every take's "
        "standing moments",
        number_between(0.0, 10.0, "s")},
+      {"--jump-burst", &FollowParams::jump_burst_s,
+       "jump_burst_s: a jump that would be the --jump-burst-jumps-th reported within this time "
+       "is not reported and the placement starts again (template seconds)",
+       number_between(0.0, 60.0, "s")},
   };
   return rows;
 }
@@ -152,6 +156,10 @@ void FollowTuning::add_options(CLI::Option_group& group) {
       .add_option("--jump-tolerance", jump_tolerance_,
                   "jump_tolerance_frames: a move back by up to this many frames is no jump")
       ->check(CLI::Range(0, 1000));
+  group
+      .add_option("--jump-burst-jumps", jump_burst_jumps_,
+                  "jump_burst_jumps: see --jump-burst (0 for no such limit)")
+      ->check(CLI::Range(0, FollowParams::kMaxJumpBurstJumps));
   group
       .add_option("--tempo-time-constant", tempo_time_constant_,
                   "tempo_time_constant_s of the tempo-centred band (all HMM variants)")
@@ -173,6 +181,7 @@ void FollowTuning::apply(FollowParams& params) const {
     if (floats_[i]) params.*rows[i].field = *floats_[i];
   }
   if (jump_tolerance_) params.jump_tolerance_frames = *jump_tolerance_;
+  if (jump_burst_jumps_) params.jump_burst_jumps = *jump_burst_jumps_;
   if (tempo_time_constant_) params.tempo_time_constant_s = *tempo_time_constant_;
   if (fixed_band_) params.tempo_adaptive = false;
   if (no_outlier_gate_) params.gate_outliers = false;

@@ -25,6 +25,7 @@ class FollowTuning {
  private:
   std::vector<std::optional<float>> floats_;  // one per row of the float table
   std::optional<int> jump_tolerance_;
+  std::optional<int> jump_burst_jumps_;
   std::optional<double> tempo_time_constant_;
   bool fixed_band_ = false;
   bool no_outlier_gate_ = false;

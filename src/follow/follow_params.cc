@@ -26,6 +26,7 @@ FollowParams FollowParams::paper() {
   params.jump_settle_s = 0.0f;
   params.jump_settle_mass = 0.0f;
   params.jump_settle_advance_s = 0.0f;
+  params.jump_burst_jumps = 0;
   params.noisy_jump_hold_s = 0.0f;
   params.unexplained_jump_hold_s = 0.0f;
   params.limb_outlier_ratio = std::numeric_limits<float>::infinity();
@@ -134,7 +135,8 @@ Status FollowParams::validate(int num_states) const {
                  {"unexplained_jump_hold_s", unexplained_jump_hold_s, 10, " s"},
                  {"unexplained_jump_hold_after_s", unexplained_jump_hold_after_s, 60, " s"},
                  {"jump_settle_s", jump_settle_s, 10, " s"},
-                 {"jump_settle_advance_s", jump_settle_advance_s, 10, " s"}};
+                 {"jump_settle_advance_s", jump_settle_advance_s, 10, " s"},
+                 {"jump_burst_s", jump_burst_s, 60, " s"}};
   for (const auto& b : bounded) {
     if (!(b.value >= 0.0f && b.value <= static_cast<float>(b.max))) {
       return params_error(std::string(b.name) + " must be in [0, " + std::to_string(b.max) + "]" +
@@ -168,6 +170,10 @@ Status FollowParams::validate(int num_states) const {
   if (!(outlier_pause_fraction >= 0.0f && std::isfinite(outlier_pause_fraction))) {
     return params_error("outlier_pause_fraction must be finite and >= 0, got " +
                         std::to_string(outlier_pause_fraction));
+  }
+  if (jump_burst_jumps < 0 || jump_burst_jumps > kMaxJumpBurstJumps) {
+    return params_error("jump_burst_jumps must be in [0, " + std::to_string(kMaxJumpBurstJumps) +
+                        "], got " + std::to_string(jump_burst_jumps));
   }
   if (jump_tolerance_frames < 0 || jump_tolerance_frames > 1000) {
     return params_error("jump_tolerance_frames must be in [0, 1000], got " +

@@ -63,9 +63,11 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
                      bool unexplained) noexcept {
   const bool adrift =
       !result.missing && result.state >= 0 && (result.lost || result.in_pause || unexplained);
+  clock_s_ += static_cast<double>(std::max(result.steps, 1)) / model.frame_rate_hz();
   if (!through_spell(model, params, adrift, result)) {
     decide(model, params, posterior, total, previous_state, previous_lost, result);
   }
+  if (result.jumped && !keeps_jump(params)) result.jumped = false;
   if (result.jumped) followed_since_jump_s_ = 0.0;
   if (adrift || result.missing || result.state < 0) {
     steps_since_steady_ += std::max(result.steps, 1);
@@ -73,6 +75,30 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
     steady_state_ = result.state;
     steps_since_steady_ = 0;
   }
+}
+
+bool JumpGate::keeps_jump(const FollowParams& params) noexcept {
+  if (params.jump_burst_jumps <= 0) return true;
+  // Drop the times that fell out of the window (they are kept oldest first).
+  int kept = 0;
+  for (int i = 0; i < recent_jumps_; ++i) {
+    const auto at = static_cast<std::size_t>(i);
+    if (clock_s_ - jump_times_[at] <= static_cast<double>(params.jump_burst_s) + 1e-9) {
+      jump_times_[static_cast<std::size_t>(kept++)] = jump_times_[at];
+    }
+  }
+  recent_jumps_ = kept;
+  if (recent_jumps_ + 1 >= params.jump_burst_jumps) {
+    // The place is lost: find it again as at the start, with no jumps on the way.
+    recent_jumps_ = 0;
+    settled_s_ = 0.0;
+    followed_since_jump_s_ = 0.0;
+    forget_advance();
+    forget_candidate();
+    return false;
+  }
+  jump_times_[static_cast<std::size_t>(recent_jumps_++)] = clock_s_;
+  return true;
 }
 
 void JumpGate::note_advance(const TemplateModel& model, int from, int to) noexcept {

@@ -503,6 +503,7 @@ TEST(JumpGate, APlaceJustLandedOnIsLeftAtOnceOneFollowedForAWhileWaits) {
   settle_at_once(params);
   params.unexplained_jump_hold_s = 0.3f;                     // 18 frames at 60 Hz
   params.unexplained_jump_hold_after_s = 0.5f;               // 30 frames
+  params.jump_burst_jumps = 0;  // three jumps in 1.2 s: no burst here (the next test)
   const float poorly = 2.0f * params.lost_residual_per_dim;  // clean sensor: over the floor
   EXPECT_EQ(JumpGate::hold_s(params, 0.0f, poorly, 0.49), 0.0f);
   EXPECT_EQ(JumpGate::hold_s(params, 0.0f, poorly, 0.5), 0.3f);
@@ -538,6 +539,50 @@ TEST(JumpGate, APlaceJustLandedOnIsLeftAtOnceOneFollowedForAWhileWaits) {
   }
 }
 
+TEST(JumpGate, ABurstOfJumpsIsAPlaceLostFoundAgainWithoutJumps) {
+  const TemplateModel model = two_takes();
+  FollowParams params;
+  params.jump_hold_s = 0.0f;
+  params.noisy_jump_hold_s = 0.0f;
+  params.jump_settle_s = 0.1f;          // 6 sure frames
+  params.jump_settle_advance_s = 0.1f;  // over 6 frames forward
+  params.jump_burst_jumps = 3;
+  params.jump_burst_s = 1.0f;  // 60 template frames
+  JumpGate gate;
+  int previous = 10;
+  for (int k = 1; k <= 10; ++k) step_to(gate, model, params, previous, 10 + k);  // settled
+  // Two far moves 20 frames apart are jumps; a third within the second is withdrawn, and the
+  // placement starts again.
+  EXPECT_TRUE(step_to(gate, model, params, previous, 150).jumped);
+  for (int k = 1; k <= 20; ++k) step_to(gate, model, params, previous, 150 + k);
+  EXPECT_TRUE(step_to(gate, model, params, previous, 40).jumped);
+  for (int k = 1; k <= 20; ++k) step_to(gate, model, params, previous, 40 + k);
+  FollowResult third = step_to(gate, model, params, previous, 120);
+  EXPECT_FALSE(third.jumped);
+  EXPECT_EQ(third.state, 120);  // the estimate moves all the same
+  // Until the placement has settled again, far moves are no jumps either.
+  EXPECT_FALSE(step_to(gate, model, params, previous, 30).jumped);
+  for (int k = 1; k <= 5; ++k) step_to(gate, model, params, previous, 30 + k);
+  EXPECT_FALSE(step_to(gate, model, params, previous, 160).jumped);  // not yet settled
+  // Six frames forward, sure of them: settled again; the next far move is a jump.
+  for (int k = 1; k <= 6; ++k) step_to(gate, model, params, previous, 160 + k);
+  EXPECT_TRUE(step_to(gate, model, params, previous, 180).jumped);
+  // Jumps further apart than jump_burst_s make no burst.
+  for (int round = 0; round < 4; ++round) {
+    const int far = previous >= 100 ? 20 : 110;
+    EXPECT_TRUE(step_to(gate, model, params, previous, far).jumped) << round;
+    for (int k = 1; k <= 61; ++k) step_to(gate, model, params, previous, far + k);
+  }
+  // Without the limit every far move is a jump.
+  params.jump_burst_jumps = 0;
+  JumpGate unlimited;
+  previous = 10;
+  for (int k = 1; k <= 10; ++k) step_to(unlimited, model, params, previous, 10 + k);
+  for (const int far : {150, 40, 120, 30}) {
+    EXPECT_TRUE(step_to(unlimited, model, params, previous, far).jumped) << far;
+  }
+}
+
 TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
   EXPECT_TRUE(FollowParams{}.validate(200));
   const float nan = std::nanf("");
@@ -549,6 +594,7 @@ TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
       {"unexplained_jump_hold_after_s",
        [](FollowParams& p, float v) { p.unexplained_jump_hold_after_s = v; }},
       {"jump_settle_advance_s", [](FollowParams& p, float v) { p.jump_settle_advance_s = v; }},
+      {"jump_burst_s", [](FollowParams& p, float v) { p.jump_burst_s = v; }},
   };
   for (const auto& [name, set] : fields) {
     for (const float bad : {-1.0f, nan, 1000.0f}) {
@@ -584,6 +630,8 @@ TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
       {"jump_old_place_mass 1.5", [](FollowParams& p) { p.jump_old_place_mass = 1.5f; }},
       {"jump_old_place_mass nan", [](FollowParams& p) { p.jump_old_place_mass = std::nanf(""); }},
       {"jump_settle_mass -0.5", [](FollowParams& p) { p.jump_settle_mass = -0.5f; }},
+      {"jump_burst_jumps -1", [](FollowParams& p) { p.jump_burst_jumps = -1; }},
+      {"jump_burst_jumps 9", [](FollowParams& p) { p.jump_burst_jumps = 9; }},
   };
   for (const auto& [what, set] : others) {
     FollowParams params;

@@ -21,8 +21,11 @@
 // forward of where it began in its take) a far move is the first placement being refined: no jump
 // is reported (half the false jumps left at 4 degrees per axis were those, and nearly all of an
 // inertial suit's, whose standing start sat on other takes' standing frames).
+// A burst of jumps (FollowParams::jump_burst_jumps within jump_burst_s) is a place lost: the jump
+// that would complete it is withdrawn and the placement starts again as at the start.
 #pragma once
 
+#include <array>
 #include <limits>
 
 #include "duet/follow/follow_params.h"
@@ -42,6 +45,8 @@ class JumpGate {
     steady_state_ = -1;
     steps_since_steady_ = 0;
     in_spell_ = false;
+    clock_s_ = 0.0;
+    recent_jumps_ = 0;
   }
 
   // `result` holds the posterior's maximum (follow_detail::decide); on return it holds the state
@@ -95,6 +100,10 @@ class JumpGate {
   // a move between them is no jump.
   static bool looks_alike(const TemplateModel& model, const FollowParams& params, int from,
                           int to) noexcept;
+  // A reported jump that would make a burst (FollowParams::jump_burst_jumps within jump_burst_s)
+  // is withdrawn and the placement starts again; otherwise its time is kept. Returns whether it
+  // still stands.
+  bool keeps_jump(const FollowParams& params) noexcept;
   // Any other frame.
   void decide(const TemplateModel& model, const FollowParams& params, const float* posterior,
               float total, int previous_state, bool previous_lost, FollowResult& result) noexcept;
@@ -111,6 +120,10 @@ class JumpGate {
   // How long (template time) the estimate has been followed since the last reported jump or the
   // first placement (spells adrift not counted).
   double followed_since_jump_s_ = 0.0;
+  double clock_s_ = 0.0;  // template time since the start (every step, spells included)
+  // When the last jumps were reported (clock_s_), newest last; recent_jumps_ of them held.
+  std::array<double, FollowParams::kMaxJumpBurstJumps> jump_times_{};
+  int recent_jumps_ = 0;
 };
 
 }  // namespace duet
