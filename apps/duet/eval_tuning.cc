@@ -139,6 +139,10 @@ const std::vector<FloatRow>& float_rows() {
        "jump_burst_s: a jump that would be the --jump-burst-jumps-th reported within this time "
        "is not reported and the placement starts again (template seconds)",
        number_between(0.0, 60.0, "s")},
+      {"--jump-catch-up", &FollowParams::jump_catch_up_s,
+       "jump_catch_up_s: a far move forward within the take ending at most this far past the "
+       "band's reach is a catch-up, not a jump (template seconds; 0 for none)",
+       number_between(0.0, 10.0, "s")},
   };
   return rows;
 }

@@ -27,6 +27,7 @@ FollowParams FollowParams::paper() {
   params.jump_settle_mass = 0.0f;
   params.jump_settle_advance_s = 0.0f;
   params.jump_burst_jumps = 0;
+  params.jump_catch_up_s = 0.0f;
   params.noisy_jump_hold_s = 0.0f;
   params.unexplained_jump_hold_s = 0.0f;
   params.limb_outlier_ratio = std::numeric_limits<float>::infinity();
@@ -136,7 +137,8 @@ Status FollowParams::validate(int num_states) const {
                  {"unexplained_jump_hold_after_s", unexplained_jump_hold_after_s, 60, " s"},
                  {"jump_settle_s", jump_settle_s, 10, " s"},
                  {"jump_settle_advance_s", jump_settle_advance_s, 10, " s"},
-                 {"jump_burst_s", jump_burst_s, 60, " s"}};
+                 {"jump_burst_s", jump_burst_s, 60, " s"},
+                 {"jump_catch_up_s", jump_catch_up_s, 10, " s"}};
   for (const auto& b : bounded) {
     if (!(b.value >= 0.0f && b.value <= static_cast<float>(b.max))) {
       return params_error(std::string(b.name) + " must be in [0, " + std::to_string(b.max) + "]" +

@@ -64,8 +64,16 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
   const bool adrift =
       !result.missing && result.state >= 0 && (result.lost || result.in_pause || unexplained);
   clock_s_ += static_cast<double>(std::max(result.steps, 1)) / model.frame_rate_hz();
+  // The place a jump would leave: the previous frame's, or found again after a spell the one
+  // before it, over the spell's steps.
+  const int from = in_spell_ ? steady_state_ : previous_state;
+  const int over = std::max(result.steps, 1) + (in_spell_ ? steps_since_steady_ : 0);
   if (!through_spell(model, params, adrift, result)) {
     decide(model, params, posterior, total, previous_state, previous_lost, result);
+  }
+  // After a lost frame every move past the band stays a jump (decide): the landing is refined.
+  if (result.jumped && !previous_lost && is_catch_up(model, params, from, result.state, over)) {
+    result.jumped = false;
   }
   if (result.jumped && !keeps_jump(params)) result.jumped = false;
   if (result.jumped) followed_since_jump_s_ = 0.0;
@@ -75,6 +83,16 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
     steady_state_ = result.state;
     steps_since_steady_ = 0;
   }
+}
+
+bool JumpGate::is_catch_up(const TemplateModel& model, const FollowParams& params, int from, int to,
+                           int steps) noexcept {
+  if (!(params.jump_catch_up_s > 0.0f) || from < 0 || to <= from ||
+      model.take_of(from) != model.take_of(to)) {
+    return false;
+  }
+  const double past_reach = static_cast<double>(to - from - 2 * steps) / model.frame_rate_hz();
+  return past_reach <= static_cast<double>(params.jump_catch_up_s) + 1e-9;
 }
 
 bool JumpGate::keeps_jump(const FollowParams& params) noexcept {

@@ -78,6 +78,7 @@ TEST(JumpGate, SmallStepsBackAreJitterLargerOnesAndOtherTakesAreJumps) {
   FollowParams params;
   params.jump_hold_s = 0.0f;
   params.jump_tolerance_frames = 6;
+  params.jump_catch_up_s = 0.0f;  // 50 -> 59 is a catch-up otherwise (tested below)
   settle_at_once(params);  // a follower that has settled (tested below)
   JumpGate gate;
   for (const auto& [from, to, jump] : {std::tuple{50, 47, false},
@@ -504,6 +505,7 @@ TEST(JumpGate, APlaceJustLandedOnIsLeftAtOnceOneFollowedForAWhileWaits) {
   params.unexplained_jump_hold_s = 0.3f;                     // 18 frames at 60 Hz
   params.unexplained_jump_hold_after_s = 0.5f;               // 30 frames
   params.jump_burst_jumps = 0;  // three jumps in 1.2 s: no burst here (the next test)
+  params.jump_catch_up_s = 0.0f;                             // 120 -> 130 is a catch-up otherwise
   const float poorly = 2.0f * params.lost_residual_per_dim;  // clean sensor: over the floor
   EXPECT_EQ(JumpGate::hold_s(params, 0.0f, poorly, 0.49), 0.0f);
   EXPECT_EQ(JumpGate::hold_s(params, 0.0f, poorly, 0.5), 0.3f);
@@ -566,7 +568,7 @@ TEST(JumpGate, ABurstOfJumpsIsAPlaceLostFoundAgainWithoutJumps) {
   EXPECT_FALSE(step_to(gate, model, params, previous, 160).jumped);  // not yet settled
   // Six frames forward, sure of them: settled again; the next far move is a jump.
   for (int k = 1; k <= 6; ++k) step_to(gate, model, params, previous, 160 + k);
-  EXPECT_TRUE(step_to(gate, model, params, previous, 180).jumped);
+  EXPECT_TRUE(step_to(gate, model, params, previous, 60).jumped);
   // Jumps further apart than jump_burst_s make no burst.
   for (int round = 0; round < 4; ++round) {
     const int far = previous >= 100 ? 20 : 110;
@@ -583,6 +585,48 @@ TEST(JumpGate, ABurstOfJumpsIsAPlaceLostFoundAgainWithoutJumps) {
   }
 }
 
+TEST(JumpGate, ACatchUpWithinTheTakeIsNoJump) {
+  const TemplateModel model = two_takes();
+  FollowParams params;
+  params.jump_hold_s = 0.0f;
+  params.noisy_jump_hold_s = 0.0f;
+  params.jump_tolerance_frames = 6;
+  params.jump_catch_up_s = 0.25f;  // 15 frames past the band's reach (2 frames a step)
+  settle_at_once(params);
+  const auto move = [&](int from, int to, bool previous_lost = false) {
+    JumpGate gate;
+    const std::vector<float> p = posterior(to);
+    FollowResult r = maximum_at(model, p, to);
+    gate.apply(model, params, p.data(), 1.0f, from, previous_lost, r);
+    EXPECT_EQ(r.state, to);  // the estimate moves whether or not it is a jump
+    return r.jumped;
+  };
+  EXPECT_FALSE(move(50, 58));  // within the band and its tolerance: as before
+  EXPECT_FALSE(move(50, 67));  // 15 frames past the band's reach (50 + 2): a catch-up
+  EXPECT_TRUE(move(50, 68));   // one more: a jump
+  EXPECT_TRUE(move(50, 40));   // back past the tolerance: a jump
+  EXPECT_TRUE(move(90, 105));  // forward into another take: a jump
+  EXPECT_TRUE(move(50, 60, /*previous_lost=*/true));  // a landing refined after a lost frame
+  // Found again after a spell adrift, the catch-up is counted from the place before the spell
+  // over the spell's steps: 10 frames adrift reach 50 + 2 x 11, and 15 frames more.
+  for (const auto& [to, jump] : {std::pair{87, false}, std::pair{88, true}}) {
+    JumpGate gate;
+    int previous = 49;
+    step_to(gate, model, params, previous, 50);
+    for (int k = 0; k < 10; ++k) {
+      const std::vector<float> p = posterior(120);
+      FollowResult r = maximum_at(model, p, 120);
+      r.in_pause = true;
+      gate.apply(model, params, p.data(), 1.0f, previous, false, r);
+      EXPECT_FALSE(r.jumped);
+      previous = r.state;
+    }
+    EXPECT_EQ(step_to(gate, model, params, previous, to).jumped, jump) << to;
+  }
+  params.jump_catch_up_s = 0.0f;
+  EXPECT_TRUE(move(50, 60));
+}
+
 TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
   EXPECT_TRUE(FollowParams{}.validate(200));
   const float nan = std::nanf("");
@@ -595,6 +639,7 @@ TEST(FollowParams, ASettlePeriodOrNoisyHoldOutOfRangeIsRejected) {
        [](FollowParams& p, float v) { p.unexplained_jump_hold_after_s = v; }},
       {"jump_settle_advance_s", [](FollowParams& p, float v) { p.jump_settle_advance_s = v; }},
       {"jump_burst_s", [](FollowParams& p, float v) { p.jump_burst_s = v; }},
+      {"jump_catch_up_s", [](FollowParams& p, float v) { p.jump_catch_up_s = v; }},
   };
   for (const auto& [name, set] : fields) {
     for (const float bad : {-1.0f, nan, 1000.0f}) {

@@ -268,6 +268,15 @@ struct FollowParams {
   int jump_burst_jumps = 3;
   float jump_burst_s = 2.0f;
   static constexpr int kMaxJumpBurstJumps = 8;
+  // A catch-up is no jump: a far move forward within the estimate's take that ends at most
+  // jump_catch_up_s (template time) past the band's reach (TemplateModel::is_jump over the steps
+  // since the place it leaves) is the follower catching up with a dancer it lagged (its tempo
+  // behind the dancer's, or a hold that kept the old place while the maximum ran ahead), not the
+  // dancer leaving their figure: the estimate moves there, the partner blends to it as to any far
+  // move (PartnerPlace), and FollowResult::jumped stays false. Improvised jumps go to another
+  // part of the dance. Three points on the CMU handshake rig: 14 of 42 false jumps (every take,
+  // seed 1). docs/evaluation.md, "A catch-up is no jump". 0: every far move can be a jump.
+  float jump_catch_up_s = 0.5f;
   // Outlier gate: a frame whose evidence would hand the pause state the majority right after a
   // frame that was followed (the first placement settled, that frame neither lost nor itself an
   // outlier) is taken for an outlier of the sensor: its evidence is set aside (transitions only,

@@ -22,7 +22,8 @@
 // is reported (half the false jumps left at 4 degrees per axis were those, and nearly all of an
 // inertial suit's, whose standing start sat on other takes' standing frames).
 // A burst of jumps (FollowParams::jump_burst_jumps within jump_burst_s) is a place lost: the jump
-// that would complete it is withdrawn and the placement starts again as at the start.
+// that would complete it is withdrawn and the placement starts again as at the start. A catch-up
+// (a move forward within the take, at most jump_catch_up_s past the band's reach) is no jump.
 #pragma once
 
 #include <array>
@@ -100,6 +101,10 @@ class JumpGate {
   // a move between them is no jump.
   static bool looks_alike(const TemplateModel& model, const FollowParams& params, int from,
                           int to) noexcept;
+  // Whether a move from `from` to `to` over `steps` template steps is a catch-up
+  // (FollowParams::jump_catch_up_s).
+  static bool is_catch_up(const TemplateModel& model, const FollowParams& params, int from, int to,
+                          int steps) noexcept;
   // A reported jump that would make a burst (FollowParams::jump_burst_jumps within jump_burst_s)
   // is withdrawn and the placement starts again; otherwise its time is kept. Returns whether it
   // still stands.

@@ -18,7 +18,9 @@ struct FollowResult {
   float confidence = 0.0f;
   float window_mass = 0.0f;  // that posterior mass before calibration
   // The estimate moved by something other than 0..2n frames forward within its take (n = steps),
-  // or changed take. False on the first frame after reset().
+  // or changed take: the dancer left their figure for another part of the dance. False on the
+  // first frame after reset(); for the HMM followers also for the moves JumpGate does not call a
+  // jump (jitter back, a catch-up forward within the take, the first placement, a burst).
   bool jumped = false;
   bool lost = false;      // no template frame explains the input (see FollowParams)
   bool in_pause = false;  // the pause state holds most of the posterior mass
