@@ -109,10 +109,7 @@ bool JumpGate::keeps_jump(const FollowParams& params) noexcept {
   if (recent_jumps_ + 1 >= params.jump_burst_jumps) {
     // The place is lost: find it again as at the start, with no jumps on the way.
     recent_jumps_ = 0;
-    settled_s_ = 0.0;
-    followed_since_jump_s_ = 0.0;
-    forget_advance();
-    forget_candidate();
+    restart_placement();
     return false;
   }
   jump_times_[static_cast<std::size_t>(recent_jumps_++)] = clock_s_;
@@ -157,10 +154,7 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
   if (!settled(params)) {
     // Still finding the first place: take the new one and start settling there.
     result.jumped = false;
-    settled_s_ = 0.0;
-    followed_since_jump_s_ = 0.0;
-    forget_advance();
-    forget_candidate();
+    restart_placement();
     return;
   }
   const float hold = hold_s(params, result.sensor_noise_per_dim, result.best_distance_per_dim,

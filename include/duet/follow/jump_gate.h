@@ -89,6 +89,14 @@ class JumpGate {
     advance_origin_ = -1;
     advance_furthest_ = -1;
   }
+  // The placement starts (again) at the current place: not settled, no candidate, no time
+  // followed since a jump.
+  void restart_placement() noexcept {
+    settled_s_ = 0.0;
+    followed_since_jump_s_ = 0.0;
+    forget_advance();
+    forget_candidate();
+  }
   // A sure frame within reach moved the estimate from `from` to `to`: advanced_s_ is how far
   // forward of where the count began the estimate has been. Jitter back and forth adds nothing
   // (summing each forward step did: a standing start jittering a frame or two about one place
