@@ -37,7 +37,7 @@ bool JumpGate::looks_alike(const TemplateModel& model, const FollowParams& param
 }
 
 bool JumpGate::through_spell(const TemplateModel& model, const FollowParams& params, bool adrift,
-                             FollowResult& result) noexcept {
+                             int over, FollowResult& result) noexcept {
   const bool unknown = result.missing || result.state < 0;
   // Adrift before any steady frame is a spell too: the maximum wandered from the first frames of
   // a performance that began unexplained (three points' `improv-library`: 17 false jumps in its
@@ -48,11 +48,9 @@ bool JumpGate::through_spell(const TemplateModel& model, const FollowParams& par
   if (adrift || unknown) return true;
   // Found again: a jump if out of reach of the place before the spell over the time it lasted
   // (a few frames back from it is jitter, as on any frame).
-  result.jumped =
-      settled(params) &&
-      model.is_jump(steady_state_, result.state, steps_since_steady_ + std::max(result.steps, 1),
-                    params.jump_tolerance_frames) &&
-      !looks_alike(model, params, steady_state_, result.state);
+  result.jumped = settled(params) &&
+                  model.is_jump(steady_state_, result.state, over, params.jump_tolerance_frames) &&
+                  !looks_alike(model, params, steady_state_, result.state);
   in_spell_ = false;
   forget_candidate();
   return true;
@@ -68,7 +66,7 @@ void JumpGate::apply(const TemplateModel& model, const FollowParams& params, con
   // before it, over the spell's steps.
   const int from = in_spell_ ? steady_state_ : previous_state;
   const int over = std::max(result.steps, 1) + (in_spell_ ? steps_since_steady_ : 0);
-  if (!through_spell(model, params, adrift, result)) {
+  if (!through_spell(model, params, adrift, over, result)) {
     decide(model, params, posterior, total, previous_state, previous_lost, result);
   }
   // After a lost frame every move past the band stays a jump (decide): the landing is refined.
@@ -91,7 +89,8 @@ bool JumpGate::is_catch_up(const TemplateModel& model, const FollowParams& param
       model.take_of(from) != model.take_of(to)) {
     return false;
   }
-  const double past_reach = static_cast<double>(to - from - 2 * steps) / model.frame_rate_hz();
+  const double past_reach =
+      static_cast<double>(to - from - TemplateModel::band_reach(steps)) / model.frame_rate_hz();
   return past_reach <= static_cast<double>(params.jump_catch_up_s) + 1e-9;
 }
 
@@ -174,7 +173,8 @@ void JumpGate::decide(const TemplateModel& model, const FollowParams& params,
   // The old place's reach: where its continuation would be.
   const int take = model.take_of(previous_state);
   const int begin = std::max(model.take_begin(take), previous_state - tolerance);
-  const int end = std::min(model.take_end(take), previous_state + 2 * steps + tolerance + 1);
+  const int end = std::min(model.take_end(take),
+                           previous_state + TemplateModel::band_reach(steps) + tolerance + 1);
   double old_mass = 0.0;
   int best = begin;  // the most likely state there
   for (int i = begin; i < end; ++i) {

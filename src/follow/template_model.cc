@@ -224,7 +224,7 @@ int TemplateModel::take_of(int state) const {
 bool TemplateModel::is_jump(int from, int to, int steps, int tolerance) const noexcept {
   if (from < 0 || to < 0) return false;
   const int moved = to - from;
-  if (moved < -tolerance || moved > 2 * steps + tolerance) return true;
+  if (moved < -tolerance || moved > band_reach(steps) + tolerance) return true;
   return take_of(from) != take_of(to);
 }
 

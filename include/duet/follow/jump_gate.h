@@ -102,8 +102,9 @@ class JumpGate {
   // (summing each forward step did: a standing start jittering a frame or two about one place
   // settled there).
   void note_advance(const TemplateModel& model, int from, int to) noexcept;
-  // While adrift, and on the frame found again: decides the frame and returns true.
-  bool through_spell(const TemplateModel& model, const FollowParams& params, bool adrift,
+  // While adrift, and on the frame found again: decides the frame and returns true. `over`: the
+  // template steps since the frame before the spell (this frame's included).
+  bool through_spell(const TemplateModel& model, const FollowParams& params, bool adrift, int over,
                      FollowResult& result) noexcept;
   // Whether the template rows of two states look alike (FollowParams::jump_alike_distance_per_dim):
   // a move between them is no jump.

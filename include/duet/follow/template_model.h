@@ -85,6 +85,8 @@ class TemplateModel {
   // where a step back by up to `tolerance` frames counts as no jump (a follower's jitter). False
   // when either state is -1 (no place yet).
   bool is_jump(int from, int to, int steps, int tolerance = 0) const noexcept;
+  // The furthest forward the band reaches over `steps` template steps: a skip (two frames) each.
+  static constexpr int band_reach(int steps) noexcept { return 2 * steps; }
 
   // The posture dimensions grouped by limb (FeatureSpec::limb_dims): the emission bounds the
   // share of the farthest (FollowParams::limb_outlier_ratio). Each dimension is below
