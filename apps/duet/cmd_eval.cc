@@ -48,6 +48,7 @@ struct EvalArgs {
   std::string trace_case = "improv-pause";
   bool no_partner_metrics = false;
   bool beam = false;
+  bool no_lost_confidence = false;
   bool noise_sweep = false;
   bool suit_sweep = false;
   bool body_sweep = false;
@@ -207,6 +208,7 @@ int run_eval(EvalArgs& args) {
   }
   options.partner_metrics = !args.no_partner_metrics;
   options.beam = args.beam;
+  options.lost_confidence = !args.no_lost_confidence;
   options.takes = args.takes;
   options.seed = args.seed;
   options.trace_case = args.plots_dir.empty() ? "" : args.trace_case;
@@ -552,6 +554,9 @@ Command register_eval(CLI::App& app) {
       "best distance, sensor noise, lost, the tracker's own confidence, the rig's "
       "posture offset and its seconds learnt) as CSV, e.g. for "
       "scripts/fit_confidence_calibration.py and scripts/fit_young_offset_confidence.py");
+  app.add_flag("--no-lost-confidence", args->no_lost_confidence,
+               "Report a lost frame's confidence as it is before the lost frames' calibration "
+               "(the input of scripts/fit_lost_confidence.py; docs/follower.md)");
   app.add_option("--plots", args->plots_dir,
                  "Write PNG plots (needs gnuplot) into this directory: accuracy.png, trace.png, "
                  "reliability.png (confidence against the share within 100 ms, per case)");

@@ -560,8 +560,10 @@ Result<EvalReport> run_evaluation(const DuetLibrary& library, const DuetLibrary*
         Result<std::unique_ptr<Tracker>> tracker =
             make_eval_tracker(trackers[k], lib.model(), options, lib.candidate_index());
         if (!tracker) return Error{label + ": " + tracker.error().message};
+        PostureBiasParams bias;
+        bias.lost_confidence = options.lost_confidence;
         Result<std::vector<FrameEstimate>> estimates =
-            follow_performance(lib, performance, std::move(tracker).value());
+            follow_performance(lib, performance, std::move(tracker).value(), bias);
         if (!estimates) return Error{label + ": " + estimates.error().message};
         MetricsAccumulator one(options.metrics);
         one.add(performance, estimates.value(), &lib_look_alikes);

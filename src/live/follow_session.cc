@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <limits>
 
+#include "duet/live/lost_confidence.h"
 #include "duet/live/young_offset_confidence.h"
 
 namespace duet {
@@ -90,6 +91,9 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
     result.confidence =
         YoungOffsetConfidence::apply(result.confidence, result.rig_offset,
                                      result.rig_offset_learnt_s, extractor_.spec().input_points);
+  }
+  if (result.lost && bias_.params().lost_confidence) {
+    result.confidence = LostConfidence::apply(result.confidence, extractor_.spec().input_points);
   }
   if (library_->grown()) report_captured_place(result);
   return result;

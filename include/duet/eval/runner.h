@@ -117,6 +117,9 @@ struct EvalOptions {
   // Keep every scored frame's estimate and error in EvalRow::frames (for --frames-csv: fitting
   // and checking the confidence calibration and the lost decision offline).
   bool keep_frames = false;
+  // Whether a lost frame's confidence goes through LostConfidence (PostureBiasParams::
+  // lost_confidence); false gives scripts/fit_lost_confidence.py the confidence before it.
+  bool lost_confidence = true;
 };
 
 // One scored (not pause) frame of a performance, when EvalOptions::keep_frames.

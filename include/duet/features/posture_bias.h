@@ -98,6 +98,9 @@ struct PostureBiasParams {
   // young (young_offset_confidence.h): at a standing start on another rig the follower matched
   // another take's stance at 0.9+ confidence and was right on 30-60 % of those frames.
   bool young_offset_confidence = true;
+  // ... and then a lost frame's confidence through LostConfidence (lost_confidence.h): three
+  // points on another rig claimed 0.9 and more on lost frames right 42-56 % of the time.
+  bool lost_confidence = true;
   // While the pause state holds the input, FollowSession looks for an offset beyond the learning
   // gate (offset_search.h): a suit calibrated 8 degrees off per joint was lost for 15 s.
   OffsetSearchParams search;

@@ -1,0 +1,49 @@
+#!/usr/bin/env python3
+"""Fit the confidence table of lost frames (src/live/lost_confidence.cc) offline.
+
+Reads the per-frame CSVs of `duet eval --no-lost-confidence --frames-csv` (columns error_ms,
+confidence, lost; tracker hmm), keeps the frames flagged lost, fits a monotone (isotonic) map from
+the session's confidence (after the young-offset table, before this one: hence
+--no-lost-confidence) to the share of those frames within 100 ms, and prints the C++ table to
+paste.
+
+Whole-body and three-point input have tables of their own:
+  scripts/fit_lost_confidence.py --full full_*.csv --head-hands points_*.csv
+Fit on performances other than the ones reported on (other seeds), every rig (`--rigs all`).
+"""
+import argparse
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from fit_confidence_calibration import hmm_frames, monotone_map  # noqa: E402
+
+# Must match src/live/lost_confidence.cc.
+KNOTS = [k / 10.0 for k in range(10)] + [0.95, 0.99, 1.0]
+MIN_FRAMES = 1000
+
+
+def table(name, paths):
+    points = [(float(row["confidence"]), correct) for row, correct in hmm_frames(paths)
+              if row["lost"] == "1"]
+    if len(points) < MIN_FRAMES:
+        sys.exit(f"{name}: {len(points)} lost frames, fewer than {MIN_FRAMES}: add performances")
+    values = monotone_map(points, KNOTS)
+    right = sum(c for _, c in points) / len(points)
+    claimed = sum(x for x, _ in points) / len(points)
+    print(f"    // {name}: fitted on " + ", ".join(p.rsplit("/", 1)[-1] for p in paths))
+    print(f"    // {len(points)} lost frames, {claimed:.3f} claimed, {right:.3f} right")
+    print(f"    {{{', '.join(f'{v:.4f}f' for v in values)}}},")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--full", nargs="+", required=True, help="whole-body frames CSVs")
+    parser.add_argument("--head-hands", nargs="+", required=True, help="three-point frames CSVs")
+    args = parser.parse_args()
+    table("whole body", args.full)
+    table("head and hands", args.head_hands)
+
+
+if __name__ == "__main__":
+    main()
