@@ -108,6 +108,12 @@ TEST(CliFollowRigs, DancingThePartnersPartIsNamedAsTheLikelyCause) {
                data_path("cmu-salsa/bvh/61/61_03_scaled.bvh") + " --input-fps 60");
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("--role partner"), std::string::npos) << r.output;
+  // The same against a grown library: the other role is asked of the captured takes.
+  const testing::CommandResult grown =
+      run_duet("follow" + two_pairs() + " --grow-library 40000 --input " +
+               data_path("cmu-salsa/bvh/61/61_03_scaled.bvh") + " --input-fps 60");
+  EXPECT_EQ(grown.exit_code, 3) << grown.output;
+  EXPECT_NE(grown.output.find("--role partner"), std::string::npos) << grown.output;
 }
 
 // The first `frames` frames of take `trial`'s leader, its world turned so that `up` is up, written
