@@ -222,6 +222,51 @@ BENCHMARK(BM_BeamStepAtScale)
     ->Iterations(6000)
     ->Unit(benchmark::kMicrosecond);
 
+// Input no part of the library explains (a user standing about, another dance): the performance
+// above moved half a standard deviation off on every feature, so every frame is lost. The beam
+// cannot settle "lost" from its candidates (every state within the lost distance must be ruled
+// out, and the 8-dimensional bound is too loose to), so such frames take the full step: the
+// counters show what a lost user costs at each size (docs/follower.md "Beam mode").
+void BM_BeamStepWhileLostAtScale(benchmark::State& state) {
+  const TemplateModel* model = library_of(static_cast<int>(state.range(0)));
+  if (model == nullptr) {
+    state.SkipWithError("salsa data not found");
+    return;
+  }
+  BeamFollower beam = BeamFollower::create(*model, {}).value();
+  std::vector<std::vector<float>> inputs =
+      performance(*salsa_model(), static_cast<int>(state.max_iterations));
+  for (std::vector<float>& phi : inputs) {
+    for (float& v : phi) v += 0.5f;
+  }
+  std::vector<double> cpu_us;
+  cpu_us.reserve(inputs.size());
+  long long lost = 0;
+  std::size_t q = 0;
+  for (auto _ : state) {
+    const double cpu_start = thread_cpu_us();
+    const FollowResult result = beam.step(inputs[q], 1.0 / 60);
+    cpu_us.push_back(thread_cpu_us() - cpu_start);
+    lost += result.lost ? 1 : 0;
+    q = (q + 1) % inputs.size();
+  }
+  state.counters["states"] = model->num_states();
+  state.counters["cpu_median_us"] = percentile(cpu_us, 50);
+  state.counters["cpu_p99_us"] = percentile(cpu_us, 99);
+  state.counters["lost_pct"] = 100.0 * static_cast<double>(lost) /
+                               static_cast<double>(std::max<std::size_t>(1, cpu_us.size()));
+  state.counters["full_step_pct"] = 100.0 * static_cast<double>(beam.context().full_steps()) /
+                                    static_cast<double>(std::max(1LL, beam.context().frames()));
+}
+BENCHMARK(BM_BeamStepWhileLostAtScale)
+    ->Arg(kRealStates)
+    ->Iterations(2000)
+    ->Arg(100000)
+    ->Iterations(500)
+    ->Arg(1000000)
+    ->Iterations(100)
+    ->Unit(benchmark::kMicrosecond);
+
 // The memory floor of the exact step: reading the features once per frame. An AVX2 sum (four
 // accumulators) over a buffer the size of the features at 27,495 states (5.5 MB, in L3) and at 1M
 // states (200 MB, from DRAM); bytes_per_second gives the floor in ns per state (200 bytes at
