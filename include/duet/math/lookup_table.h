@@ -1,7 +1,7 @@
 // Reading fitted calibration tables: which band a value falls in, and a piecewise-linear curve
-// through knots. ConfidenceCalibration and YoungOffsetConfidence both map a confidence through
-// such tables (fitted by scripts/fit_confidence_calibration.py and
-// scripts/fit_young_offset_confidence.py).
+// through knots. ConfidenceCalibration, YoungOffsetConfidence and LostConfidence map a confidence
+// through such tables (fitted by scripts/fit_confidence_calibration.py,
+// scripts/fit_young_offset_confidence.py and scripts/fit_lost_confidence.py).
 #pragma once
 
 #include <algorithm>
