@@ -39,6 +39,12 @@ Status BeamParams::validate() const {
   if (!(outside_mass_tolerance >= 0.0f && std::isfinite(outside_mass_tolerance))) {
     return fail("outside_mass_tolerance must be finite and >= 0");
   }
+  if (!(lost_full_step_s >= 0.0 && std::isfinite(lost_full_step_s))) {
+    return fail("lost_full_step_s must be finite and >= 0");
+  }
+  if (!(lost_spell_before_s >= 0.0 && std::isfinite(lost_spell_before_s))) {
+    return fail("lost_spell_before_s must be finite and >= 0");
+  }
   return Ok{};
 }
 
@@ -81,6 +87,8 @@ void BeamContext::reset() noexcept {
   background_ = 0.0f;
   full_next_ = true;
   full_steps_ = 0;
+  deferred_steps_ = 0;
+  since_full_s_ = 0.0;
   history_.reset();
   frame_noise_ = 0.0f;
 }
@@ -192,8 +200,8 @@ BeamForward::CandidateSet BeamForward::candidates_within(const float* phi, float
 }
 
 bool BeamForward::sparse_emission(const float* phi, const CandidateSet& candidates,
-                                  BeamContext& context, FollowResult& result,
-                                  float& settling_bound) const noexcept {
+                                  BeamContext& context, FollowResult& result, float& settling_bound,
+                                  bool must_settle) const noexcept {
   const TemplateModel& model = *exact_.model_;
   const int num_states = model.num_states();
   const FollowParams& params = exact_.params_;
@@ -296,7 +304,7 @@ bool BeamForward::sparse_emission(const float* phi, const CandidateSet& candidat
       needed = std::max(needed, bound_for(1.0, 2.0 * pause - sum));
     }
   }
-  if (needed > 0.0f) {
+  if (needed > 0.0f && must_settle) {
     // A little beyond, so that a search to it settles the frame (the tests above are strict).
     settling_bound = needed < FLT_MAX / 2 ? needed * 1.001f + 1e-6f : FLT_MAX;
     return false;
@@ -332,18 +340,53 @@ bool BeamForward::sparse_emission(const float* phi, const CandidateSet& candidat
   return true;
 }
 
-bool BeamForward::sparse_step(const float* phi, BeamContext& context,
-                              FollowResult& result) const noexcept {
+bool BeamForward::sparse_step(const float* phi, BeamContext& context, FollowResult& result,
+                              bool accept_unsettled) const noexcept {
   float settling_bound = FLT_MAX;
   if (sparse_emission(phi, nearest_candidates(phi, beam_.jump_candidates, context), context, result,
-                      settling_bound) ||
-      sparse_emission(phi, nearest_candidates(phi, beam_.wide_jump_candidates, context), context,
-                      result, settling_bound)) {
+                      settling_bound)) {
     return true;
+  }
+  const CandidateSet wide = nearest_candidates(phi, beam_.wide_jump_candidates, context);
+  if (sparse_emission(phi, wide, context, result, settling_bound)) return true;
+  if (accept_unsettled) {
+    return sparse_emission(phi, wide, context, result, settling_bound, false);
   }
   if (settling_bound >= FLT_MAX) return false;
   const CandidateSet within = candidates_within(phi, settling_bound, context);
   return within.found >= 0 && sparse_emission(phi, within, context, result, settling_bound);
+}
+
+bool BeamForward::between_full_steps(double dt_s, const BeamContext& context) const noexcept {
+  return beam_.lost_full_step_s > 0.0 && context.history_.previous_lost &&
+         context.history_.previous_state >= 0 &&
+         context.history_.lost_spell_s + 1e-9 >= beam_.lost_spell_before_s &&
+         context.since_full_s_ + dt_s < beam_.lost_full_step_s;
+}
+
+bool BeamForward::unexplained_nearby(const float* phi, BeamContext& context,
+                                     FollowResult& result) const noexcept {
+  const TemplateModel& model = *exact_.model_;
+  const FollowParams& params = exact_.params_;
+  const CandidateSet nearest = nearest_candidates(phi, beam_.jump_candidates, context);
+  const float unexplained_sq = exact_.noise_levels_.lost_distance_sq(
+      context.frame_noise_, context.history_.explained_residual.level());
+  float best_plain = FLT_MAX;
+  // The place reported before, then the candidates, measured as the lost test measures.
+  for (int k = -1; k < nearest.found; ++k) {
+    const int state = k < 0 ? context.history_.previous_state
+                            : static_cast<int>(context.candidates_[static_cast<std::size_t>(k)]);
+    const float plain = follow_detail::state_emission_distance(model, phi, state,
+                                                               follow_detail::emission_caps(params))
+                            .plain;
+    best_plain = std::min(best_plain, plain);
+    if (follow_detail::lost_test_distance(model, params, phi, plain, state) <= unexplained_sq) {
+      return false;
+    }
+  }
+  result.best_distance_per_dim = best_plain / static_cast<float>(model.num_dims());
+  result.lost = best_plain > exact_.noise_levels_.lost_ceiling_sq();
+  return true;
 }
 
 void BeamForward::renormalise_without_evidence(BeamContext& context) const noexcept {
@@ -437,17 +480,7 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   result.steps = exact_.steps_for(dt_s);
   const BandProbabilities band = exact_.band_for(context.history_.tempo.tempo());
 
-  bool dense = context.full_next_;
-  if (dense) {
-    materialise(context);
-    for (int s = 0; s < result.steps; ++s) {
-      exact_.transition(context.alpha_.data(), band, context.scratch_.data());
-      context.alpha_.swap(context.scratch_);
-    }
-  } else {
-    for (int s = 0; s < result.steps; ++s) sparse_transition(band, context);
-  }
-
+  // The sensor's noise and the filtered features (neither depends on the posterior).
   context.history_.sensor_noise.update(features, dt_s, !result.missing);
   result.sensor_noise_per_dim = context.history_.sensor_noise.variance_per_dim();
   context.frame_noise_ = result.sensor_noise_per_dim;
@@ -455,9 +488,35 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   const float* phi = nullptr;  // the filtered features, while the frame has them
   if (!result.missing) {
     phi = context.history_.noise_filter.apply(features, dt_s, context.frame_noise_).data();
+  }
+
+  // In a spell lost, between full steps (BeamParams::lost_full_step_s): with no beam (the
+  // posterior spread wide), a frame that neither the place reported before nor the nearest jump
+  // candidates explain weighs no evidence; with a beam, the emission over the beam and the wide
+  // candidates finishes the frame although the states left out could change a decision.
+  const bool spell = phi != nullptr && between_full_steps(dt_s, context);
+  const bool deferred = spell && context.full_next_ && unexplained_nearby(phi, context, result);
+  bool dense = context.full_next_ && !deferred;
+  if (dense) {
+    materialise(context);
+    const int steps = context.deferred_steps_ + result.steps;
+    for (int s = 0; s < steps; ++s) {
+      exact_.transition(context.alpha_.data(), band, context.scratch_.data());
+      context.alpha_.swap(context.scratch_);
+    }
+    context.deferred_steps_ = 0;
+  } else if (deferred) {
+    context.deferred_steps_ += result.steps;  // the dense posterior waits for the next full step
+  } else {
+    for (int s = 0; s < result.steps; ++s) sparse_transition(band, context);
+  }
+
+  if (deferred) {
+    // Lost: decided by unexplained_nearby.
+  } else if (!result.missing) {
     // Uncertain with the usual candidates: widen the search; still uncertain, the beam may have
     // lost the dancer: finish the frame with the full step.
-    if (!dense && !sparse_step(phi, context, result)) {
+    if (!dense && !sparse_step(phi, context, result, spell)) {
       materialise(context);
       dense = true;
     }
@@ -474,8 +533,16 @@ FollowResult BeamForward::step(std::span<const float> features, double dt_s,
   }
 
   const float* alpha = context.alpha_.data();
-  if (dense) {
+  context.since_full_s_ += dt_s > 0.0 && std::isfinite(dt_s) ? dt_s : 0.0;
+  if (deferred) {
+    // Lost, at the place reported before (the posterior is the last full step's).
+    follow_detail::describe_state(model, alpha, 1.0f, context.history_.previous_state,
+                                  params.confidence_window_frames, result);
+    result.in_pause = true;
+    result.jumped = false;
+  } else if (dense) {
     ++context.full_steps_;
+    context.since_full_s_ = 0.0;
     follow_detail::decide(model, alpha, 1.0f, alpha[num_states], context.history_.previous_state,
                           result.steps, params.confidence_window_frames, result);
   } else {

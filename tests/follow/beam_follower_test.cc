@@ -116,10 +116,56 @@ TEST_F(BeamTest, AFarDancerTakesTheFullStepAndIsFoundAgain) {
   EXPECT_GT(beam.context().beam_size(), 0);
 }
 
+TEST_F(BeamTest, ALostSpellTakesTheFullStepOncePerIntervalAndIsFoundAgainAtOnce) {
+  // Four seconds far from every state: lost on every frame; once lost for
+  // BeamParams::lost_spell_before_s (2 s), the full step (every state's emission) only once per
+  // lost_full_step_s (0.5 s), not on every frame as when exact.
+  BeamParams every_frame;
+  every_frame.lost_full_step_s = 0.0;
+  BeamFollower spaced = BeamFollower::create(model_, {}).value();
+  BeamFollower exact_beam = BeamFollower::create(model_, {}, every_frame).value();
+  HmmFollower exact = HmmFollower::create(model_, {}).value();
+  for (std::size_t t = 0; t < 60; ++t) {
+    spaced.step(inputs_[t], 1.0 / 60);
+    exact_beam.step(inputs_[t], 1.0 / 60);
+    exact.step(inputs_[t], 1.0 / 60);
+  }
+  const long long spaced_before = spaced.context().full_steps();
+  const long long exact_before = exact_beam.context().full_steps();
+  const std::vector<float> far(kDims, 50.0f);
+  constexpr int kFarFrames = 240;
+  long long spaced_at_3s = 0;
+  for (int t = 0; t < kFarFrames; ++t) {
+    if (t == 180) spaced_at_3s = spaced.context().full_steps();
+    const FollowResult s = spaced.step(far, 1.0 / 60);
+    const FollowResult e = exact.step(far, 1.0 / 60);
+    exact_beam.step(far, 1.0 / 60);
+    EXPECT_EQ(s.lost, e.lost) << "far frame " << t;
+    EXPECT_TRUE(std::isfinite(s.confidence) && std::isfinite(s.log_likelihood));
+  }
+  EXPECT_GE(exact_beam.context().full_steps() - exact_before, kFarFrames - 4);
+  EXPECT_GE(spaced_at_3s - spaced_before, 100) << "exact for the first 2 s";
+  EXPECT_LE(spaced.context().full_steps() - spaced_at_3s, 3) << "one per 0.5 s in the last 1 s";
+  // Back on the template: the first frames find the dancer as the exact step does.
+  int differing = 0;
+  for (std::size_t t = 60; t < 200; ++t) {
+    const FollowResult s = spaced.step(inputs_[t], 1.0 / 60);
+    exact_beam.step(inputs_[t], 1.0 / 60);
+    const FollowResult e = exact.step(inputs_[t], 1.0 / 60);
+    if (t >= 63) {
+      EXPECT_EQ(s.state, e.state) << "frame " << t;
+      EXPECT_EQ(s.lost, e.lost) << "frame " << t;
+    }
+    differing += s.state != e.state ? 1 : 0;
+  }
+  EXPECT_LE(differing, 3);
+}
+
 TEST_F(BeamTest, ABeamTooWideFallsBackToTheFullStepWithTheSameStates) {
   HmmFollower exact = HmmFollower::create(model_, {}).value();
   BeamParams narrow;
   narrow.max_states = 1;  // every beam is too wide: the full step on every frame
+  narrow.lost_full_step_s = 0.0;  // even while lost
   BeamFollower beam = BeamFollower::create(model_, {}, narrow).value();
   for (std::size_t t = 0; t < inputs_.size(); ++t) {
     ASSERT_EQ(exact.step(inputs_[t], 1.0 / 60).state, beam.step(inputs_[t], 1.0 / 60).state)
@@ -209,6 +255,11 @@ TEST(BeamParamsTest, RejectsBadParameters) {
   bad = BeamParams{};
   bad.prune_ratio = std::numeric_limits<float>::quiet_NaN();
   EXPECT_FALSE(BeamFollower::create(model, {}, bad));
+  bad = BeamParams{};
+  bad.lost_full_step_s = -1.0;
+  Result<BeamFollower> negative = BeamFollower::create(model, {}, bad);
+  ASSERT_FALSE(negative);
+  EXPECT_NE(negative.error().message.find("lost_full_step_s"), std::string::npos);
   // A model of velocities alone has no posture for the index.
   const TemplateModel velocities = test::make_model({100}, 8, 1, 60.0, 8);
   Result<BeamFollower> no_posture = BeamFollower::create(velocities, {});

@@ -22,6 +22,8 @@
 //     frame's log-likelihood misses it.
 //   - States whose posterior falls below prune_ratio times the maximum leave the beam.
 // The first frame after reset() is a full step (the initial distribution is uniform).
+// One departure from the exact step, for cost: a spell lost for long takes the full step only
+// now and then (BeamParams::lost_full_step_s).
 // Only for the jump HMM: a left-to-right HMM (no pause state) recovers from a wrong place only
 // through the little mass it keeps everywhere, which a beam drops (measured: up to 2.4 points of
 // accuracy apart even at a prune ratio of 1e-20), so create() rejects it.
@@ -65,6 +67,18 @@ struct BeamParams {
   // confidence window exceeds this fraction of the kept mass (or could be the maximum, or could
   // turn the pause state's majority).
   float outside_mass_tolerance = 1e-3f;
+  // While a spell lost lasts, the full step is taken at most once per lost_full_step_s of input
+  // time, once the input has been lost by distance for lost_spell_before_s (a dance flagged lost
+  // for a moment, three points on another rig, stays exact). Between full steps, with a beam,
+  // the emission over the beam and the wide candidates finishes the frame although the states
+  // left out could change a decision; with none, a frame that neither the place reported before
+  // nor the nearest candidates explain weighs no evidence, as a missing frame (its transitions
+  // wait for the next full step). Deciding "lost" exactly needs every state within the lost
+  // distance ruled out, which the index's bound cannot do: a lost user took the full step on
+  // every frame (14 ms at 1M states; docs/follower.md "Beam mode"). lost_full_step_s 0: every
+  // such frame takes the full step.
+  double lost_full_step_s = 0.5;
+  double lost_spell_before_s = 2.0;
 
   Status validate() const;
 
@@ -114,6 +128,10 @@ class BeamContext {
   std::vector<float> candidate_d2_;
   float background_ = 0.0f;  // resumed mass per unit of R_i, not yet in alpha_
   bool full_next_ = true;
+  // Lost between full steps (BeamParams::lost_full_step_s): the template steps whose transitions
+  // wait for the next full step, and the input time since the last one.
+  int deferred_steps_ = 0;
+  double since_full_s_ = 0.0;
   long long full_steps_ = 0;
   // Tempo, jump gate, sensor noise (which scales the pause level and lost distance), input
   // filter and explained residual, as HmmForward's.
@@ -162,12 +180,18 @@ class BeamForward {
   // The emission over the beam and the candidates, with the usual, then the wide candidates,
   // then the states within the bound that settles the frame; false when none settles it and the
   // full step must finish the frame.
-  bool sparse_step(const float* phi, BeamContext& context, FollowResult& result) const noexcept;
+  // accept_unsettled (a spell lost between full steps): the wide candidates' emission finishes
+  // the frame even when the states left out could change a decision (no radius search, no full
+  // step).
+  bool sparse_step(const float* phi, BeamContext& context, FollowResult& result,
+                   bool accept_unsettled = false) const noexcept;
   // Emission over the beam and these candidates; false (context unchanged but for next_) when
   // the states left out could change a decision. settling_bound is then the bound beyond which
   // they could not (FLT_MAX: none).
+  // must_settle false (a spell lost between full steps): accepted whatever the states left out.
   bool sparse_emission(const float* phi, const CandidateSet& candidates, BeamContext& context,
-                       FollowResult& result, float& settling_bound) const noexcept;
+                       FollowResult& result, float& settling_bound,
+                       bool must_settle = true) const noexcept;
   // Adds the background to every state (the dense prediction of the full step).
   void materialise(BeamContext& context) const noexcept;
   // A frame without evidence (missing, or an outlier set aside): the beam, the background and
@@ -175,6 +199,12 @@ class BeamForward {
   void renormalise_without_evidence(BeamContext& context) const noexcept;
   // After a full step: the states above the prune threshold become the beam, unless too many.
   void rebuild_beam(BeamContext& context) const noexcept;
+  // Whether the frame falls in a spell lost between full steps (BeamParams::lost_full_step_s).
+  bool between_full_steps(double dt_s, const BeamContext& context) const noexcept;
+  // Whether neither the place reported before nor any of the nearest jump candidates is within
+  // the lost distance; if so, sets result's best distance and fixed-ceiling lost flag.
+  bool unexplained_nearby(const float* phi, BeamContext& context,
+                          FollowResult& result) const noexcept;
   int sparse_argmax(const BeamContext& context) const noexcept;
 
   HmmForward exact_;
