@@ -11,6 +11,7 @@ Fit on performances other than the ones reported on (other takes and seed), e.g.
       --no-partner-metrics --takes 2,4,9,11 --seed 7 --noise-deg $n --frames-csv train_$n.csv; done
   scripts/fit_confidence_calibration.py train_*.csv
 """
+import argparse
 import bisect
 import csv
 import math
@@ -85,6 +86,18 @@ def monotone_map(points, knots):
     for i in range(1, len(values)):
         values[i] = max(values[i], values[i - 1])
     return values
+
+
+def main_per_input(doc, table):
+    """The command line of a script that fits one table per kind of input: --full and
+    --head-hands, each a list of frames CSVs, given to table(name, paths) in that order."""
+    parser = argparse.ArgumentParser(description=doc,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--full", nargs="+", required=True, help="whole-body frames CSVs")
+    parser.add_argument("--head-hands", nargs="+", required=True, help="three-point frames CSVs")
+    args = parser.parse_args()
+    table("whole body", args.full)
+    table("head and hands", args.head_hands)
 
 
 def main(paths):

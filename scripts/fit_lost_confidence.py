@@ -11,15 +11,13 @@ Whole-body and three-point input have tables of their own:
   scripts/fit_lost_confidence.py --full full_*.csv --head-hands points_*.csv
 Fit on performances other than the ones reported on (other seeds), every rig (`--rigs all`).
 """
-import argparse
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from fit_confidence_calibration import hmm_frames, monotone_map  # noqa: E402
+from fit_confidence_calibration import hmm_frames, main_per_input, monotone_map  # noqa: E402
+from fit_young_offset_confidence import KNOTS  # noqa: E402
 
-# Must match src/live/lost_confidence.cc.
-KNOTS = [k / 10.0 for k in range(10)] + [0.95, 0.99, 1.0]
 MIN_FRAMES = 1000
 
 
@@ -36,14 +34,5 @@ def table(name, paths):
     print(f"    {{{', '.join(f'{v:.4f}f' for v in values)}}},")
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--full", nargs="+", required=True, help="whole-body frames CSVs")
-    parser.add_argument("--head-hands", nargs="+", required=True, help="three-point frames CSVs")
-    args = parser.parse_args()
-    table("whole body", args.full)
-    table("head and hands", args.head_hands)
-
-
 if __name__ == "__main__":
-    main()
+    main_per_input(__doc__, table)

@@ -11,15 +11,15 @@ Whole-body and three-point input have tables of their own:
   scripts/fit_young_offset_confidence.py --full full_*.csv --head-hands points_*.csv
 Fit on performances other than the ones reported on (other seeds), every rig (`--rigs all`).
 """
-import argparse
 import bisect
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from fit_confidence_calibration import hmm_frames, monotone_map  # noqa: E402
+from fit_confidence_calibration import hmm_frames, main_per_input, monotone_map  # noqa: E402
 
-# Must match src/live/young_offset_confidence.cc.
+# Must match src/live/young_offset_confidence.cc (KNOTS: duet/math/lookup_table.h's
+# kConfidenceKnots, which scripts/fit_lost_confidence.py shares).
 OFFSET_EDGES = [0.03, 0.06, 0.1]  # RMS per posture dimension, standardised units
 LEARNT_EDGES = [1.0, 2.0, 3.0, 5.0]  # seconds; from SETTLED_S on the identity
 SETTLED_S = 8.0
@@ -61,15 +61,5 @@ def table(name, paths):
     print("    },")
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--full", nargs="+", required=True, help="whole-body frames CSVs")
-    parser.add_argument("--head-hands", nargs="+", required=True, help="three-point frames CSVs")
-    args = parser.parse_args()
-    table("whole body", args.full)
-    table("head and hands", args.head_hands)
-
-
 if __name__ == "__main__":
-    main()
+    main_per_input(__doc__, table)

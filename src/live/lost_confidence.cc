@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <span>
 
 #include "duet/math/lookup_table.h"
@@ -11,11 +10,6 @@ namespace duet {
 namespace {
 
 constexpr int kInputs = 2;  // InputPoints::kFullBody, kHeadHands
-// Knots at the session's confidence 0, 0.1, ..., 0.9, 0.95, 0.99, 1; must match the fitting
-// script.
-constexpr float kKnots[] = {0.0f, 0.1f, 0.2f, 0.3f,  0.4f,  0.5f, 0.6f,
-                            0.7f, 0.8f, 0.9f, 0.95f, 0.99f, 1.0f};
-constexpr int kKnotCount = static_cast<int>(std::size(kKnots));
 
 // Fitted by scripts/fit_lost_confidence.py on `duet eval --trackers hmm --no-partner-metrics
 // --rigs all --takes 0,1,...,13 --seed S --non-dance none --no-lost-confidence --frames-csv` for
@@ -24,7 +18,7 @@ constexpr int kKnotCount = static_cast<int>(std::size(kKnots));
 // body-size, late-frames; three points (`--input-points head,hands`) with clean, tempo-fast,
 // noise, improv, improv-library, improv-30hz-noisy, harsh, suit-drift. The reported evaluation
 // uses seeds 1 and 7.
-constexpr float kTable[kInputs][kKnotCount] = {
+constexpr float kTable[kInputs][kConfidenceKnotCount] = {
     // whole body: fitted on full_23.csv, full_31.csv
     // 4893 lost frames, 0.836 claimed, 0.787 right
     {0.2500f, 0.2567f, 0.2844f, 0.3121f, 0.3293f, 0.3328f, 0.6386f, 0.6396f, 0.6431f, 0.7310f,
@@ -40,7 +34,7 @@ constexpr float kTable[kInputs][kKnotCount] = {
 float LostConfidence::apply(float confidence, InputPoints points) noexcept {
   const float c = std::isfinite(confidence) ? std::clamp(confidence, 0.0f, 1.0f) : 0.0f;
   const float* row = kTable[points == InputPoints::kHeadHands ? 1 : 0];
-  return interpolate_knots(kKnots, std::span<const float>(row, kKnotCount), c);
+  return interpolate_knots(kConfidenceKnots, std::span<const float>(row, kConfidenceKnotCount), c);
 }
 
 }  // namespace duet

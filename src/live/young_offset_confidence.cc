@@ -15,10 +15,6 @@ constexpr float kOffsetEdges[] = {0.03f, 0.06f, 0.1f};      // RMS per posture d
 constexpr float kLearntEdges[] = {1.0f, 2.0f, 3.0f, 5.0f};  // seconds; kSettledS on: identity
 constexpr int kOffsetBands = static_cast<int>(std::size(kOffsetEdges)) + 1;
 constexpr int kLearntBands = static_cast<int>(std::size(kLearntEdges)) + 1;
-// Knots at the tracker's confidence 0, 0.1, ..., 0.9, 0.95, 0.99, 1.
-constexpr float kKnots[] = {0.0f, 0.1f, 0.2f, 0.3f,  0.4f,  0.5f, 0.6f,
-                            0.7f, 0.8f, 0.9f, 0.95f, 0.99f, 1.0f};
-constexpr int kKnotCount = static_cast<int>(std::size(kKnots));
 
 // Fitted by scripts/fit_young_offset_confidence.py on `duet eval --trackers hmm
 // --no-partner-metrics --rigs all --takes 0,1,...,13 --seed S --non-dance none --frames-csv` for
@@ -27,7 +23,7 @@ constexpr int kKnotCount = static_cast<int>(std::size(kKnots));
 // body-size, late-frames; three points (`--input-points head,hands`) with clean, tempo-fast,
 // improv, improv-library, noise, improv-30hz-noisy, harsh, suit-drift. The reported evaluation
 // uses seeds 1 and 7.
-constexpr float kTable[kInputs][kOffsetBands][kLearntBands][kKnotCount] = {
+constexpr float kTable[kInputs][kOffsetBands][kLearntBands][kConfidenceKnotCount] = {
     // whole body: fitted on full_11.csv, full_23.csv, full_31.csv, full_41.csv
     {
         {
@@ -181,7 +177,7 @@ float YoungOffsetConfidence::apply(float confidence, float offset_rms, float lea
   const int input = points == InputPoints::kHeadHands ? 1 : 0;
   const float* row =
       kTable[input][band_of(offset_rms, kOffsetEdges)][band_of(learnt_s, kLearntEdges)];
-  return interpolate_knots(kKnots, std::span<const float>(row, kKnotCount), c);
+  return interpolate_knots(kConfidenceKnots, std::span<const float>(row, kConfidenceKnotCount), c);
 }
 
 }  // namespace duet

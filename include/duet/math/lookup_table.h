@@ -11,6 +11,13 @@
 
 namespace duet {
 
+// The knots of the session's confidence tables (YoungOffsetConfidence, LostConfidence): a
+// confidence of 0, 0.1, ..., 0.9, 0.95, 0.99, 1. Must match scripts/fit_young_offset_confidence.py.
+inline constexpr float kConfidenceKnots[] = {0.0f, 0.1f, 0.2f, 0.3f,  0.4f,  0.5f, 0.6f,
+                                             0.7f, 0.8f, 0.9f, 0.95f, 0.99f, 1.0f};
+inline constexpr int kConfidenceKnotCount = 13;
+static_assert(sizeof(kConfidenceKnots) / sizeof(float) == kConfidenceKnotCount);
+
 // Band b holds values in [edges[b - 1], edges[b]): 0 below the first edge, edges.size() from the
 // last on. NaN falls in band 0. Allocates nothing.
 inline int band_of(float value, std::span<const float> edges) noexcept {
