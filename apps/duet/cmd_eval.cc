@@ -17,7 +17,6 @@
 #include "duet/eval/non_dance.h"
 #include "duet/eval/report.h"
 #include "duet/eval/runner.h"
-#include "duet/follow/hmm_follower.h"
 #include "duet/io/atomic_write.h"
 #include "eval_non_dance.h"
 #include "eval_recorded.h"
@@ -389,18 +388,20 @@ int run_eval(EvalArgs& args) {
       hmm.emission_noise_allowance, hmm.noise_filter_density, hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
   if (!non_dance.value().empty()) {
-    fmt::print(
-        "\nnon-dance input (motion no part of the library explains; hmm, exact step): lost\n");
+    fmt::print("\nnon-dance input (motion no part of the library explains; hmm, {}): lost\n",
+               options.beam ? "beam mode" : "exact step");
     // Each clip as it is and, when shorter, looped to half a minute: the posture offset has time
-    // to learn from a long one (docs/evaluation.md, "Non-dance input for half a minute").
+    // to learn from a long one (docs/evaluation.md, "Non-dance input for half a minute"). The
+    // follower is the cases' hmm, in beam mode under --beam.
     const auto report_lost = [&](const LoadedMotion& motion, const std::string& name) {
-      Result<HmmFollower> follower = HmmFollower::create(library->model(), options.hmm);
-      if (!follower) {
-        fmt::print(stderr, "duet eval: {}\n", follower.error().message);
+      Result<std::unique_ptr<Tracker>> tracker = make_eval_tracker(
+          TrackerKind::kHmm, library->model(), options, library->candidate_index());
+      if (!tracker) {
+        fmt::print(stderr, "duet eval: {}\n", tracker.error().message);
         return false;
       }
-      Result<NonDanceResult> result = follow_non_dance(
-          *library, motion, name, std::make_unique<HmmFollower>(std::move(follower).value()));
+      Result<NonDanceResult> result =
+          follow_non_dance(*library, motion, name, std::move(tracker).value());
       if (!result) {
         fmt::print(stderr, "duet eval: --non-dance {}\n", result.error().message);
         return false;

@@ -230,6 +230,20 @@ TEST(CliEval, ReportsNonDanceInputAsLost) {
     EXPECT_GE(lost, std::string(clip) == "walk looped" ? 95.0 : 80.0) << clip;
   }
   EXPECT_EQ(r.output.find("dance-short looped"), std::string::npos) << r.output;  // 63 s already
+  EXPECT_NE(r.output.find("hmm, exact step"), std::string::npos) << r.output;
+
+  // Under --beam the clips are followed in beam mode too, and still lost.
+  r = run_duet("eval " + pairs + " --beam --non-dance bandai --data-dir " + data_path(""));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_NE(r.output.find("non-dance input (motion no part of the library explains; hmm, beam "
+                          "mode)"),
+            std::string::npos)
+      << r.output;
+  for (const char* clip : {"walk", "dance-short", "byebye"}) {
+    const std::size_t at = r.output.find(std::string("  ") + clip + " ");
+    ASSERT_NE(at, std::string::npos) << clip << "\n" << r.output;
+    EXPECT_GE(std::stod(r.output.substr(at + 2 + std::string(clip).size())), 95.0) << clip;
+  }
 
   // Against the whole salsa library the wave's arm coming down is a take's standing pose; held
   // for half a minute it was followed in runs of 1-27 frames (93.6 % lost) until a dancer found
