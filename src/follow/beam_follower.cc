@@ -35,6 +35,9 @@ Status BeamParams::validate() const {
     return fail("radius_candidates must be >= wide_jump_candidates");
   }
   if (!(prune_ratio >= 0.0f && prune_ratio < 1.0f)) return fail("prune_ratio must be in [0, 1)");
+  if (!(unsettled_prune_ratio >= 0.0f && unsettled_prune_ratio < 1.0f)) {
+    return fail("unsettled_prune_ratio must be in [0, 1)");
+  }
   if (max_states < 1) return fail("max_states must be >= 1");
   if (!(outside_mass_tolerance >= 0.0f && std::isfinite(outside_mass_tolerance))) {
     return fail("outside_mass_tolerance must be finite and >= 0");
@@ -50,7 +53,10 @@ Status BeamParams::validate() const {
 
 BeamParams BeamParams::suited_to(const FollowParams& params) {
   BeamParams beam;
-  if (!params.tempo_adaptive || params.skip_prob == 0.0f) beam.prune_ratio = 1e-20f;
+  if (!params.tempo_adaptive || params.skip_prob == 0.0f) {
+    beam.prune_ratio = std::min(beam.prune_ratio, 1e-20f);
+    beam.unsettled_prune_ratio = std::min(beam.unsettled_prune_ratio, 1e-20f);
+  }
   return beam;
 }
 
@@ -322,7 +328,7 @@ bool BeamForward::sparse_emission(const float* phi, const CandidateSet& candidat
   }
   // The posterior over the merged states; those below the threshold leave the beam.
   const float scale = static_cast<float>(1.0 / sum);
-  const float threshold = largest * beam_.prune_ratio;
+  const float threshold = prune_threshold(context, {weighted, count}, largest);
   context.beam_.clear();
   for (std::size_t k = 0; k < count; ++k) {
     const int i = context.next_[k];
@@ -415,12 +421,30 @@ void BeamForward::materialise(BeamContext& context) const noexcept {
   context.background_ = 0.0f;
 }
 
+float BeamForward::prune_threshold(const BeamContext& context, std::span<const float> masses,
+                                   float largest) const noexcept {
+  const float usual = largest * beam_.prune_ratio;
+  if (context.history_.jump_gate.settled(exact_.params_) ||
+      !(beam_.unsettled_prune_ratio < beam_.prune_ratio)) {
+    return usual;
+  }
+  // Deeper, unless that keeps a beam too wide to save anything (a library of look-alikes).
+  const float deep = largest * beam_.unsettled_prune_ratio;
+  const int most = beam_.max_states / 2;
+  int kept = 0;
+  for (const float mass : masses) {
+    if (mass >= deep && mass > 0.0f && ++kept > most) return usual;
+  }
+  return deep;
+}
+
 void BeamForward::rebuild_beam(BeamContext& context) const noexcept {
   const int num_states = exact_.model_->num_states();
   float* alpha = context.alpha_.data();
   float largest = 0.0f;
   for (int i = 0; i < num_states; ++i) largest = std::max(largest, alpha[i]);
-  const float threshold = largest * beam_.prune_ratio;
+  const float threshold =
+      prune_threshold(context, {alpha, static_cast<std::size_t>(num_states)}, largest);
   context.beam_.clear();
   for (int i = 0; i < num_states; ++i) {
     if (alpha[i] >= threshold && alpha[i] > 0.0f) {

@@ -256,6 +256,11 @@ TEST(BeamParamsTest, RejectsBadParameters) {
   bad.prune_ratio = std::numeric_limits<float>::quiet_NaN();
   EXPECT_FALSE(BeamFollower::create(model, {}, bad));
   bad = BeamParams{};
+  bad.unsettled_prune_ratio = 1.0f;
+  Result<BeamFollower> unsettled = BeamFollower::create(model, {}, bad);
+  ASSERT_FALSE(unsettled);
+  EXPECT_NE(unsettled.error().message.find("unsettled_prune_ratio"), std::string::npos);
+  bad = BeamParams{};
   bad.lost_full_step_s = -1.0;
   Result<BeamFollower> negative = BeamFollower::create(model, {}, bad);
   ASSERT_FALSE(negative);
