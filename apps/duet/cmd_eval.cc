@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cstdlib>
 #include <filesystem>
 #include <iterator>
@@ -35,7 +36,7 @@ namespace {
 
 struct EvalArgs {
   LibraryArgs library;
-  std::vector<int> takes;
+  std::vector<std::string> takes;  // indices, FIRST-LAST ranges, or "all"
   std::vector<std::string> cases;
   std::vector<std::string> trackers;
   std::vector<std::string> rigs = {"native"};
@@ -126,6 +127,50 @@ std::string shell_quote(const std::string& text) {
   return out + "'";
 }
 
+// --takes: indices, FIRST-LAST ranges and "all" into take indices, each once, in the order given;
+// an error that names the bad item.
+Result<std::vector<int>> parse_takes(const std::vector<std::string>& items, int pair_count) {
+  const auto bad = [&](const std::string& item, const std::string& why) -> Error {
+    return Error{fmt::format("--takes {}: {}", item, why)};
+  };
+  const auto index = [&](const std::string& item, std::string_view text) -> Result<int> {
+    int k = -1;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), k);
+    if (ec != std::errc() || end != text.data() + text.size() || text.empty()) {
+      return bad(item, "expected a take index, FIRST-LAST or all");
+    }
+    if (k < 0 || k >= pair_count) {
+      return bad(item, fmt::format("the library has {} pair{} (takes 0..{})", pair_count,
+                                   pair_count == 1 ? "" : "s", pair_count - 1));
+    }
+    return k;
+  };
+  std::vector<int> takes;
+  const auto add = [&](int k) {
+    if (std::ranges::find(takes, k) == takes.end()) takes.push_back(k);
+  };
+  for (const std::string& item : items) {
+    if (item == "all") {
+      for (int k = 0; k < pair_count; ++k) add(k);
+      continue;
+    }
+    const std::size_t dash = item.find('-', 1);
+    if (dash == std::string::npos) {
+      Result<int> k = index(item, item);
+      if (!k) return k.error();
+      add(k.value());
+      continue;
+    }
+    Result<int> first = index(item, std::string_view(item).substr(0, dash));
+    if (!first) return first.error();
+    Result<int> last = index(item, std::string_view(item).substr(dash + 1));
+    if (!last) return last.error();
+    if (last.value() < first.value()) return bad(item, "the range ends before it begins");
+    for (int k = first.value(); k <= last.value(); ++k) add(k);
+  }
+  return takes;
+}
+
 int write_plots(const EvalReport& report, const std::string& dir, const std::string& gnuplot) {
   const std::string quiet = " >/dev/null 2>&1";
   const bool cairo =
@@ -187,15 +232,13 @@ int run_eval(EvalArgs& args) {
       options.trackers.push_back(kind);
     }
   }
-  if (args.takes.empty()) {  // the first, middle and last take
+  Result<std::vector<int>> take_list = parse_takes(args.takes, pair_count);
+  if (!take_list) return usage_error(take_list.error().message);
+  if (take_list.value().empty()) {  // the first, middle and last take
     for (const int k : {0, (pair_count - 1) / 2, pair_count - 1}) {
-      if (std::ranges::find(args.takes, k) == args.takes.end()) args.takes.push_back(k);
-    }
-  }
-  for (const int k : args.takes) {
-    if (k < 0 || k >= pair_count) {
-      return usage_error(fmt::format("--takes {}: there are {} pairs (takes 0..{})", k, pair_count,
-                                     pair_count - 1));
+      if (std::ranges::find(take_list.value(), k) == take_list.value().end()) {
+        take_list.value().push_back(k);
+      }
     }
   }
   if (std::ranges::none_of(standard,
@@ -208,7 +251,7 @@ int run_eval(EvalArgs& args) {
   options.partner_metrics = !args.no_partner_metrics;
   options.beam = args.beam;
   options.lost_confidence = !args.no_lost_confidence;
-  options.takes = args.takes;
+  options.takes = take_list.value();
   options.seed = args.seed;
   options.trace_case = args.plots_dir.empty() ? "" : args.trace_case;
   options.keep_frames = !args.frames_csv_path.empty();
@@ -451,8 +494,9 @@ Command register_eval(CLI::App& app) {
   auto args = std::make_shared<EvalArgs>();
   add_library_options(app, args->library);
   app.add_option("--takes", args->takes,
-                 "Takes to perform from, as indices of the --pair list, e.g. 0,2 (default: the "
-                 "first, middle and last)")
+                 "Takes to perform from, as indices of the library's pairs (the --pair list "
+                 "after the library's): e.g. 0,2, a range 0-13, or all (default: the first, "
+                 "middle and last)")
       ->delimiter(',');
   app.add_option("--rigs", args->rigs,
                  "Rigs to deliver every case on, comma-separated (default native): native (the "

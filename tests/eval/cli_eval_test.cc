@@ -124,6 +124,8 @@ TEST(CliEval, BadOptionsExitTwoAndBadFilesExitOne) {
   const std::pair<std::string, std::string> bad_options[] = {
       {"--cases clean,bogus", "unknown case 'bogus'"},
       {"--takes 1", "--takes 1"},
+      {"--takes 0-1", "--takes 0-1: the library has 1 pair (takes 0..0)"},
+      {"--takes first", "expected a take index, FIRST-LAST or all"},
       {"--trackers hmm,magic", ""},
       {"--sigma -1", ""},
       {"--trace-case nothing", ""},
@@ -150,6 +152,27 @@ TEST(CliEval, BadOptionsExitTwoAndBadFilesExitOne) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("garbage.bvh"), std::string::npos) << r.output;
   std::filesystem::remove_all(dir);
+}
+
+TEST(CliEval, TakesAreIndicesRangesOrAll) {
+  const std::string base = "eval " + pair("10") + " " + pair("05") + " " + pair("01") +
+                           " --fps 60 --trackers nearest --cases clean --no-partner-metrics "
+                           "--non-dance none --takes ";
+  const std::pair<std::string, std::string> lists[] = {
+      {"1-2", "performances from takes 1 (60_05_scaled), 2 (60_01_scaled);"},
+      {"all", "takes 0 (60_10_scaled), 1 (60_05_scaled), 2 (60_01_scaled);"},
+      {"2,0-1,2", "takes 2 (60_01_scaled), 0 (60_10_scaled), 1 (60_05_scaled);"},
+  };
+  for (const auto& [list, named] : lists) {
+    const auto r = run_duet(base + list);
+    ASSERT_EQ(r.exit_code, 0) << list << ": " << r.output;
+    EXPECT_NE(r.output.find(named), std::string::npos) << list << ": " << r.output;
+  }
+  const auto backwards = run_duet(base + "2-1");
+  EXPECT_EQ(backwards.exit_code, 2) << backwards.output;
+  EXPECT_NE(backwards.output.find("--takes 2-1: the range ends before it begins"),
+            std::string::npos)
+      << backwards.output;
 }
 
 TEST(CliEval, ScoresARecordingOfATakeOnItsOwnRig) {
