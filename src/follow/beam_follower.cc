@@ -35,9 +35,13 @@ Status BeamParams::validate() const {
     return fail("radius_candidates must be >= wide_jump_candidates");
   }
   if (!(prune_ratio >= 0.0f && prune_ratio < 1.0f)) return fail("prune_ratio must be in [0, 1)");
-  if (!(unsettled_prune_ratio >= 0.0f && unsettled_prune_ratio < 1.0f)) {
-    return fail("unsettled_prune_ratio must be in [0, 1)");
+  if (!(deep_prune_ratio >= 0.0f && deep_prune_ratio < 1.0f)) {
+    return fail("deep_prune_ratio must be in [0, 1)");
   }
+  if (!(well_fitting_ratio >= 1.0f && std::isfinite(well_fitting_ratio))) {
+    return fail("well_fitting_ratio must be finite and >= 1");
+  }
+  if (well_fitting_states < 0) return fail("well_fitting_states must be >= 0");
   if (max_states < 1) return fail("max_states must be >= 1");
   if (!(outside_mass_tolerance >= 0.0f && std::isfinite(outside_mass_tolerance))) {
     return fail("outside_mass_tolerance must be finite and >= 0");
@@ -55,7 +59,7 @@ BeamParams BeamParams::suited_to(const FollowParams& params) {
   BeamParams beam;
   if (!params.tempo_adaptive || params.skip_prob == 0.0f) {
     beam.prune_ratio = std::min(beam.prune_ratio, 1e-20f);
-    beam.unsettled_prune_ratio = std::min(beam.unsettled_prune_ratio, 1e-20f);
+    beam.deep_prune_ratio = std::min(beam.deep_prune_ratio, 1e-20f);
   }
   return beam;
 }
@@ -329,10 +333,19 @@ bool BeamForward::sparse_emission(const float* phi, const CandidateSet& candidat
   // The posterior over the merged states; those below the threshold leave the beam.
   const float scale = static_cast<float>(1.0 / sum);
   const float threshold = prune_threshold(context, {weighted, count}, largest);
+  // A few states that fit about as well as the best one keep far less mass (BeamParams::
+  // well_fitting_ratio): the exact step keeps every state, and its mass grows there frame by
+  // frame once the place followed stops fitting.
+  const float fits_sq = best + std::log(beam_.well_fitting_ratio) / inv_two_sigma_sq;
+  const float fit_threshold = largest * beam_.deep_prune_ratio;
+  int well_fitting = 0;
   context.beam_.clear();
   for (std::size_t k = 0; k < count; ++k) {
     const int i = context.next_[k];
-    if (weighted[k] >= threshold && weighted[k] > 0.0f) {
+    const bool fits = weighted[k] < threshold && weighted[k] >= fit_threshold && d2[k] <= fits_sq &&
+                      well_fitting < beam_.well_fitting_states;
+    if (fits) ++well_fitting;
+    if ((weighted[k] >= threshold || fits) && weighted[k] > 0.0f) {
       alpha[i] = weighted[k] * scale;
       context.beam_.push_back(i);
     } else {
@@ -425,11 +438,11 @@ float BeamForward::prune_threshold(const BeamContext& context, std::span<const f
                                    float largest) const noexcept {
   const float usual = largest * beam_.prune_ratio;
   if (context.history_.jump_gate.settled(exact_.params_) ||
-      !(beam_.unsettled_prune_ratio < beam_.prune_ratio)) {
+      !(beam_.deep_prune_ratio < beam_.prune_ratio)) {
     return usual;
   }
   // Deeper, unless that keeps a beam too wide to save anything (a library of look-alikes).
-  const float deep = largest * beam_.unsettled_prune_ratio;
+  const float deep = largest * beam_.deep_prune_ratio;
   const int most = beam_.max_states / 2;
   int kept = 0;
   for (const float mass : masses) {

@@ -21,7 +21,8 @@
 //     the far states, where the exact step keeps it below a per-state bound) is dropped, and the
 //     frame's log-likelihood misses it.
 //   - States whose posterior falls below prune_ratio times the maximum leave the beam (far
-//     below it, unsettled_prune_ratio, until the first placement has settled).
+//     below it, deep_prune_ratio, until the first placement has settled, and for a few states
+//     that fit the input about as well as the best one).
 // The first frame after reset() is a full step (the initial distribution is uniform).
 // One departure from the exact step, for cost: a spell lost for long takes the full step only
 // now and then (BeamParams::lost_full_step_s).
@@ -67,7 +68,15 @@ struct BeamParams {
   // many takes, and a place whose mass fell below 1e-8 of the maximum for a moment there was the
   // dance a second later (`suit-drift`, every take: 95.16 % within 100 ms at 1e-8 throughout,
   // the exact step's 95.90, docs/follower.md "Beam mode").
-  float unsettled_prune_ratio = 1e-20f;
+  float deep_prune_ratio = 1e-20f;
+  // Once settled, up to well_fitting_states states a frame (the first in the library's order)
+  // stay down to deep_prune_ratio when their emission is within well_fitting_ratio of the best
+  // one's: a place that fits the input as well as the one followed, its mass far below, is where
+  // the exact step finds the dance again once the place followed stops fitting (`clean@asf`,
+  // take 60_13: the beam stayed on 60_06 where the exact step moved to 60_13 after 3 s; every
+  // take 98.63 against the exact step's 98.87 %). 0 states: none.
+  float well_fitting_ratio = 10.0f;
+  int well_fitting_states = 32;
   // Above this many states the next frame is a full step (a beam this wide saves nothing).
   int max_states = 4096;
   // A full step finishes the frame when the mass the left-out states may carry within one
@@ -207,7 +216,7 @@ class BeamForward {
   // After a full step: the states above the prune threshold become the beam, unless too many.
   void rebuild_beam(BeamContext& context) const noexcept;
   // The mass below which a state leaves the beam, of states holding `masses` (the largest
-  // `largest`): BeamParams::unsettled_prune_ratio times the largest until the first placement
+  // `largest`): BeamParams::deep_prune_ratio times the largest until the first placement
   // has settled, while that keeps at most half of BeamParams::max_states; else prune_ratio times
   // it.
   float prune_threshold(const BeamContext& context, std::span<const float> masses,
