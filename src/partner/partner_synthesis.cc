@@ -364,6 +364,7 @@ std::string PartnerParams::validate() const {
   }
   const std::pair<const char*, double> references[] = {
       {"user_facing_jitter_reference_rad", user_facing_jitter_reference_rad},
+      {"facing_max_turn_rad_s", facing_max_turn_rad_s},
       {"ik_target_jitter_reference_m", ik_target_jitter_reference_m},
       {"ik_difference_time_constant_s", ik_difference_time_constant_s},
       {"ik_difference_power_time_constant_s", ik_difference_power_time_constant_s},
@@ -496,6 +497,21 @@ double PartnerContext::facing_jitter(const Vec3& facing, double dt) noexcept {
   constexpr double kJitterTimeConstantS = 1.0, kMoveRad = 0.5;
   user_facing_jitter_.add(user_facing_yaw_, dt, kJitterTimeConstantS, kMoveRad);
   return user_facing_jitter_.rms();
+}
+
+Quat PartnerContext::capped_facing_turn(const Quat& turn, const Quat& template_rotation,
+                                        const Quat& previous_template_rotation,
+                                        double extra_rad) const noexcept {
+  // The shown heading (turn * template) moves from last frame's by the template's own turn at
+  // most, plus extra_rad: a user's facing read to turn 40 degrees in a frame (three points at an
+  // improvised cut, a tracking glitch) turned the whole partner as fast (2629 deg/s).
+  const double own = std::abs(
+      wrap_angle(heading_yaw(template_rotation) - heading_yaw(previous_template_rotation)));
+  const double last = heading_yaw(user_heading_.rotation);
+  const double change = wrap_angle(heading_yaw(turn * template_rotation) - last);
+  const double most = own + extra_rad;
+  if (std::abs(change) <= most) return turn;
+  return yaw_rotation(last + std::copysign(most, change)) * template_rotation.conjugate();
 }
 
 double PartnerContext::ik_target_jitter(std::size_t hand, const Vec3& target, double dt,
@@ -639,6 +655,7 @@ bool PartnerSynthesisJob::run() const noexcept {
     if (p.smooth) {
       const bool relative = p.smooth_relative_to_template && p.align && has_position;
       Transform template_heading;  // the identity when not relative
+      const Quat previous_template_rotation = ctx.template_rotation_;
       if (relative) {
         template_heading = model->alignment().template_heading_at(frame_position);
         // A taller user's steps are longer: the template's path scaled like the spacing.
@@ -667,9 +684,15 @@ bool PartnerSynthesisJob::run() const noexcept {
         facing_filter.beta /= 1.0 + ratio * ratio;
       }
       const Vec3 smooth_facing = ctx.user_facing_filter_.filter(facing, dt, facing_filter);
-      const Quat turn = smooth_facing.norm() > 1e-6
-                            ? yaw_rotation(std::atan2(smooth_facing.x(), smooth_facing.z()))
-                            : yaw_rotation(std::atan2(facing.x(), facing.z()));
+      Quat turn = smooth_facing.norm() > 1e-6
+                      ? yaw_rotation(std::atan2(smooth_facing.x(), smooth_facing.z()))
+                      : yaw_rotation(std::atan2(facing.x(), facing.z()));
+      if (relative && ctx.heading_is_relative_ && p.facing_max_turn_rad_s > 0.0) {
+        turn =
+            ctx.capped_facing_turn(turn, template_heading.rotation,
+                                   jumped ? template_heading.rotation : previous_template_rotation,
+                                   p.facing_max_turn_rad_s * dt);
+      }
       const Vec3 template_position = turn * template_heading.translation;
       if (relative && ctx.heading_is_relative_ && jumped && ctx.user_root_filter_.primed()) {
         // ctx.user_heading_: the heading shown last frame (relative implies align).

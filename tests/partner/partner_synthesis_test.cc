@@ -658,6 +658,44 @@ TEST(PartnerSynthesis, AJitteringUserHeadingIsSmoothedHarderThanASteadyTurn) {
   EXPECT_NE(bad.validate().find("user_facing_jitter_reference_rad"), std::string::npos);
 }
 
+TEST(PartnerSynthesis, AFacingReadToTurnAtOnceTurnsThePartnerAtTheCap) {
+  // The user's facing is read to turn 0.7 rad (40 degrees) in one frame and stay there (three
+  // points at an improvised cut; a tracking glitch); the template does not turn. With the cap the
+  // partner's heading turns at most facing_max_turn_rad_s; without it, the facing filter let the
+  // step through in a few frames. Both end at the new facing.
+  Duet duet(240, 0, 0);
+  constexpr double kStepRad = 0.7;
+  const auto run_step = [&](double cap_rad_s) {
+    PartnerParams params = only(true, false, true, false, false);
+    params.facing_max_turn_rad_s = cap_rad_s;
+    Runner run(duet.model, params);
+    std::vector<double> yaws;
+    for (int f = 0; f < 240; ++f) {
+      const double yaw = f >= 100 ? kStepRad : 0.0;
+      UserPose user = user_from(duet.leader, f, duet.roles);
+      user.root_rotation_ws = yaw_rotation(yaw) * user.root_rotation_ws;
+      user.body_heading = Transform{yaw_rotation(yaw), Vec3::Zero()} * user.body_heading;
+      run.frame_position = f;
+      run.step(duet.follower, f, user);
+      yaws.push_back(heading_yaw(run.r[0]));
+    }
+    double fastest = 0.0;
+    for (std::size_t f = 90; f < yaws.size(); ++f) {
+      fastest = std::max(fastest, std::abs(wrap_angle(yaws[f] - yaws[f - 1])) * kFps);
+    }
+    return std::pair{fastest, yaws};
+  };
+  const auto [capped_fastest, capped] = run_step(6.0);
+  const auto [free_fastest, free] = run_step(0.0);
+  EXPECT_LE(capped_fastest, 6.0 + 1e-6);
+  EXPECT_GT(free_fastest, 2.0 * 6.0);
+  EXPECT_NEAR(wrap_angle(capped.back() - free.back()), 0.0, 1e-3);
+  EXPECT_NEAR(wrap_angle(capped.back() - capped[90]), kStepRad, 0.02);
+  PartnerParams bad;
+  bad.facing_max_turn_rad_s = -1.0;
+  EXPECT_NE(bad.validate().find("facing_max_turn_rad_s"), std::string::npos);
+}
+
 TEST(PartnerSynthesis, BlendHidesAJump) {
   Duet duet(220, 0, 0);
   // Frames >= 100 of the response have the arms and root elsewhere (another part of the dance).

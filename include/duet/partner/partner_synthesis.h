@@ -152,6 +152,11 @@ struct PartnerParams {
   // noise by about 0.04 rad and is smoothed hard (beta 2). 0: no adaptation. Measured in
   // docs/evaluation.md ("Partner steadiness").
   double user_facing_jitter_reference_rad = 0.02;
+  // smooth and align: the partner's heading turns at most this much faster than the template's
+  // own heading turns at its frame (rad/s): a user's facing that is read to change at once (three
+  // points at an improvised cut, where the head's yaw over the body differs between the two
+  // moments; a tracking glitch) turned the whole partner at up to 2629 deg/s. 0: no limit.
+  double facing_max_turn_rad_s = 6.0;
   // smooth: what the 1-euro filter smooths is the user's heading relative to the template's at
   // the partner's frame (the facing as a turn from the template's, the position as a shift from the
   // template's pelvis), which holds still while the user dances the template, turns and steps
@@ -392,6 +397,11 @@ class PartnerContext {
   // The jitter (metres, RMS over the axes) of each response hand's raw IK target, after adding
   // this frame's target; restart: the target moved on (a jump, another hand held).
   double ik_target_jitter(std::size_t hand, const Vec3& target, double dt, bool restart) noexcept;
+  // The filtered facing turn from the template's heading, held so that the heading shown turns
+  // from last frame's (user_heading_) at most by the template's own turn plus extra_rad
+  // (PartnerParams::facing_max_turn_rad_s times the frame's time).
+  Quat capped_facing_turn(const Quat& turn, const Quat& template_rotation,
+                          const Quat& previous_template_rotation, double extra_rad) const noexcept;
   std::array<std::array<JitterMeter, 3>, 2> ik_target_jitter_;  // per hand, per axis
   std::array<double, 2> ik_ramp_{0.0, 0.0};  // per response hand, linear fade state in [0, 1]
   std::array<int, 2> ik_pair_{-1, -1};       // pair that last drove that hand
