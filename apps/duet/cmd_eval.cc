@@ -498,13 +498,15 @@ Command register_eval(CLI::App& app) {
                  "after the library's): e.g. 0,2, a range 0-13, or all (default: the first, "
                  "middle and last)")
       ->delimiter(',');
-  app.add_option("--rigs", args->rigs,
-                 "Rigs to deliver every case on, comma-separated (default native): native (the "
-                 "library's), proportioned (our own: other proportions and rest pose), asf "
-                 "(cmu-salsa 60.asf), handshake (cmu-handshake 18_01.bvh), bandai (a third-party "
-                 "rig), all, or a motion file whose skeleton to use. A case on another rig is "
-                 "reported as CASE@RIG: the same performance, its sensor errors included, "
-                 "retargeted (docs/retarget.md)")
+  app.add_option(
+         "--rigs", args->rigs,
+         "Rigs to deliver every case on, comma-separated (default native): native (the "
+         "library's), proportioned (our own: other proportions and rest pose), asf "
+         "(cmu-salsa 60.asf), handshake (cmu-handshake 18_01.bvh), bandai (a third-party "
+         "rig), game-avatar, depth-camera, inertial-suit (rigs of another build: "
+         "docs/retarget.md), all, or a motion file whose skeleton to use. A case on another rig is "
+         "reported as CASE@RIG: the same performance, its sensor errors included, "
+         "retargeted (docs/retarget.md)")
       ->delimiter(',');
   app.add_option("--non-dance", args->non_dance,
                  "Motion no part of the library explains, comma-separated, followed after the "

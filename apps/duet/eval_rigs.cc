@@ -5,7 +5,9 @@
 
 #include "duet/io/motion_argument.h"
 #include "duet/io/motion_file.h"
+#include "duet/motion/generic_rigs.h"
 #include "duet/motion/rig_variants.h"
+#include "duet/motion/role_detection.h"
 
 namespace duet::app {
 
@@ -33,8 +35,12 @@ Result<EvalRig> load_file_rig(const std::string& name, const std::string& word) 
 }  // namespace
 
 const std::vector<std::string>& known_eval_rig_names() {
-  static const std::vector<std::string> names = {"native", "proportioned", "asf", "handshake",
-                                                 "bandai"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> all = {"native", "proportioned"};
+    for (const DataRig& rig : kDataRigs) all.emplace_back(rig.name);
+    for (const GenericRigInfo& rig : generic_rigs()) all.emplace_back(rig.name);
+    return all;
+  }();
   return names;
 }
 
@@ -63,6 +69,18 @@ Result<std::vector<EvalRig>> load_eval_rigs(const std::vector<std::string>& entr
       JointRoles roles = tmpl.roles;
       roles.convention = "proportioned";
       rigs.push_back({"proportioned", std::move(rig), roles});
+      continue;
+    }
+    const auto generic = std::ranges::find_if(
+        generic_rigs(), [&](const GenericRigInfo& r) { return entry == r.name; });
+    if (generic != generic_rigs().end()) {
+      // Its roles come from role detection, as a user's file's would.
+      auto rig = std::make_shared<Skeleton>(make_generic_rig(generic->rig));
+      RoleDetection detection = detect_roles_report(*rig);
+      if (!detection.complete()) {
+        return Error{"--rigs " + entry + ": " + detection.problem};  // a bug, not the user's
+      }
+      rigs.push_back({entry, std::move(rig), std::move(detection.roles)});
       continue;
     }
     const auto data_rig = std::ranges::find_if(
