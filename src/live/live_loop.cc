@@ -142,6 +142,11 @@ LiveLoop::LiveLoop(std::shared_ptr<const DuetLibrary> library, const SourceSkele
   out_.partner_rotations_ws.assign(partner_n, Quat::Identity());
   shown_pose_.resize(partner_joints);
   user_height_m_ = measure_body(*user_.skeleton, user_.roles).standing_height_m;
+  for (const auto& take : library_->takes()) {
+    hand_frame_turns_.push_back(hand_frame_turns(*user_.skeleton, user_.roles,
+                                                 take.template_motion.clip.skeleton(),
+                                                 take.template_motion.roles));
+  }
   // Until the first frame, the partner stands in its first captured pose.
   const Clip& response = library_->takes()[0].response_motion.clip;
   std::ranges::copy(response.translations_ls(0), out_.partner_translations_ls.begin());
@@ -192,7 +197,14 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   const int frame_in_take = place.frame;
   const PartnerModel& model = models_[static_cast<std::size_t>(take)];
   const Clip& response = library_->takes()[static_cast<std::size_t>(take)].response_motion.clip;
-  if (!head_hands_bodies_.empty()) place_head_hands_user(take, frame_in_take);
+  if (!head_hands_bodies_.empty()) {
+    place_head_hands_user(take, frame_in_take);
+  } else {
+    const std::array<Quat, 2>& turns = hand_frame_turns_[static_cast<std::size_t>(take)];
+    for (std::size_t s = 0; s < 2; ++s) {
+      user_pose_.wrist_rotations_ws[s] = (user_pose_.wrist_rotations_ws[s] * turns[s]).normalized();
+    }
+  }
 
   PartnerSynthesisJob job;
   job.model = &model;

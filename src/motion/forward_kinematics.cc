@@ -36,4 +36,13 @@ std::vector<Vec3> world_positions(const Clip& clip) {
   return result;
 }
 
+std::vector<Vec3> rest_positions(const Skeleton& skeleton) {
+  const auto n = static_cast<std::size_t>(skeleton.joint_count());
+  std::vector<Vec3> offsets(n), positions(n);
+  std::vector<Quat> identity(n, Quat::Identity()), world(n);
+  for (std::size_t j = 0; j < n; ++j) offsets[j] = skeleton.joints[j].offset;
+  forward_kinematics(skeleton, offsets, identity, positions, world);
+  return positions;
+}
+
 }  // namespace duet

@@ -11,15 +11,6 @@ namespace duet {
 
 namespace {
 
-std::vector<Vec3> rest_positions(const Skeleton& skeleton) {
-  const auto n = skeleton.joints.size();
-  std::vector<Vec3> offsets(n), positions(n);
-  std::vector<Quat> identity(n, Quat::Identity()), world(n);
-  for (std::size_t j = 0; j < n; ++j) offsets[j] = skeleton.joints[j].offset;
-  forward_kinematics(skeleton, offsets, identity, positions, world);
-  return positions;
-}
-
 // in[j]: joint j is `root` or below it (parents come before children).
 std::vector<bool> subtree(const Skeleton& skeleton, int root) {
   std::vector<bool> in(skeleton.joints.size(), false);

@@ -470,6 +470,35 @@ UserPose user_pose_from_world(std::span<const Vec3> positions_ws,
   return user;
 }
 
+std::array<Quat, 2> hand_frame_turns(const Skeleton& user, const JointRoles& user_roles,
+                                     const Skeleton& template_skeleton,
+                                     const JointRoles& template_roles) {
+  std::array<Quat, 2> turns = {Quat::Identity(), Quat::Identity()};
+  const std::vector<Vec3> user_rest = rest_positions(user);
+  const std::vector<Vec3> template_rest = rest_positions(template_skeleton);
+  const auto forearm = [](const std::vector<Vec3>& rest, const JointRoles& roles, Side side,
+                          Vec3& out) {
+    const bool left = side == Side::kLeft;
+    const int elbow = roles[left ? Role::kLeftElbow : Role::kRightElbow];
+    const int wrist = roles[left ? Role::kLeftWrist : Role::kRightWrist];
+    const auto n = static_cast<int>(rest.size());
+    if (elbow < 0 || wrist < 0 || elbow >= n || wrist >= n) return false;
+    out = rest[static_cast<std::size_t>(wrist)] - rest[static_cast<std::size_t>(elbow)];
+    return out.norm() > 1e-9;
+  };
+  for (const Side side : {Side::kLeft, Side::kRight}) {
+    Vec3 user_forearm, template_forearm;
+    if (forearm(user_rest, user_roles, side, user_forearm) &&
+        forearm(template_rest, template_roles, side, template_forearm)) {
+      // R_template = R_user * turn: a template-frame vector along its rest forearm is, in the
+      // user's hand frame, along the user's rest forearm.
+      turns[static_cast<std::size_t>(side)] =
+          Quat::FromTwoVectors(template_forearm, user_forearm).normalized();
+    }
+  }
+  return turns;
+}
+
 void PartnerContext::resize(int joint_count) {
   const auto n = static_cast<std::size_t>(std::max(joint_count, 0));
   inertializer_.resize(joint_count);

@@ -211,6 +211,35 @@ TEST(CliEval, ScoresARecordingOfATakeOnItsOwnRig) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(CliEval, DeliversCasesOnRigsOfAnotherBuild) {
+  // Issue 10: the rigs made in code (a game avatar with twist joints in an A-pose, a depth
+  // camera's body without clavicles, an inertial suit's five-joint spine), their roles found by
+  // role detection: followed as on the library's rig, the partner's hands met on each body.
+  const auto dir = scratch_dir("generic_rigs");
+  const std::string csv = (dir / "eval.csv").string();
+  const std::string partner_csv = (dir / "partner.csv").string();
+  const std::string rigs[] = {"game-avatar", "depth-camera", "inertial-suit"};
+  const auto r = run_duet("eval " + pair("01") + " " + pair("03") +
+                          " --fps 60 --trackers hmm --cases clean --non-dance none "
+                          "--rigs game-avatar,depth-camera,inertial-suit --csv " +
+                          csv + " --partner-csv " + partner_csv);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto rows = pooled_rows(read_text(csv));
+  const auto partner_rows = pooled_rows(read_text(partner_csv));
+  for (const std::string& rig : rigs) {
+    const std::string row = "clean@" + rig;
+    ASSERT_EQ(rows.count({row, "hmm"}), 1u) << read_text(csv);
+    EXPECT_GE(std::stod(rows.at({row, "hmm"}).at("acc_100ms")), 0.98) << row;
+    ASSERT_EQ(partner_rows.count({row, "all"}), 1u) << read_text(partner_csv);
+    EXPECT_LT(std::stod(partner_rows.at({row, "all"}).at("median_hand_error_cm")), 2.0) << row;
+  }
+  const auto bad = run_duet("eval " + pair("01") + " --fps 60 --rigs game-avatr");
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(bad.output.find("game-avatar, depth-camera, inertial-suit"), std::string::npos)
+      << bad.output;
+  std::filesystem::remove_all(dir);
+}
+
 TEST(CliEval, ARecordingAtAnotherRateThanItsTakeFailsBeforeTheRun) {
   // The AMC read at the loader's 120 fps default has the take's frame count in half its time:
   // scored, every frame's truth would be off by 2x (0.3 % within 100 ms with 0.4 % lost).

@@ -4,6 +4,8 @@
 // the leader's part exactly, elsewhere in the room.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -13,6 +15,8 @@
 #include "duet/io/bvh.h"
 #include "duet/math/rotation.h"
 #include "duet/motion/forward_kinematics.h"
+#include "duet/motion/retarget.h"
+#include "duet/motion/rig_variants.h"
 #include "duet/partner/partner_synthesis.h"
 
 namespace duet {
@@ -149,6 +153,50 @@ TEST(PartnerData, FollowerSynthesisedForAUserWhoDancesTheLeaderElsewhere) {
   EXPECT_LT(error_max, 0.15);
   EXPECT_GT(gap_frames, 0);
   EXPECT_LT(gap_sum / std::max(gap_frames, 1), 0.01);
+}
+
+// Issue 10: the grip offsets are held in the template hand's frame. On a rig whose rest pose holds
+// the arms 40 degrees down (an A-pose; the retargeter keeps the hands' turn relative to the
+// forearm), the user's hands are turned into the template's by hand_frame_turns; without the turn
+// they differ by about the 40 degrees, which swung a 10-30 cm grip offset by centimetres.
+TEST(PartnerData, AnAPoseRigsHandsTurnIntoTheTemplatesHandFrames) {
+  LOAD_OR_SKIP(pair);
+  RigProportions a_pose;
+  a_pose.arms_down_deg = 40.0;
+  auto rig = std::make_shared<const Skeleton>(
+      make_proportioned_rig(pair.leader.skeleton(), pair.leader_roles, a_pose));
+  Result<Clip> on_rig = retarget_clip(pair.leader, pair.leader_roles, rig, pair.leader_roles);
+  ASSERT_TRUE(on_rig.ok()) << on_rig.error().message;
+  const std::array<Quat, 2> same = hand_frame_turns(pair.leader.skeleton(), pair.leader_roles,
+                                                    pair.leader.skeleton(), pair.leader_roles);
+  for (const Quat& turn : same) EXPECT_LT(rad_to_deg(log_map(turn).norm()), 1e-6);
+  const std::array<Quat, 2> turns =
+      hand_frame_turns(*rig, pair.leader_roles, pair.leader.skeleton(), pair.leader_roles);
+
+  const auto n = static_cast<std::size_t>(pair.leader.joint_count());
+  std::vector<Vec3> positions(n);
+  std::vector<Quat> template_ws(n), user_ws(n);
+  double worst_turned = 0.0, least_unturned = 180.0;
+  for (int f = 0; f < pair.leader.frame_count(); f += 10) {
+    forward_kinematics(pair.leader.skeleton(), pair.leader.translations_ls(f),
+                       pair.leader.rotations_ls(f), positions, template_ws);
+    forward_kinematics(*rig, on_rig.value().translations_ls(f), on_rig.value().rotations_ls(f),
+                       positions, user_ws);
+    for (const Side side : {Side::kLeft, Side::kRight}) {
+      const auto wrist = static_cast<std::size_t>(
+          pair.leader_roles[side == Side::kLeft ? Role::kLeftWrist : Role::kRightWrist]);
+      const auto angle_deg = [&](const Quat& user) {
+        return rad_to_deg(log_map(template_ws[wrist].conjugate() * user).norm());
+      };
+      worst_turned =
+          std::max(worst_turned, angle_deg(user_ws[wrist] * turns[static_cast<std::size_t>(side)]));
+      least_unturned = std::min(least_unturned, angle_deg(user_ws[wrist]));
+    }
+  }
+  std::cout << "A-pose rig's hands against the template's: " << worst_turned
+            << " deg at most turned, at least " << least_unturned << " deg unturned\n";
+  EXPECT_LT(worst_turned, 2.0);
+  EXPECT_GT(least_unturned, 30.0);
 }
 
 }  // namespace

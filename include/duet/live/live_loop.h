@@ -9,6 +9,7 @@
 // I/O. Threads, sockets and files are the caller's (the net layer, the recorder).
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string_view>
 #include <vector>
@@ -117,6 +118,9 @@ class LiveLoop {
   LiveOutput out_;
   UserPose user_pose_;
   double user_height_m_ = 0.0;  // measure_body of the user's skeleton: fits the partner's spacing
+  // Per take, the user's hand frames turned into the template's (hand_frame_turns), where the
+  // grip offsets are held.
+  std::vector<std::array<Quat, 2>> hand_frame_turns_;
   // Three-point users (head and hands only): one HeadHandsBody per take; empty for a full body.
   std::vector<HeadHandsBody> head_hands_bodies_;
   Quat device_correction_ = Quat::Identity();  // a point's device rotation -> canonical

@@ -17,4 +17,8 @@ void forward_kinematics(const Skeleton& skeleton, std::span<const Vec3> translat
 // World positions of every joint at every frame: result[frame * joint_count + joint].
 std::vector<Vec3> world_positions(const Clip& clip);
 
+// World positions of every joint in the rest pose (every rotation the identity, the root at its
+// offset). A BVH or ASF rig's joint frames are the world's there.
+std::vector<Vec3> rest_positions(const Skeleton& skeleton);
+
 }  // namespace duet

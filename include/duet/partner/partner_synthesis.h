@@ -339,6 +339,17 @@ struct UserPose {
 UserPose user_pose_from_world(std::span<const Vec3> positions_ws,
                               std::span<const Quat> rotations_ws, const JointRoles& roles) noexcept;
 
+// How a hand joint's frame differs between two rigs (issue 10), per Side. The grip offsets
+// (IkTarget::kCapturedOffset) are held in the template hand's frame; on the user's rig a vector v
+// of that frame is R_user_hand * turn * v in the world. A BVH or ASF rig's joint frames are the
+// world's in its rest pose, so a rig whose rest pose holds the arms otherwise than the
+// template's (an A-pose against the capture's T-pose) has its hands turned by the turn between
+// the two rest forearms (elbow -> wrist, the smallest arc); a twist about the forearm is not seen
+// there. Identity for a side whose elbow or wrist either rig lacks.
+std::array<Quat, 2> hand_frame_turns(const Skeleton& user, const JointRoles& user_roles,
+                                     const Skeleton& template_skeleton,
+                                     const JointRoles& template_roles);
+
 // State kept between frames, sized once for a skeleton. One context per partner being
 // synthesised; it may be used with every PartnerModel whose response skeleton has that many
 // joints (e.g. all takes of a library: moving to another take is a jump).
