@@ -2,12 +2,18 @@
 // (docs/retarget.md).
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <system_error>
+
 #include "commands.h"
 #include "duet/io/bvh.h"
 #include "duet/io/motion_argument.h"
 #include "duet/io/motion_file.h"
+#include "duet/motion/generic_rigs.h"
 #include "duet/motion/retarget.h"
 #include "duet/motion/rig_variants.h"
+#include "duet/motion/role_detection.h"
 #include "library_options.h"
 #include "motion_options.h"
 #include "number_checks.h"
@@ -27,6 +33,31 @@ struct RetargetArgs {
   std::optional<double> stride_scale;
   bool no_feet = false;
 };
+
+// The generic rig (generic_rigs.h) a --rig word names, when it names one and no file.
+const GenericRigInfo* generic_rig_named(const std::vector<std::string>& words) {
+  if (words.size() != 1) return nullptr;
+  std::error_code ec;  // a name too long for a path is no file either, not an exception
+  if (std::filesystem::exists(words.front(), ec)) return nullptr;
+  const auto rigs = generic_rigs();
+  const auto found = std::ranges::find_if(
+      rigs, [&](const GenericRigInfo& rig) { return rig.name == words.front(); });
+  return found == rigs.end() ? nullptr : &*found;
+}
+
+// A --rig word: a motion file (motion_word_check), or a generic rig's name.
+CLI::Validator rig_word_check() {
+  return CLI::Validator(
+      [](std::string& word) -> std::string {
+        if (generic_rig_named({word}) != nullptr) return {};
+        Result<std::vector<std::string>> split = split_motion_argument(word);
+        if (split) return {};
+        std::string names;
+        for (const GenericRigInfo& rig : generic_rigs()) names += ", " + std::string(rig.name);
+        return split.error().message + " (nor a rig made in code:" + names.substr(1) + ")";
+      },
+      "MOTION", "");
+}
 
 // The rig as a BVH file can carry it: a root with position channels and three rotation channels
 // on every joint (a rig read from a file with fewer would drop the retargeted rotations).
@@ -66,9 +97,18 @@ int run_retarget(const RetargetArgs& args) {
     return kExitUsage;
   }
 
+  const GenericRigInfo* generic = generic_rig_named(args.rig);
+  if (generic != nullptr && (args.rig_scale || !args.rig_map_path.empty())) {
+    fmt::print(stderr,
+               "duet retarget: --rig {} is a rig made in code, in metres with its own roles: "
+               "--rig-scale and --rig-map do not apply\n",
+               generic->name);
+    return kExitUsage;
+  }
+
   // One word may be SKELETON.asf+MOTION.amc, as everywhere else a motion is taken.
   std::vector<std::string> inputs = args.inputs;
-  std::vector<std::string> rig_files = args.rig;
+  std::vector<std::string> rig_files = generic != nullptr ? std::vector<std::string>{} : args.rig;
   for (std::vector<std::string>* files : {&inputs, &rig_files}) {
     if (files->size() != 1) continue;
     Result<std::vector<std::string>> split = split_motion_argument(files->front());
@@ -113,6 +153,17 @@ int run_retarget(const RetargetArgs& args) {
                          rig_roles);
     rig_metres_per_unit = rig.value().metres_per_unit;
     rig_name = rig.value().description;
+  }
+  if (generic != nullptr) {
+    rig_skeleton = make_generic_rig(generic->rig);
+    RoleDetection detection = detect_roles_report(rig_skeleton);
+    if (!detection.complete()) {  // a bug, not the user's
+      fmt::print(stderr, "duet retarget: rig {}: {}\n", generic->name, detection.problem);
+      return kExitFailure;
+    }
+    rig_roles = std::move(detection.roles);
+    rig_metres_per_unit = 1.0;
+    rig_name = std::string(generic->name) + " (a rig made in code, docs/retarget.md)";
   }
   if (!args.proportions.empty()) {
     rig_skeleton = make_proportioned_rig(rig_skeleton, rig_roles, proportions);
@@ -166,9 +217,11 @@ Command register_retarget(CLI::App& app) {
                  "The target skeleton: a .bvh file (its motion only tells where its head faces "
                  "when its rest pose is no standing body), or an .asf and an "
                  ".amc file (two words, or SKELETON.asf+MOTION.amc); the output is written in its "
-                 "units. Put it after the input (it takes up to two files)")
+                 "units. Or a rig made in code (written in metres): game-avatar, depth-camera, "
+                 "inertial-suit (docs/retarget.md). Put it after the input (it takes up to two "
+                 "files)")
       ->expected(1, 2)
-      ->check(motion_word_check());
+      ->check(rig_word_check());
   app.add_option("-o,--output", args->output, "Output BVH file (written atomically)")->required();
   add_motion_file_options(app, args->input);
   app.add_option("--rig-scale", args->rig_scale,

@@ -69,6 +69,29 @@ TEST(CliRetarget, OntoTheHandshakeRigReadsBackAtTheRigsSizeWithFeetOnTheFloor) {
   std::filesystem::remove(out);
 }
 
+TEST(CliRetarget, OntoARigMadeInCodeByName) {
+  // The evaluation's rigs of another build (generic_rigs.h) as files of one's own: written in
+  // metres, their roles found again from the joint names; a misspelt name is no file either.
+  const auto out = temp("avatar.bvh");
+  CommandResult r =
+      run_duet("retarget --fps 60 " + kSalsa + " --rig game-avatar -o " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const LoadedMotion written = load({out.string()});
+  EXPECT_EQ(written.roles.convention, "names");
+  EXPECT_EQ(written.units_name, "metres");
+  EXPECT_NEAR(written.body.standing_height_m, 1.80, 0.08);
+  EXPECT_EQ(written.clip.frame_count(), load({kSalsa}).clip.frame_count());
+  std::filesystem::remove(out);
+  r = run_duet("retarget --fps 60 " + kSalsa + " --rig game-avatr -o " + out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("nor a rig made in code: game-avatar"), std::string::npos) << r.output;
+  r = run_duet("retarget --fps 60 " + kSalsa + " --rig depth-camera --rig-scale 0.01 -o " +
+               out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--rig-scale and --rig-map do not apply"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST(CliRetarget, ProportionsWithoutARigUseTheInputsOwnSkeleton) {
   const auto out = temp("proportioned.bvh");
   const CommandResult r =
