@@ -8,13 +8,14 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cstdlib>
 #include <filesystem>
 #include <iterator>
+#include <optional>
 #include <set>
 
 #include "commands.h"
+#include "duet/base/parse_number.h"
 #include "duet/eval/non_dance.h"
 #include "duet/eval/report.h"
 #include "duet/eval/runner.h"
@@ -134,11 +135,9 @@ Result<std::vector<int>> parse_takes(const std::vector<std::string>& items, int 
     return Error{fmt::format("--takes {}: {}", item, why)};
   };
   const auto index = [&](const std::string& item, std::string_view text) -> Result<int> {
-    int k = -1;
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), k);
-    if (ec != std::errc() || end != text.data() + text.size() || text.empty()) {
-      return bad(item, "expected a take index, FIRST-LAST or all");
-    }
+    const std::optional<int> parsed = parse_number<int>(text);
+    if (!parsed) return bad(item, "expected a take index, FIRST-LAST or all");
+    const int k = *parsed;
     if (k < 0 || k >= pair_count) {
       return bad(item, fmt::format("the library has {} pair{} (takes 0..{})", pair_count,
                                    pair_count == 1 ? "" : "s", pair_count - 1));

@@ -3,11 +3,12 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <charconv>
 #include <filesystem>
+#include <optional>
 #include <random>
 
 #include "commands.h"
+#include "duet/base/parse_number.h"
 #include "duet/io/points_csv.h"
 #include "duet/live/live_loop.h"
 #include "duet/live/source_neuron.h"
@@ -74,12 +75,9 @@ bool parse_http(const std::string& text, std::string& address, std::uint16_t& po
     if (colon > 0) address = text.substr(0, colon);
     port_text = std::string_view(text).substr(colon + 1);
   }
-  unsigned value = 0;
-  const auto [ptr, ec] =
-      std::from_chars(port_text.data(), port_text.data() + port_text.size(), value);
-  if (ec != std::errc() || ptr != port_text.data() + port_text.size() || value > 65535)
-    return false;
-  port = static_cast<std::uint16_t>(value);
+  const std::optional<std::uint16_t> value = parse_number<std::uint16_t>(port_text);
+  if (!value) return false;
+  port = *value;
   return true;
 }
 

@@ -2,11 +2,11 @@
 
 #include <fmt/format.h>
 
-#include <charconv>
 #include <cmath>
 #include <memory>
 #include <optional>
 
+#include "duet/base/parse_number.h"
 #include "duet/eval/performance.h"
 #include "duet/io/motion_argument.h"
 
@@ -20,13 +20,8 @@ int find_take(const DuetLibrary& library, const std::string& word) {
   for (std::size_t k = 0; k < takes.size(); ++k) {
     if (takes[k].name == word) return static_cast<int>(k);
   }
-  int index = -1;
-  const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), index);
-  if (error == std::errc() && end == word.data() + word.size() && index >= 0 &&
-      index < static_cast<int>(takes.size())) {
-    return index;
-  }
-  return -1;
+  const std::optional<int> index = parse_number<int>(word);
+  return index && *index >= 0 && *index < static_cast<int>(takes.size()) ? *index : -1;
 }
 
 std::string take_names(const DuetLibrary& library) {

@@ -1,12 +1,13 @@
 #include "duet/io/points_csv.h"
 
-#include <algorithm>
-#include <charconv>
-#include <cmath>
-#include <vector>
-
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <vector>
+
+#include "duet/base/parse_number.h"
 #include "duet/motion/head_hands.h"
 #include "duet/motion/limits.h"
 #include "text_file.h"
@@ -34,11 +35,9 @@ std::string_view trim(std::string_view text) {
 }
 
 bool parse_double(std::string_view token, double& value) {
-  token = trim(token);
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  if (token.empty()) return false;
-  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  return ec == std::errc() && end == token.data() + token.size() && std::isfinite(value);
+  const std::optional<double> parsed = parse_number<double>(trim(token), PlusSign::kAllowed);
+  if (parsed) value = *parsed;
+  return parsed.has_value();
 }
 
 // The column names of the header, for messages.

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 
+#include "duet/base/parse_number.h"
 #include "duet/math/rotation.h"
 
 namespace duet {
@@ -34,6 +35,7 @@ class Tokens {
   std::size_t pos_ = 0;
 };
 
+// Non-finite values parse here (unlike parse_number): the caller reports them as such.
 bool parse_double(std::string_view token, double& value) {
   const char* begin = token.data();
   const char* end = begin + token.size();
@@ -43,9 +45,7 @@ bool parse_double(std::string_view token, double& value) {
 }
 
 bool parse_int(std::string_view token) {
-  long long value = 0;
-  const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  return ec == std::errc() && ptr == token.data() + token.size();
+  return parse_number<long long>(token, PlusSign::kAllowed).has_value();
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 #include "duet/live/source_spec.h"
 
-#include <charconv>
 #include <cmath>
+#include <optional>
+
+#include "duet/base/parse_number.h"
 
 namespace duet {
 
@@ -12,18 +14,16 @@ Error spec_error(std::string_view text, const std::string& reason) {
 }
 
 bool parse_port(std::string_view text, std::uint16_t& port) {
-  unsigned value = 0;
-  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || ptr != text.data() + text.size() || value == 0 || value > 65535) {
-    return false;
-  }
-  port = static_cast<std::uint16_t>(value);
+  const std::optional<std::uint16_t> value = parse_number<std::uint16_t>(text);
+  if (!value || *value == 0) return false;
+  port = *value;
   return true;
 }
 
-bool parse_number(std::string_view text, double& value) {
-  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  return ec == std::errc() && ptr == text.data() + text.size() && std::isfinite(value);
+bool parse_finite(std::string_view text, double& value) {
+  const std::optional<double> parsed = parse_number<double>(text);
+  if (parsed) value = *parsed;
+  return parsed.has_value();
 }
 
 bool parse_flag(std::string_view text, bool& value) {
@@ -69,7 +69,7 @@ std::optional<std::string> apply_query(std::string_view query, SourceSpec& spec)
     const std::string bad = "bad value '" + std::string(value) + "' for " + std::string(key);
     if (spec.kind == SourceKind::kReplay) {
       if (key == "speed") {
-        if (!parse_number(value, spec.replay.speed) || spec.replay.speed < 0.05 ||
+        if (!parse_finite(value, spec.replay.speed) || spec.replay.speed < 0.05 ||
             spec.replay.speed > 20.0) {
           return bad + " (a number from 0.05 to 20)";
         }
@@ -80,7 +80,7 @@ std::optional<std::string> apply_query(std::string_view query, SourceSpec& spec)
         continue;
       }
       if (key == "start") {
-        if (!parse_number(value, spec.replay.start_s) || spec.replay.start_s < 0.0) {
+        if (!parse_finite(value, spec.replay.start_s) || spec.replay.start_s < 0.0) {
           return bad + " (seconds >= 0)";
         }
         continue;

@@ -1,9 +1,10 @@
 #include "duet/motion/rig_variants.h"
 
-#include <charconv>
 #include <cmath>
+#include <optional>
 #include <vector>
 
+#include "duet/base/parse_number.h"
 #include "duet/math/rotation.h"
 #include "duet/motion/forward_kinematics.h"
 
@@ -104,14 +105,12 @@ bool parse_rig_proportions(std::string_view text, RigProportions& proportions, s
       return false;
     }
     const std::string_view key = item.substr(0, eq), value_text = item.substr(eq + 1);
-    double value = 0.0;
-    const auto [end, ec] =
-        std::from_chars(value_text.data(), value_text.data() + value_text.size(), value);
-    if (ec != std::errc{} || end != value_text.data() + value_text.size() ||
-        !std::isfinite(value)) {
+    const std::optional<double> number = parse_number<double>(value_text);
+    if (!number) {
       error = "'" + std::string(item) + "': the value is not a number";
       return false;
     }
+    const double value = *number;
     const bool factor = key == "arms" || key == "legs" || key == "trunk";
     if (factor && !(value > 0.0 && value <= 10.0)) {
       error = "'" + std::string(item) + "': a length factor must be in (0, 10]";

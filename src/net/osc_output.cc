@@ -2,8 +2,9 @@
 
 #include <array>
 #include <boost/asio/ip/udp.hpp>
-#include <charconv>
+#include <optional>
 
+#include "duet/base/parse_number.h"
 #include "duet/net/osc_writer.h"
 
 namespace duet::net {
@@ -27,14 +28,9 @@ bool parse_osc_target(const std::string& text, std::string& host, std::uint16_t&
     if (host.find(':') != std::string::npos) return false;  // a bare IPv6 address needs brackets
     port_text = std::string_view(text).substr(colon + 1);
   }
-  unsigned value = 0;
-  const auto [ptr, ec] =
-      std::from_chars(port_text.data(), port_text.data() + port_text.size(), value);
-  if (ec != std::errc() || ptr != port_text.data() + port_text.size() || value == 0 ||
-      value > 65535 || host.empty()) {
-    return false;
-  }
-  port = static_cast<std::uint16_t>(value);
+  const std::optional<std::uint16_t> value = parse_number<std::uint16_t>(port_text);
+  if (!value || *value == 0 || host.empty()) return false;
+  port = *value;
   return true;
 }
 
