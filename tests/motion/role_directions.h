@@ -1,0 +1,77 @@
+// The role bones' directions of two clips of one motion, compared frame by frame: what the
+// retargeting tests hold to 2 degrees (retarget_test.cc, generic_rigs_test.cc).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+#include <vector>
+
+#include "duet/math/rotation.h"
+#include "duet/motion/body_space.h"
+#include "duet/motion/clip.h"
+#include "duet/motion/forward_kinematics.h"
+#include "duet/motion/skeleton_map.h"
+
+namespace duet::test {
+
+// The bones the tests compare: upper arms, forearms, thighs, shins, and pelvis centre -> head.
+struct Bone {
+  Role from, to;
+};
+inline constexpr Bone kLimbs[] = {
+    {Role::kLeftShoulder, Role::kLeftElbow},
+    {Role::kLeftElbow, Role::kLeftWrist},
+    {Role::kRightShoulder, Role::kRightElbow},
+    {Role::kRightElbow, Role::kRightWrist},
+    {Role::kLeftHip, Role::kLeftKnee},
+    {Role::kLeftKnee, Role::kLeftAnkle},
+    {Role::kRightHip, Role::kRightKnee},
+    {Role::kRightKnee, Role::kRightAnkle},
+    {Role::kSpine, Role::kChest},
+    {Role::kNeck, Role::kHead},
+    {Role::kLeftAnkle, Role::kLeftToe},
+    {Role::kRightAnkle, Role::kRightToe},
+};
+
+inline double angle_deg(const Vec3& a, const Vec3& b) {
+  return rad_to_deg(std::atan2(a.cross(b).norm(), a.dot(b)));
+}
+
+struct Stats {
+  double max = 0.0, median = 0.0;
+};
+inline Stats stats(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return {v.back(), v[v.size() / 2]};
+}
+
+// Per frame, the largest angle between the two clips' role bones (and, with `pelvis_to_head`,
+// the pelvis-centre -> head line).
+inline std::vector<double> direction_errors(const Clip& a, const JointRoles& ra, const Clip& b,
+                                            const JointRoles& rb, bool pelvis_to_head) {
+  const std::vector<Vec3> pa = world_positions(a), pb = world_positions(b);
+  const auto na = static_cast<std::size_t>(a.joint_count()),
+             nb = static_cast<std::size_t>(b.joint_count());
+  std::vector<double> errors;
+  for (int f = 0; f < a.frame_count(); ++f) {
+    const std::span<const Vec3> fa(pa.data() + static_cast<std::size_t>(f) * na, na);
+    const std::span<const Vec3> fb(pb.data() + static_cast<std::size_t>(f) * nb, nb);
+    auto at = [](std::span<const Vec3> p, const JointRoles& r, Role role) {
+      return p[static_cast<std::size_t>(r[role])];
+    };
+    double worst = 0.0;
+    for (const Bone& bone : kLimbs) {
+      worst = std::max(worst, angle_deg(at(fa, ra, bone.to) - at(fa, ra, bone.from),
+                                        at(fb, rb, bone.to) - at(fb, rb, bone.from)));
+    }
+    if (pelvis_to_head) {
+      worst = std::max(worst, angle_deg(at(fa, ra, Role::kHead) - pelvis_centre(fa, ra),
+                                        at(fb, rb, Role::kHead) - pelvis_centre(fb, rb)));
+    }
+    errors.push_back(worst);
+  }
+  return errors;
+}
+
+}  // namespace duet::test
