@@ -2,7 +2,6 @@
 // (docs/retarget.md).
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <filesystem>
 #include <system_error>
 
@@ -13,7 +12,6 @@
 #include "duet/motion/generic_rigs.h"
 #include "duet/motion/retarget.h"
 #include "duet/motion/rig_variants.h"
-#include "duet/motion/role_detection.h"
 #include "library_options.h"
 #include "motion_options.h"
 #include "number_checks.h"
@@ -39,10 +37,7 @@ const GenericRigInfo* generic_rig_named(const std::vector<std::string>& words) {
   if (words.size() != 1) return nullptr;
   std::error_code ec;  // a name too long for a path is no file either, not an exception
   if (std::filesystem::exists(words.front(), ec)) return nullptr;
-  const auto rigs = generic_rigs();
-  const auto found = std::ranges::find_if(
-      rigs, [&](const GenericRigInfo& rig) { return rig.name == words.front(); });
-  return found == rigs.end() ? nullptr : &*found;
+  return find_generic_rig(words.front());
 }
 
 // A --rig word: a motion file (motion_word_check), or a generic rig's name.
@@ -155,13 +150,13 @@ int run_retarget(const RetargetArgs& args) {
     rig_name = rig.value().description;
   }
   if (generic != nullptr) {
-    rig_skeleton = make_generic_rig(generic->rig);
-    RoleDetection detection = detect_roles_report(rig_skeleton);
-    if (!detection.complete()) {  // a bug, not the user's
-      fmt::print(stderr, "duet retarget: rig {}: {}\n", generic->name, detection.problem);
+    Result<GenericRigWithRoles> made = make_generic_rig_with_roles(generic->rig);
+    if (!made) {
+      fmt::print(stderr, "duet retarget: rig {}: {}\n", generic->name, made.error().message);
       return kExitFailure;
     }
-    rig_roles = std::move(detection.roles);
+    rig_skeleton = std::move(made.value().skeleton);
+    rig_roles = std::move(made.value().roles);
     rig_metres_per_unit = 1.0;
     rig_name = std::string(generic->name) + " (a rig made in code, docs/retarget.md)";
   }

@@ -7,7 +7,6 @@
 #include "duet/io/motion_file.h"
 #include "duet/motion/generic_rigs.h"
 #include "duet/motion/rig_variants.h"
-#include "duet/motion/role_detection.h"
 
 namespace duet::app {
 
@@ -71,16 +70,11 @@ Result<std::vector<EvalRig>> load_eval_rigs(const std::vector<std::string>& entr
       rigs.push_back({"proportioned", std::move(rig), roles});
       continue;
     }
-    const auto generic = std::ranges::find_if(
-        generic_rigs(), [&](const GenericRigInfo& r) { return entry == r.name; });
-    if (generic != generic_rigs().end()) {
-      // Its roles come from role detection, as a user's file's would.
-      auto rig = std::make_shared<Skeleton>(make_generic_rig(generic->rig));
-      RoleDetection detection = detect_roles_report(*rig);
-      if (!detection.complete()) {
-        return Error{"--rigs " + entry + ": " + detection.problem};  // a bug, not the user's
-      }
-      rigs.push_back({entry, std::move(rig), std::move(detection.roles)});
+    if (const GenericRigInfo* generic = find_generic_rig(entry); generic != nullptr) {
+      Result<GenericRigWithRoles> made = make_generic_rig_with_roles(generic->rig);
+      if (!made) return Error{"--rigs " + entry + ": " + made.error().message};
+      rigs.push_back({entry, std::make_shared<Skeleton>(std::move(made.value().skeleton)),
+                      std::move(made.value().roles)});
       continue;
     }
     const auto data_rig = std::ranges::find_if(

@@ -1,11 +1,13 @@
 #include "duet/motion/generic_rigs.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "duet/math/rotation.h"
+#include "duet/motion/role_detection.h"
 
 namespace duet {
 
@@ -30,6 +32,13 @@ class RigBuilder {
     }
     skeleton_.joints.push_back(Joint{name, p, offset, std::move(channels), false});
     positions_.push_back(position);
+  }
+  // Joints each below the one before, the first below `parent`.
+  void chain(std::string parent, std::initializer_list<std::pair<std::string, Vec3>> joints) {
+    for (const auto& [name, position] : joints) {
+      add(name, parent, position);
+      parent = name;
+    }
   }
 
   // Every joint without children ends in an End Site `tip` past it (forward for the toes, on
@@ -86,34 +95,34 @@ Body body_of_height(double height_m) { return Body{height_m / 1.75}; }
 
 Skeleton game_avatar() {
   const Body b = body_of_height(1.80);
+  const auto spine = [&](double share) { return lerp(b.pelvis(), b.chest(), share); };
   RigBuilder r;
-  r.add("root", "", Vec3::Zero());
-  r.add("pelvis", "root", b.pelvis());
-  std::string below = "pelvis";
-  const double spine_at[] = {0.2, 0.45, 0.7, 0.85, 1.0};
-  for (int i = 0; i < 5; ++i) {
-    const std::string name = "spine_0" + std::to_string(i + 1);
-    r.add(name, below, lerp(b.pelvis(), b.chest(), spine_at[i]));
-    below = name;
-  }
-  r.add("neck_01", "spine_05", b.neck());
-  r.add("neck_02", "neck_01", lerp(b.neck(), b.head(), 0.5));
-  r.add("head", "neck_02", b.head());
+  r.chain("", {{"root", Vec3::Zero()},
+               {"pelvis", b.pelvis()},
+               {"spine_01", spine(0.2)},
+               {"spine_02", spine(0.45)},
+               {"spine_03", spine(0.7)},
+               {"spine_04", spine(0.85)},
+               {"spine_05", b.chest()},
+               {"neck_01", b.neck()},
+               {"neck_02", lerp(b.neck(), b.head(), 0.5)},
+               {"head", b.head()}});
   for (const auto& [s, side] : {std::pair{"l", 1.0}, std::pair{"r", -1.0}}) {
     const std::string x = std::string("_") + s;
     const auto [elbow, wrist, hand] = b.arm(side, 45.0);
-    r.add("clavicle" + x, "spine_05", b.at(0.03 * side, 1.40, 0.0));
-    r.add("upperarm" + x, "clavicle" + x, b.shoulder(side));
+    r.chain("spine_05", {{"clavicle" + x, b.at(0.03 * side, 1.40, 0.0)},
+                         {"upperarm" + x, b.shoulder(side)},
+                         {"lowerarm" + x, elbow},
+                         {"hand" + x, wrist},
+                         {"middle_01" + x, hand}});
+    r.chain("pelvis", {{"thigh" + x, b.hip(side)},
+                       {"calf" + x, b.knee(side)},
+                       {"foot" + x, b.ankle(side)},
+                       {"ball" + x, b.toe(side)}});
+    // Twist helpers beside the limb joints, halfway along their bones.
     r.add("upperarm_twist_01" + x, "upperarm" + x, lerp(b.shoulder(side), elbow, 0.5));
-    r.add("lowerarm" + x, "upperarm" + x, elbow);
     r.add("lowerarm_twist_01" + x, "lowerarm" + x, lerp(elbow, wrist, 0.5));
-    r.add("hand" + x, "lowerarm" + x, wrist);
-    r.add("middle_01" + x, "hand" + x, hand);
-    r.add("thigh" + x, "pelvis", b.hip(side));
     r.add("thigh_twist_01" + x, "thigh" + x, lerp(b.hip(side), b.knee(side), 0.5));
-    r.add("calf" + x, "thigh" + x, b.knee(side));
-    r.add("foot" + x, "calf" + x, b.ankle(side));
-    r.add("ball" + x, "foot" + x, b.toe(side));
   }
   return std::move(r).finish();
 }
@@ -121,49 +130,47 @@ Skeleton game_avatar() {
 Skeleton depth_camera() {
   const Body b = body_of_height(1.60);
   RigBuilder r;
-  r.add("SpineBase", "", b.pelvis());
-  r.add("SpineMid", "SpineBase", lerp(b.pelvis(), b.chest(), 0.5));
-  r.add("SpineShoulder", "SpineMid", b.at(0.0, 1.43, -0.02));
-  r.add("Neck", "SpineShoulder", b.neck());
-  r.add("Head", "Neck", b.head());
-  for (const auto& [s, side] : {std::pair{"Left", 1.0}, std::pair{"Right", -1.0}}) {
-    const std::string x = s;
+  r.chain("", {{"SpineBase", b.pelvis()},
+               {"SpineMid", lerp(b.pelvis(), b.chest(), 0.5)},
+               {"SpineShoulder", b.at(0.0, 1.43, -0.02)},
+               {"Neck", b.neck()},
+               {"Head", b.head()}});
+  for (const auto& [x, side] : {std::pair{"Left", 1.0}, std::pair{"Right", -1.0}}) {
     const auto [elbow, wrist, hand] = b.arm(side, 0.0);
-    r.add("Shoulder" + x, "SpineShoulder", b.shoulder(side));
-    r.add("Elbow" + x, "Shoulder" + x, elbow);
-    r.add("Wrist" + x, "Elbow" + x, wrist);
-    r.add("Hand" + x, "Wrist" + x, hand);
-    r.add("Hip" + x, "SpineBase", b.hip(side));
-    r.add("Knee" + x, "Hip" + x, b.knee(side));
-    r.add("Ankle" + x, "Knee" + x, b.ankle(side));
-    r.add("Foot" + x, "Ankle" + x, b.toe(side));
+    r.chain("SpineShoulder", {{"Shoulder" + std::string(x), b.shoulder(side)},
+                              {"Elbow" + std::string(x), elbow},
+                              {"Wrist" + std::string(x), wrist},
+                              {"Hand" + std::string(x), hand}});
+    r.chain("SpineBase", {{"Hip" + std::string(x), b.hip(side)},
+                          {"Knee" + std::string(x), b.knee(side)},
+                          {"Ankle" + std::string(x), b.ankle(side)},
+                          {"Foot" + std::string(x), b.toe(side)}});
   }
   return std::move(r).finish();
 }
 
 Skeleton inertial_suit() {
   const Body b = body_of_height(1.92);
+  const auto spine = [&](double share) { return lerp(b.pelvis(), b.chest(), share); };
   RigBuilder r;
-  r.add("Pelvis", "", b.pelvis());
-  std::string below = "Pelvis";
-  const char* spine[] = {"L5", "L3", "T12", "T8"};
-  for (int i = 0; i < 4; ++i) {
-    r.add(spine[i], below, lerp(b.pelvis(), b.chest(), 0.25 * (i + 1)));
-    below = spine[i];
-  }
-  r.add("Neck", "T8", b.neck());
-  r.add("Head", "Neck", b.head());
+  r.chain("", {{"Pelvis", b.pelvis()},
+               {"L5", spine(0.25)},
+               {"L3", spine(0.5)},
+               {"T12", spine(0.75)},
+               {"T8", spine(1.0)},
+               {"Neck", b.neck()},
+               {"Head", b.head()}});
   for (const auto& [s, side] : {std::pair{"Left", 1.0}, std::pair{"Right", -1.0}}) {
     const std::string x = s;
     const auto [elbow, wrist, hand] = b.arm(side, 10.0);
-    r.add(x + "Shoulder", "T8", b.at(0.04 * side, 1.42, -0.02));
-    r.add(x + "UpperArm", x + "Shoulder", b.shoulder(side));
-    r.add(x + "ForeArm", x + "UpperArm", elbow);
-    r.add(x + "Hand", x + "ForeArm", wrist);
-    r.add(x + "UpperLeg", "Pelvis", b.hip(side));
-    r.add(x + "LowerLeg", x + "UpperLeg", b.knee(side));
-    r.add(x + "Foot", x + "LowerLeg", b.ankle(side));
-    r.add(x + "Toe", x + "Foot", b.toe(side));
+    r.chain("T8", {{x + "Shoulder", b.at(0.04 * side, 1.42, -0.02)},
+                   {x + "UpperArm", b.shoulder(side)},
+                   {x + "ForeArm", elbow},
+                   {x + "Hand", wrist}});
+    r.chain("Pelvis", {{x + "UpperLeg", b.hip(side)},
+                       {x + "LowerLeg", b.knee(side)},
+                       {x + "Foot", b.ankle(side)},
+                       {x + "Toe", b.toe(side)}});
   }
   return std::move(r).finish();
 }
@@ -171,6 +178,21 @@ Skeleton inertial_suit() {
 }  // namespace
 
 std::span<const GenericRigInfo> generic_rigs() { return kRigs; }
+
+const GenericRigInfo* find_generic_rig(std::string_view name) {
+  const auto found =
+      std::ranges::find_if(kRigs, [&](const GenericRigInfo& rig) { return rig.name == name; });
+  return found == kRigs.end() ? nullptr : &*found;
+}
+
+Result<GenericRigWithRoles> make_generic_rig_with_roles(GenericRig rig) {
+  GenericRigWithRoles made{make_generic_rig(rig), {}};
+  RoleDetection detection = detect_roles_report(made.skeleton);
+  // Every rig here is made to be read by role detection: a role it misses is a bug.
+  if (!detection.complete()) return Error{"rig made in code: " + detection.problem};
+  made.roles = std::move(detection.roles);
+  return made;
+}
 
 Skeleton make_generic_rig(GenericRig rig) {
   switch (rig) {

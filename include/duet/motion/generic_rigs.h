@@ -10,7 +10,9 @@
 #include <span>
 #include <string_view>
 
+#include "duet/base/result.h"
 #include "duet/motion/skeleton.h"
+#include "duet/motion/skeleton_map.h"
 
 namespace duet {
 
@@ -35,10 +37,20 @@ struct GenericRigInfo {
 
 // Every generic rig, in the order above.
 std::span<const GenericRigInfo> generic_rigs();
+// The rig `name` names (GenericRigInfo::name); nullptr for any other name.
+const GenericRigInfo* find_generic_rig(std::string_view name);
 
 // The rig's skeleton in metres, Y up, facing +Z, its left towards +X, standing on y = 0 in its
 // rest pose (every rotation the identity). The root has position and rotation channels, every
 // other joint rotation channels; each leaf ends in an End Site.
 Skeleton make_generic_rig(GenericRig rig);
+
+// The rig and the roles role detection finds on it by their names, as a user's file's would be
+// read. An error only if detection misses a role (a bug of this file, not the caller's).
+struct GenericRigWithRoles {
+  Skeleton skeleton;
+  JointRoles roles;
+};
+Result<GenericRigWithRoles> make_generic_rig_with_roles(GenericRig rig);
 
 }  // namespace duet
