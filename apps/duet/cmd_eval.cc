@@ -572,9 +572,10 @@ Command register_eval(CLI::App& app) {
                         "how a wrong calibration costs");
   app.add_option("--tell-head-height", args->tell_head_height,
                  "Three points: tell the follower each performer's head height standing (the "
-                 "highest the head is over the performance) times FACTOR (1: exactly, 1.05: 5 % "
+                 "highest the head holds for half a second over the performance) times FACTOR (1: "
+                 "exactly, 1.05: 5 % "
                  "high), as duet follow's and duet serve's --head-height would (default: not "
-                 "told; the unit is then the highest the head has been so far)")
+                 "told; the unit is then the highest the head has held so far)")
       ->option_text("FACTOR")
       ->check(number_between(0.5, 2.0, "factor"));
   app.add_flag("--tell-arms-forward", args->tell_arms_forward,

@@ -81,7 +81,7 @@ CLI::Option* add_head_height_option(CLI::App& app, double& metres) {
                   "point with the user standing straight: the headset's for a headset (a height "
                   "calibration; a headset says nothing of the body's size), the head joint's for "
                   "a recording at the joints. Device offsets taken out of the points are taken "
-                  "out of it too. Default: learnt as the highest the head has been, which a "
+                  "out of it too. Default: learnt as the highest the head has held, which a "
                   "dance that starts low gets wrong until the dancer stands (docs/features.md, "
                   "three points' unit)")
       ->option_text("M")
@@ -100,7 +100,7 @@ std::optional<std::string> head_height_note(const Clip& points, const JointRoles
   const double head_point = highest + offsets.eyes_m.y();
   return fmt::format(
       "the head was at most {:.2f} m high in the first second and {:.2f} m later: the follower "
-      "learns the body's size from the highest the head has been, so it took the dancer as "
+      "learns the body's size from the highest the head has held, so it took the dancer as "
       "{:.0f} % smaller until they stood. --head-height {:.2f} (the head's height standing) "
       "gives the size from the first frame",
       first + offsets.eyes_m.y(), head_point, 100.0 * (1.0 - first / highest), head_point);

@@ -164,11 +164,13 @@ FeatureExtractor::Context::Sample FeatureExtractor::extract_head_hands(
   now.yaw = heading_yaw(head_canonical);
   now.effectors[0] = context.positions_ws_[at(Role::kLeftWrist)];
   now.effectors[1] = context.positions_ws_[at(Role::kRightWrist)];
-  // Lengths in head heights: the one a calibration gave, else the highest the head has been,
+  // Lengths in head heights: the one a calibration gave, else the highest the head has held,
   // which a dancer reaches standing in the first moments (a floor keeps a first frame on the
   // ground from dividing by ~0).
   constexpr double kLowestHeadHeightM = 0.5;
-  context.head_height_max_m_ = std::max({context.head_height_max_m_, head.y(), kLowestHeadHeightM});
+  context.head_height_max_m_ =
+      std::max({context.head_height_max_m_, held_head_height(context, head.y(), time_s),
+                kLowestHeadHeightM});
   const double per_height = 1.0 / context.head_height_m();
   const Quat to_heading = yaw_rotation(-now.yaw);
 
@@ -220,6 +222,27 @@ const FeatureExtractor::Context::Sample* FeatureExtractor::velocity_reference(
     if (time_s - sample.time_s >= spec_.velocity_window_s) break;
   }
   return reference;
+}
+
+double FeatureExtractor::held_head_height(const Context& context, double head_y,
+                                          double time_s) noexcept {
+  // The median over a window, not the frame's own height: a hop, a moment on tiptoe or a
+  // sensor's spike would otherwise only ever raise the unit (one 0.1 s rise of 7 % kept a
+  // retargeted take lost for 11 s; docs/features.md, three points' unit).
+  constexpr double kHeldS = 0.3;
+  std::array<double, Context::kHistory + 1> heights;
+  std::size_t n = 0;
+  if (std::isfinite(head_y)) heights[n++] = head_y;
+  for (int age = 0; age < context.count_; ++age) {
+    const int index = (context.newest_ - age + Context::kHistory) % Context::kHistory;
+    const Context::Sample& sample = context.history_[static_cast<std::size_t>(index)];
+    if (!(time_s - sample.time_s < kHeldS)) break;
+    if (std::isfinite(sample.root.y())) heights[n++] = sample.root.y();
+  }
+  if (n == 0) return 0.0;
+  const auto middle = heights.begin() + static_cast<std::ptrdiff_t>(n / 2);
+  std::nth_element(heights.begin(), middle, heights.begin() + static_cast<std::ptrdiff_t>(n));
+  return *middle;
 }
 
 void FeatureExtractor::remember(Context& context, const Context::Sample& sample) noexcept {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "duet/math/median.h"
 #include "duet/math/rotation.h"
 #include "duet/motion/body_space.h"
 #include "duet/motion/forward_kinematics.h"
@@ -223,12 +224,29 @@ double highest_head_m(const Clip& clip, const JointRoles& roles, int frames) {
   const auto n = static_cast<std::size_t>(clip.joint_count());
   std::vector<Vec3> positions(n);
   std::vector<Quat> rotations(n);
-  double highest = 0.0;
-  for (int f = 0; f < std::min(frames, clip.frame_count()); ++f) {
+  const int count = std::min(frames, clip.frame_count());
+  std::vector<double> heights;
+  heights.reserve(static_cast<std::size_t>(std::max(count, 0)));
+  for (int f = 0; f < count; ++f) {
     forward_kinematics(clip.skeleton(), clip.translations_ls(f), clip.rotations_ls(f), positions,
                        rotations);
-    const double y = positions[static_cast<std::size_t>(head)].y();
-    if (std::isfinite(y)) highest = std::max(highest, y);
+    heights.push_back(positions[static_cast<std::size_t>(head)].y());
+  }
+  if (heights.empty()) return 0.0;
+  // The level the head holds: the median of each half second, so that a hop, a stretch on tiptoe
+  // for a moment or a sensor's spike does not pass for the body's height.
+  constexpr double kHeldS = 0.5;
+  const auto window = std::clamp<std::size_t>(
+      static_cast<std::size_t>(std::lround(kHeldS * clip.frame_rate())), 1, heights.size());
+  double highest = 0.0;
+  std::vector<double> held;
+  held.reserve(window);
+  for (std::size_t start = 0; start + window <= heights.size(); ++start) {
+    held.clear();
+    for (std::size_t f = start; f < start + window; ++f) {
+      if (std::isfinite(heights[f])) held.push_back(heights[f]);
+    }
+    if (!held.empty()) highest = std::max(highest, upper_median(held));
   }
   return highest;
 }

@@ -389,7 +389,7 @@ struct LiveServer::Impl {
     log(message.head_height_m > 0.0
             ? fmt::format("the headset's height standing: {:.2f} m (the user's size from it)",
                           message.head_height_m)
-            : std::string("the user's size is learnt again from the highest the head has been"));
+            : std::string("the user's size is learnt again from the highest the head has held"));
   }
 
   // A body calibration from the headset (the viewer: both grips held while standing straight with

@@ -1,7 +1,7 @@
 // A height calibration in VR (docs/protocol.md, `head_height`): standing straight, the user
 // holds both controllers' grip buttons for a second, and the headset's height goes to the server,
 // which then knows the user's size from the first step instead of learning it from the highest
-// the head has been (a dance that starts low fools that for its first seconds). Held with both
+// the head has held (a dance that starts low fools that for its first seconds). Held with both
 // arms straight forward, the same hold also calibrates the body (`arms_forward`): where this body
 // holds its hands, which another body's shoulders and head place differently.
 

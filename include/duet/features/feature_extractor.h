@@ -31,11 +31,11 @@ class FeatureExtractor {
    public:
     void reset() noexcept;
     // Head and hands: the user's head height standing (metres), known from a calibration, as the
-    // unit of lengths; 0 (the default) learns it, as the highest the head has been. Kept across
+    // unit of lengths; 0 (the default) learns it, as the highest the head has held. Kept across
     // reset().
     void set_head_height(double head_height_m) noexcept { head_height_known_m_ = head_height_m; }
     // The calibration's height (0: none) and the unit of lengths in use: the calibration's, else
-    // the highest the head has been (0 before the first frame).
+    // the highest the head has held (0 before the first frame).
     double known_head_height_m() const noexcept { return head_height_known_m_; }
     double head_height_m() const noexcept {
       return head_height_known_m_ > 0.0 ? head_height_known_m_ : head_height_max_m_;
@@ -59,8 +59,8 @@ class FeatureExtractor {
     std::array<Sample, kHistory> history_{};
     int newest_ = -1;
     int count_ = 0;
-    // Head and hands: the highest the head has been (metres), the unit of lengths there, since a
-    // headset says nothing of the body's size.
+    // Head and hands: the highest the head has held (metres; held_head_height), the unit of
+    // lengths there, since a headset says nothing of the body's size.
     double head_height_max_m_ = 0.0;
     double head_height_known_m_ = 0.0;  // set_head_height; 0: learnt
     std::array<Vec3, 2> hand_offsets_{Vec3::Zero(), Vec3::Zero()};  // set_hand_offsets
@@ -105,6 +105,9 @@ class FeatureExtractor {
   // (the first frames of a performance); null when there is none.
   const Context::Sample* velocity_reference(const Context& context, double time_s) const noexcept;
   static void remember(Context& context, const Context::Sample& sample) noexcept;
+  // The level the head holds: the median of its height at `time_s` (head_y) and at the
+  // remembered frames of the last 0.3 s (the last Context::kHistory frames above 213 Hz).
+  static double held_head_height(const Context& context, double head_y, double time_s) noexcept;
   // The velocity blocks: the root's velocity in the heading frame and the yaw rate, then the
   // speeds of the first `effectors` effectors, lengths times per_unit (FeatureSpec).
   void put_velocities(const Context& context, const Context::Sample& now, const Quat& to_heading,

@@ -43,7 +43,7 @@ class FollowSession {
   Status set_head_height(double head_height_m);
   static constexpr double kHeadHeightRangeM[2] = {0.5, 2.5};
   // The calibration's height (0: none) and the three points' unit of lengths in use (the
-  // calibration's, else the highest the head has been; 0 before the first frame).
+  // calibration's, else the highest the head has held; 0 before the first frame).
   double known_head_height_m() const noexcept { return context_.known_head_height_m(); }
   double head_height_m() const noexcept { return context_.head_height_m(); }
 

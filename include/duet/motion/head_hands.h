@@ -68,9 +68,11 @@ Result<std::array<Quat, 2>> rest_grip_frames(const Skeleton& skeleton, const Joi
 Result<Clip> head_hands_clip(const Clip& full_body, const JointRoles& roles,
                              const DevicePointOffsets& offsets = {});
 
-// The highest the head joint is over a clip's first `frames` frames (all by default), metres above
-// the floor, y up: over a whole dance, a standing calibration of the performer's head height (0
-// when no frame has a finite head). Any rig with a head role, three points included.
+// The highest the head joint holds over a clip's first `frames` frames (all by default), metres
+// above the floor, y up: the highest median of its height over half a second (the whole clip when
+// shorter), so a hop or a sensor's spike does not count. Over a whole dance, a standing
+// calibration of the performer's head height (0 when no frame has a finite head). Any rig with a
+// head role, three points included.
 double highest_head_m(const Clip& clip, const JointRoles& roles,
                       int frames = std::numeric_limits<int>::max());
 
