@@ -92,6 +92,31 @@ bool frame_at(const FrameVectors& v, PointFn point, Quat& frame) {
   return frame_from(up, point(v.lateral_to) - point(v.lateral_from), frame);
 }
 
+using TrunkPoint = Retargeter::TrunkPoint;
+
+template <typename PointFn>
+Vec3 point_at(const TrunkPoint& trunk_point, PointFn point) {
+  Vec3 sum = Vec3::Zero();
+  for (std::size_t k = 0; k < trunk_point.joints.size(); ++k) {
+    if (trunk_point.joints[k] >= 0) sum += trunk_point.weights[k] * point(trunk_point.joints[k]);
+  }
+  return sum;
+}
+
+// The source's frame of a two-vector joint (frame_at), its up measured along the trunk where the
+// target's joints sit on it: the hips' up ends at the point the target's spine follows, the
+// chest's starts at the point the target's chest follows.
+template <typename PointFn>
+bool source_frame_at(Role role, const JointRoles& roles, const TrunkPoint& spine_point,
+                     const TrunkPoint& chest_point, PointFn point, Quat& frame) {
+  const FrameVectors v = frame_vectors(role, roles);
+  const Vec3 up =
+      role == Role::kHips
+          ? Vec3(point_at(spine_point, point) - 0.5 * (point(v.up_from_a) + point(v.up_from_b)))
+          : Vec3(point(v.up_to) - point_at(chest_point, point));
+  return frame_from(up, point(v.lateral_to) - point(v.lateral_from), frame);
+}
+
 bool below(const Skeleton& skeleton, int ancestor, std::initializer_list<int> joints) {
   for (int j : joints) {
     if (j != ancestor && !is_ancestor(skeleton, ancestor, j)) return false;
@@ -144,6 +169,47 @@ std::vector<Vec3> rest_positions(const Skeleton& skeleton, std::vector<Vec3>& of
   std::vector<Quat> world(n);
   forward_kinematics(skeleton, offsets, identities, positions, world);
   return positions;
+}
+
+// The trunk as a path along its role joints: pelvis centre -> spine -> chest -> neck (the points'
+// joints, the pelvis centre being the midpoint of the thigh joints), and its segments' rest
+// lengths.
+struct TrunkPath {
+  std::array<double, 3> lengths{};
+  double total() const { return lengths[0] + lengths[1] + lengths[2]; }
+};
+
+TrunkPath trunk_path(const std::vector<Vec3>& rest, const JointRoles& roles) {
+  const auto at = [&](Role role) { return rest[static_cast<std::size_t>(roles[role])]; };
+  const Vec3 pelvis = 0.5 * (at(Role::kLeftHip) + at(Role::kRightHip));
+  return {{(at(Role::kSpine) - pelvis).norm(), (at(Role::kChest) - at(Role::kSpine)).norm(),
+           (at(Role::kNeck) - at(Role::kChest)).norm()}};
+}
+
+// The point `share` of the way along the source's trunk path, as a weighted sum of its joints.
+TrunkPoint trunk_point(const TrunkPath& path, const JointRoles& roles, double share) {
+  const int lh = roles[Role::kLeftHip], rh = roles[Role::kRightHip];
+  const int spine = roles[Role::kSpine], chest = roles[Role::kChest], neck = roles[Role::kNeck];
+  double along = std::clamp(share, 0.0, 1.0) * path.total();
+  TrunkPoint point;
+  if (along < path.lengths[0] || (path.lengths[1] <= 0.0 && path.lengths[2] <= 0.0)) {
+    const double w = path.lengths[0] > 0.0 ? std::min(along / path.lengths[0], 1.0) : 1.0;
+    point.joints = {lh, rh, spine};
+    point.weights = {0.5 * (1.0 - w), 0.5 * (1.0 - w), w};
+    return point;
+  }
+  along -= path.lengths[0];
+  if (along < path.lengths[1] || path.lengths[2] <= 0.0) {
+    const double w = path.lengths[1] > 0.0 ? std::min(along / path.lengths[1], 1.0) : 1.0;
+    point.joints = {spine, chest, -1};
+    point.weights = {1.0 - w, w, 0.0};
+    return point;
+  }
+  along -= path.lengths[1];
+  const double w = std::min(along / path.lengths[2], 1.0);
+  point.joints = {chest, neck, -1};
+  point.weights = {1.0 - w, w, 0.0};
+  return point;
 }
 
 std::string check_roles(const Skeleton& skeleton, const JointRoles& roles,
@@ -200,6 +266,21 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
   std::vector<Quat> s_identity, t_identity;
   const std::vector<Vec3> s_rest = rest_positions(s, s_offsets, s_identity);
   const std::vector<Vec3> t_rest = rest_positions(t, t_offsets, t_identity);
+  // The rigs need not put their spine and chest joints at the same heights of the trunk: the
+  // target's follow the source's trunk at their own shares of its length.
+  {
+    const TrunkPath s_path = trunk_path(s_rest, source_roles);
+    const TrunkPath t_path = trunk_path(t_rest, target_roles);
+    const bool measurable = s_path.total() > kShortBone && t_path.total() > kShortBone;
+    const double spine_share = measurable ? t_path.lengths[0] / t_path.total() : -1.0;
+    const double chest_share =
+        measurable ? (t_path.lengths[0] + t_path.lengths[1]) / t_path.total() : -1.0;
+    r.spine_point_ = measurable ? trunk_point(s_path, source_roles, spine_share)
+                                : TrunkPoint{{source_roles[Role::kSpine], -1, -1}, {1.0, 0.0, 0.0}};
+    r.chest_point_ = measurable ? trunk_point(s_path, source_roles, chest_share)
+                                : TrunkPoint{{source_roles[Role::kChest], -1, -1}, {1.0, 0.0, 0.0}};
+  }
+  const auto s_rest_at = [&](int j) { return s_rest[static_cast<std::size_t>(j)]; };
   r.rules_.assign(static_cast<std::size_t>(t.joint_count()), JointRule{});
   auto rule_of = [&](int joint) -> JointRule& { return r.rules_[static_cast<std::size_t>(joint)]; };
   auto free = [&](int joint) {
@@ -247,8 +328,7 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
     Quat t_frame, s_frame;
     if (!frame_at(
             tv, [&](int j) { return t_rest[static_cast<std::size_t>(j)]; }, t_frame) ||
-        !frame_at(
-            sv, [&](int j) { return s_rest[static_cast<std::size_t>(j)]; }, s_frame)) {
+        !source_frame_at(role, source_roles, r.spine_point_, r.chest_point_, s_rest_at, s_frame)) {
       continue;
     }
     rule_of(tj) = {Rule::kFrame, sj, -1, -1, -1, -1, (s_frame * t_frame.conjugate()).normalized()};
@@ -258,8 +338,13 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
     const int tj = target_roles[bone.joint], te = target_roles[bone.end];
     const int sj = source_roles[bone.joint], se = source_roles[bone.end];
     if (!free(tj) || !is_ancestor(t, tj, te) || !is_ancestor(s, sj, se)) continue;
+    // The spine bone runs between the points of the source's trunk the target's spine and chest
+    // follow.
+    const bool spine = bone.joint == Role::kSpine;
     const Vec3 t_dir = t_rest[static_cast<std::size_t>(te)] - t_rest[static_cast<std::size_t>(tj)];
-    const Vec3 s_dir = s_rest[static_cast<std::size_t>(se)] - s_rest[static_cast<std::size_t>(sj)];
+    const Vec3 s_dir =
+        spine ? Vec3(point_at(r.chest_point_, s_rest_at) - point_at(r.spine_point_, s_rest_at))
+              : Vec3(s_rest_at(se) - s_rest_at(sj));
     if (!(t_dir.norm() > 1e-9) || !(s_dir.norm() > 1e-9)) continue;
     rule_of(tj) = {Rule::kDirection,
                    sj,
@@ -269,7 +354,7 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
                    -1,
                    Quat::FromTwoVectors(t_dir, s_dir).normalized(),
                    tj,
-                   sj};
+                   spine ? kTrunkPoints : sj};
   }
   // End joints follow their parent role's bone.
   for (const BonePair& follower : kFollowers) {
@@ -411,7 +496,9 @@ void Retargeter::retarget_frame(std::span<const Vec3> source_translations_ls,
             chain_vector(t, joint, rule.target_end, target_translations_ls, target_rotations_ls) -
             chain_vector(t, joint, rule.target_start, target_translations_ls, target_rotations_ls);
         world = ws(rule.source) * rule.alignment;
-        const Vec3 wanted = ps(rule.source_end) - ps(rule.source_start);
+        const Vec3 wanted = rule.source_start == kTrunkPoints
+                                ? Vec3(point_at(chest_point_, ps) - point_at(spine_point_, ps))
+                                : Vec3(ps(rule.source_end) - ps(rule.source_start));
         const Vec3 current = world * bone_ls;
         if (wanted.norm() > 1e-9 && current.norm() > 1e-9) {
           world = Quat::FromTwoVectors(current, wanted) * world;
@@ -428,7 +515,7 @@ void Retargeter::retarget_frame(std::span<const Vec3> source_translations_ls,
                   return chain_vector(t, joint, e, target_translations_ls, target_rotations_ls);
                 },
                 local_frame) &&
-            frame_at(frame_vectors(role, source_roles_), ps, source_frame);
+            source_frame_at(role, source_roles_, spine_point_, chest_point_, ps, source_frame);
         world = ok ? source_frame * local_frame.conjugate() : ws(rule.source) * rule.alignment;
         break;
       }

@@ -313,7 +313,10 @@ TEST(CliHeadHands, ACalibrationFollowsAnotherBodyAsTheLibrarysOwn) {
   EXPECT_EQ(told.output.find("note:"), std::string::npos) << told.output;
   const double untold_share = share_on_take(untold_trace, 8);  // 60_10
   const double told_share = share_on_take(told_trace, 8);
-  EXPECT_GT(told_share, 0.98) << "untold " << untold_share;
+  // Measured 0.978 (0.997 before the retargeter read the trunk as a path: the take's 0.1 s hop at
+  // 5 s now lifts this rig's head 10 cm over where the library dancer's was; docs/evaluation.md,
+  // "The trunk as a path"), untold 0.715.
+  EXPECT_GT(told_share, 0.97) << "untold " << untold_share;
   EXPECT_LT(untold_share, told_share - 0.03);
 
   // Arms down is no calibration; a full body is not calibrated this way.

@@ -14,6 +14,10 @@
 //   - the hips and the chest are oriented from two vectors each, the trunk's up (pelvis centre ->
 //     spine; chest -> neck) kept exact and the left-right line (right hip -> left hip; right
 //     shoulder -> left shoulder) made perpendicular to it, so the body's facing and twist transfer.
+//     The rigs need not put their spine and chest joints at the same heights: each follows the
+//     point of the source's trunk (pelvis centre -> spine -> chest -> neck) at its own share of
+//     its trunk's length, so a bent trunk keeps its shape (taking the source's spine direction for
+//     a game avatar's longer lower trunk put its shoulders 20 cm further forward in a deep bend).
 //     When a rig's neck joint sits on its chest joint (the CMU MotionBuilder rig) there is no
 //     chest up: the chest then turns like a bone whose direction is the shoulder line.
 //   - an end joint (head, hands, toes) keeps its rotation relative to its parent role's bone, seen
@@ -31,6 +35,7 @@
 // continuous (no popping); docs/retarget.md gives its measured frame-to-frame change.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <span>
@@ -91,6 +96,15 @@ class Retargeter {
   const Skeleton& target() const { return *target_; }
   std::shared_ptr<const Skeleton> target_ptr() const { return target_; }
 
+  // A point of the source's trunk a target joint follows: a weighted sum of source role joints.
+  struct TrunkPoint {
+    std::array<int, 3> joints = {-1, -1, -1};
+    std::array<double, 3> weights = {0.0, 0.0, 0.0};
+  };
+  // JointRule::source_start of the spine bone: it runs from the spine's trunk point to the
+  // chest's.
+  static constexpr int kTrunkPoints = -2;
+
   // How a target joint gets its rotation (public for the implementation's helpers only).
   // kFacing: the world rotation of the source joint times the alignment (the head, with
   // RetargetOptions' head corrections).
@@ -117,6 +131,8 @@ class Retargeter {
   RetargetOptions options_;
   double stride_scale_ = 1.0;
   std::vector<JointRule> rules_;  // per target joint
+  TrunkPoint spine_point_;        // where on the source's trunk the target's spine sits
+  TrunkPoint chest_point_;        // and its chest
   // Per-frame scratch (sized at creation).
   std::vector<Vec3> source_positions_;
   std::vector<Quat> source_world_;
