@@ -94,6 +94,7 @@ bool frame_at(const FrameVectors& v, PointFn point, Quat& frame) {
 
 using TrunkPoint = Retargeter::TrunkPoint;
 
+// Where a trunk point is: the weighted sum of its joints' positions, `point(j)` giving each.
 template <typename PointFn>
 Vec3 point_at(const TrunkPoint& trunk_point, PointFn point) {
   Vec3 sum = Vec3::Zero();
