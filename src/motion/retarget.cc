@@ -269,17 +269,16 @@ Result<Retargeter> Retargeter::create(std::shared_ptr<const Skeleton> source,
   const std::vector<Vec3> t_rest = rest_positions(t, t_offsets, t_identity);
   // The rigs need not put their spine and chest joints at the same heights of the trunk: the
   // target's follow the source's trunk at their own shares of its length.
-  {
-    const TrunkPath s_path = trunk_path(s_rest, source_roles);
-    const TrunkPath t_path = trunk_path(t_rest, target_roles);
-    const bool measurable = s_path.total() > kShortBone && t_path.total() > kShortBone;
-    const double spine_share = measurable ? t_path.lengths[0] / t_path.total() : -1.0;
-    const double chest_share =
-        measurable ? (t_path.lengths[0] + t_path.lengths[1]) / t_path.total() : -1.0;
-    r.spine_point_ = measurable ? trunk_point(s_path, source_roles, spine_share)
-                                : TrunkPoint{{source_roles[Role::kSpine], -1, -1}, {1.0, 0.0, 0.0}};
-    r.chest_point_ = measurable ? trunk_point(s_path, source_roles, chest_share)
-                                : TrunkPoint{{source_roles[Role::kChest], -1, -1}, {1.0, 0.0, 0.0}};
+  // A trunk too short to measure keeps the source's own spine and chest joints.
+  r.spine_point_ = TrunkPoint{{source_roles[Role::kSpine], -1, -1}, {1.0, 0.0, 0.0}};
+  r.chest_point_ = TrunkPoint{{source_roles[Role::kChest], -1, -1}, {1.0, 0.0, 0.0}};
+  if (const TrunkPath s_path = trunk_path(s_rest, source_roles),
+      t_path = trunk_path(t_rest, target_roles);
+      s_path.total() > kShortBone && t_path.total() > kShortBone) {
+    const double spine_share = t_path.lengths[0] / t_path.total();
+    const double chest_share = (t_path.lengths[0] + t_path.lengths[1]) / t_path.total();
+    r.spine_point_ = trunk_point(s_path, source_roles, spine_share);
+    r.chest_point_ = trunk_point(s_path, source_roles, chest_share);
   }
   const auto s_rest_at = [&](int j) { return s_rest[static_cast<std::size_t>(j)]; };
   r.rules_.assign(static_cast<std::size_t>(t.joint_count()), JointRule{});
