@@ -630,7 +630,8 @@ Command register_eval(CLI::App& app) {
       ->check(fps_check());
   cases
       ->add_option("--body-scale", args->settings.body_scale,
-                   "Body size factor of the body-size case (default 1.15)")
+                   "Body size of the body-size case against the template dancer's, on every rig "
+                   "(default 1.15)")
       ->check(number_between(0.1, 10.0));
   cases
       ->add_option("--suit-bias-deg", args->settings.suit_bias_deg,

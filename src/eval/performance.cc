@@ -9,6 +9,7 @@
 
 #include "duet/math/rotation.h"
 #include "duet/motion/arms_forward.h"
+#include "duet/motion/body_space.h"
 #include "duet/motion/forward_kinematics.h"
 #include "duet/motion/head_hands.h"
 #include "duet/motion/limits.h"
@@ -680,15 +681,24 @@ Result<Performance> with_rig(Performance performance, std::shared_ptr<const Skel
 
 namespace {
 
-// The performance on recipe.rig, scaled there by recipe.body_scale; as it is without a rig.
+double standing_height_m(const Performance& performance) {
+  return measure_body(performance.motion.skeleton(), performance.roles).standing_height_m;
+}
+
+// The performance on recipe.rig, sized there by recipe.body_scale; as it is without a rig.
 Result<Performance> delivered(Performance performance, const PerformanceRecipe& recipe) {
   if (!recipe.rig) return performance;
+  const double template_height_m = standing_height_m(performance);
   Result<Performance> moved = with_rig(std::move(performance), recipe.rig, recipe.rig_roles);
   if (!moved) return moved.error();
-  // On another rig the body is scaled after retargeting: retargeting onto the rig gives the rig's
-  // own bone lengths, and a scale before it was lost (body-size@asf was clean@asf).
-  if (recipe.body_scale != 1.0) return with_body_scale(std::move(moved).value(), recipe.body_scale);
-  return moved;
+  // On another rig the body is sized after retargeting: retargeting onto the rig gives the rig's
+  // own bone lengths, and a scale before it was lost (body-size@asf was clean@asf). The size is
+  // the template dancer's times body_scale, not the rig's: a sweep of 1.1x on a 1.96 m rig was a
+  // 1.23x body.
+  const double rig_height_m = standing_height_m(moved.value());
+  if (!recipe.body_scale || !(template_height_m > 0.0) || !(rig_height_m > 0.0)) return moved;
+  return with_body_scale(std::move(moved).value(),
+                         *recipe.body_scale * template_height_m / rig_height_m);
 }
 
 }  // namespace
@@ -751,8 +761,8 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     options.seed = derive_seed(seed, 11);
     performance = play(sources[0], options);
   }
-  if (recipe.body_scale != 1.0 && !recipe.rig)
-    performance = with_body_scale(std::move(performance), recipe.body_scale);
+  if (recipe.body_scale && *recipe.body_scale != 1.0 && !recipe.rig)
+    performance = with_body_scale(std::move(performance), *recipe.body_scale);
   if (recipe.room_yaw_rad != 0.0 || !recipe.room_offset_m.isZero()) {
     performance =
         with_room_placement(std::move(performance), recipe.room_yaw_rad, recipe.room_offset_m);

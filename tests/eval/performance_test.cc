@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "duet/eval/runner.h"
 #include "duet/features/feature_extractor.h"
@@ -552,7 +553,7 @@ TEST(EvalCases, HarshCaseAndNoiseSweepHaveIssue11sMagnitudes) {
   EXPECT_NEAR(harsh->recipe.noise.rotation_deg, 4.0 * std::sqrt(3.0), 1e-12);  // 4 per axis
   EXPECT_DOUBLE_EQ(harsh->recipe.noise.position_m, 0.01);
   EXPECT_DOUBLE_EQ(harsh->recipe.loss.repeat_fraction, 0.03);
-  EXPECT_DOUBLE_EQ(harsh->recipe.body_scale, 1.1);
+  EXPECT_DOUBLE_EQ(harsh->recipe.body_scale.value_or(0.0), 1.1);
   // Fixed: a gentler --noise-deg does not soften it.
   CaseSettings gentle;
   gentle.noise_rotation_deg = 0.5;
@@ -592,7 +593,7 @@ TEST(EvalCases, HarshCaseAndNoiseSweepHaveIssue11sMagnitudes) {
   for (int i = 0; i < 5; ++i) {
     const EvalCase& c = bodies[static_cast<std::size_t>(i)];
     EXPECT_EQ(c.name, "body-sweep-" + std::to_string(80 + 10 * i));
-    EXPECT_DOUBLE_EQ(c.recipe.body_scale, 0.8 + 0.1 * i);
+    EXPECT_DOUBLE_EQ(c.recipe.body_scale.value_or(0.0), 0.8 + 0.1 * i);
     EXPECT_DOUBLE_EQ(c.recipe.noise.rotation_deg, 4.0);
     EXPECT_TRUE(c.recipe.improvise);
     EXPECT_DOUBLE_EQ(c.recipe.improvise_options.pause_prob, 1.0);
@@ -698,15 +699,19 @@ TEST(MakePerformance, ComposesImprovisationNoiseAndALowRate) {
   EXPECT_EQ(again.value().times_s, p.value().times_s);
 }
 
-TEST(MakePerformance, ABodySizeOnAnotherRigIsThatRigsBodyScaled) {
-  // Retargeting onto a rig gives the rig's bone lengths: the body's scale is applied after it,
-  // or body-size@rig would be the rig's own body (it was).
+TEST(MakePerformance, ABodySizeOnAnotherRigIsThatSizeOfTheTemplateDancer) {
+  // Retargeting onto a rig gives the rig's bone lengths: the body is sized after it, or
+  // body-size@rig would be the rig's own body (it was). The size is the template dancer's times
+  // the factor, whatever the rig's own size: on a rig 1.3x the dancer, 1.15 is 1.15, not 1.5.
   const Fixture f = make_fixture(120);
   const SourceTake source = f.source();
-  const auto head_to_foot_m = [&](double body_scale) {
+  auto bigger_rig = std::make_shared<Skeleton>(f.clip.skeleton());
+  for (Joint& joint : bigger_rig->joints) joint.offset *= 1.3;
+  const auto head_to_foot_m = [&](std::shared_ptr<const Skeleton> rig,
+                                  std::optional<double> body_scale) {
     PerformanceRecipe recipe;
-    recipe.rig = f.clip.skeleton_ptr();
-    recipe.rig_roles = f.roles;
+    recipe.rig = std::move(rig);
+    if (recipe.rig) recipe.rig_roles = f.roles;
     recipe.body_scale = body_scale;
     Result<Performance> p = make_performance(std::span(&source, 1), recipe, 3);
     EXPECT_TRUE(p) << p.error().message;
@@ -716,7 +721,13 @@ TEST(MakePerformance, ABodySizeOnAnotherRigIsThatRigsBodyScaled) {
             world[static_cast<std::size_t>(f.roles[Role::kLeftAnkle])])
         .norm();
   };
-  EXPECT_NEAR(head_to_foot_m(1.15) / head_to_foot_m(1.0), 1.15, 1e-6);
+  const double dancer = head_to_foot_m(nullptr, std::nullopt);
+  ASSERT_GT(dancer, 0.5);
+  EXPECT_NEAR(head_to_foot_m(nullptr, 1.15) / dancer, 1.15, 1e-6);
+  EXPECT_NEAR(head_to_foot_m(bigger_rig, std::nullopt) / dancer, 1.3, 1e-6);  // the rig's own
+  EXPECT_NEAR(head_to_foot_m(bigger_rig, 1.15) / dancer, 1.15, 1e-6);
+  EXPECT_NEAR(head_to_foot_m(bigger_rig, 1.0) / dancer, 1.0, 1e-6);
+  EXPECT_NEAR(head_to_foot_m(f.clip.skeleton_ptr(), 0.9) / dancer, 0.9, 1e-6);
 }
 
 // The angle at the elbow (upper arm against forearm) of the left arm at every frame: a property

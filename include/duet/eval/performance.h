@@ -248,7 +248,11 @@ struct PerformanceRecipe {
   bool improvise = false;
   PlayOptions play;                    // when !improvise (seed ignored)
   ImproviseOptions improvise_options;  // when improvise (seed ignored)
-  double body_scale = 1.0;
+  // The dancer's size against the template dancer's (with_body_scale). On another rig the body is
+  // scaled after retargeting so that its standing height (measure_body) is this times the
+  // template dancer's: body-size@rig is then the size it names whatever the rig's own size.
+  // None: as delivered (on another rig, the rig's own body).
+  std::optional<double> body_scale;
   double room_yaw_rad = 0.0;
   Vec3 room_offset_m = Vec3::Zero();
   double world_tilt_deg = 0.0;          // the sensor's world tilted (with_world_tilt)
