@@ -9,6 +9,9 @@
 // library built from the same three points (16 dims).
 // BM_DevicePointsToJoints: one headset pose moved from the devices to the joints (duet serve
 // --source xr does it to every xr_pose before the step above).
+// BM_WristsOnUserBody: where the user's body puts the wrists at the partner's frame (the live
+// loop's contact IK, full body), per frame: take 01's dancer retargeted onto the library's own rig
+// (/0) and onto the CMU ASF rig (/1).
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -22,6 +25,7 @@
 #include "duet/io/motion_file.h"
 #include "duet/live/duet_library.h"
 #include "duet/live/follow_session.h"
+#include "duet/live/wrists_on_user_body.h"
 #include "duet/motion/device_points.h"
 #include "duet/motion/head_hands.h"
 #include "salsa_pairs.h"
@@ -130,6 +134,36 @@ void BM_DevicePointsToJoints(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_DevicePointsToJoints)->Unit(benchmark::kNanosecond);
+
+void BM_WristsOnUserBody(benchmark::State& state) {
+  MotionLoadOptions load;
+  load.frame_rate = 60.0;
+  Result<LoadedMotion> dancer = load_motion({kSalsa + "/bvh/60/60_01_scaled.bvh"}, load);
+  Result<LoadedMotion> user =
+      state.range(0) == 0
+          ? load_motion({kSalsa + "/bvh/60/60_01_scaled.bvh"}, load)
+          : load_motion({kSalsa + "/asf-amc/60.asf", kSalsa + "/asf-amc/60_01.amc"}, load);
+  if (!dancer || !user) {
+    state.SkipWithError("salsa data not found");
+    return;
+  }
+  SourceSkeleton user_skeleton;
+  user_skeleton.skeleton = user.value().clip.skeleton_ptr();
+  user_skeleton.roles = user.value().roles;
+  Result<WristsOnUserBody> wrists = WristsOnUserBody::create({&dancer.value()}, user_skeleton);
+  if (!wrists) {
+    state.SkipWithError(wrists.error().message.c_str());
+    return;
+  }
+  const int frames = dancer.value().clip.frame_count();
+  double frame = 0.0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(wrists.value().wrist_difference_hs(0, frame));
+    frame += 1.25;  // the playhead between frames
+    if (frame >= frames - 1) frame = 0.0;
+  }
+}
+BENCHMARK(BM_WristsOnUserBody)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace duet

@@ -87,8 +87,17 @@ Result<LiveLoop> LiveLoop::create(std::shared_ptr<const DuetLibrary> library,
       head_hands_bodies.push_back(std::move(body).value());
     }
   }
+  std::optional<WristsOnUserBody> wrists_on_user_body;
+  if (head_hands_bodies.empty()) {
+    // A skeleton the retargeter cannot read leaves the contact IK its plain steady difference.
+    std::vector<const LoadedMotion*> dancers;
+    for (const DuetTake& take : library->takes()) dancers.push_back(&take.template_motion);
+    Result<WristsOnUserBody> wrists = WristsOnUserBody::create(std::move(dancers), user);
+    if (wrists) wrists_on_user_body = std::move(wrists).value();
+  }
   LiveLoop loop(std::move(library), user, std::move(session).value(), std::move(models), params);
   loop.head_hands_bodies_ = std::move(head_hands_bodies);
+  loop.wrists_on_user_body_ = std::move(wrists_on_user_body);
   loop.device_correction_ = head_hands_device_correction();
   return loop;
 }
@@ -219,6 +228,9 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
     position = std::clamp(position, 0.0, static_cast<double>(model.frame_count() - 1));
   } else {
     playhead_.reset();
+  }
+  if (wrists_on_user_body_ && params_.contact) {
+    user_pose_.wrist_body_difference_hs = wrists_on_user_body_->wrist_difference_hs(take, position);
   }
   job.frame = static_cast<int>(std::lround(position));
   job.frame_position = position;

@@ -150,13 +150,13 @@ Vec3 step_towards(const Vec3& from, const Vec3& to, double most) {
   return distance > most ? Vec3(from + (to - from) * (most / distance)) : to;
 }
 
-// One frame of an arm joint's IK correction (a rotation vector): `raw` through the joint's 1-euro
-// filter, then at most `most` from what was shown last frame once the filter has a past. Returns
-// the new `shown`.
-Vec3 step_correction(OneEuroFilter3& filter, Vec3& shown, const Vec3& raw, double dt,
-                     const OneEuroParams& params, double most) {
+// One frame of an arm joint's IK correction (a rotation vector): `raw`'s part beyond `base`
+// through the joint's 1-euro filter, `base` as it is, then at most `most` from what was shown last
+// frame once the filter has a past. Returns the new `shown`.
+Vec3 step_correction(OneEuroFilter3& filter, Vec3& shown, const Vec3& raw, const Vec3& base,
+                     double dt, const OneEuroParams& params, double most) {
   const bool primed = filter.primed();
-  const Vec3 filtered = filter.filter(raw, dt, params);
+  const Vec3 filtered = base + filter.filter(raw - base, dt, params);
   shown = primed ? step_towards(shown, filtered, most) : filtered;
   return shown;
 }
@@ -837,7 +837,8 @@ bool PartnerSynthesisJob::run() const noexcept {
       const double most = p.ik_correction_max_speed_rad_s * dt;
       const OneEuroParams filter = correction_filter_of(r);
       for (std::size_t k = 0; k < 2; ++k) {
-        const Vec3 c = step_correction(filters[k], shown[k], Vec3::Zero(), dt, filter, most);
+        const Vec3 c =
+            step_correction(filters[k], shown[k], Vec3::Zero(), Vec3::Zero(), dt, filter, most);
         out_r[joints[k]] = (out_r[joints[k]] * exp_map(c)).normalized();
       }
     };
@@ -898,14 +899,18 @@ bool PartnerSynthesisJob::run() const noexcept {
         }
         raw_target += carried_by * offset;
       }
+      // The captured wrist moved by what the user's body alone changes (WristsOnUserBody): only
+      // the rest of the sensed difference is averaged and doubted, and filtered (below). The
+      // difference is taken from the captured wrist before the foot lock's shift: the shift is the
+      // partner's own and known exactly, so the arm takes it whole.
+      Vec3 expected =
+          ctx.positions_ws_[static_cast<std::size_t>(roles[kArms[r].wrist])] - foot_lock_shift;
+      const bool bodies_differ = p.align && !user->wrist_body_difference_hs[t].isZero();
+      if (bodies_differ) expected += heading.rotation * user->wrist_body_difference_hs[t];
       if (steady) {
-        // The difference is taken from the captured wrist before the foot lock's shift: the
-        // shift is the partner's own and known exactly, so the arm takes it whole; only the
-        // user's difference from the capture is averaged and trusted by its share.
-        raw_target = ctx.steady_ik_target(
-            r, raw_target,
-            ctx.positions_ws_[static_cast<std::size_t>(roles[kArms[r].wrist])] - foot_lock_shift,
-            p.align ? heading.rotation : Quat::Identity(), p, dt, target_restarts);
+        raw_target = ctx.steady_ik_target(r, raw_target, expected,
+                                          p.align ? heading.rotation : Quat::Identity(), p, dt,
+                                          target_restarts);
       }
       // Keep the target continuous across jumps (5.3): the step of the raw target is absorbed
       // by an offset that decays like the blend. The speed test uses at least one model frame
@@ -955,17 +960,35 @@ bool PartnerSynthesisJob::run() const noexcept {
         for (OneEuroFilter3& filter : filters) filter.reset();
       }
       if (p.smooth) {
-        // The correction (captured -> IK, in the joint's own frame) through the 1-euro filter,
-        // then put back on the captured rotation; the wrist lands where that arm reaches.
-        // At most ik_correction_max_speed_rad_s: the IK adds at most that to a joint's speed.
+        // The arm the bodies alone ask for (the captured arm reaching the expected target: as
+        // smooth as the capture, no sensor in it) is taken whole.
+        Quat base_start = captured_start, base_mid = captured_mid;
+        if (bodies_differ) {
+          IkTwoBoneJob base =
+              chain_job(chain, captured_start, captured_mid, expected + ctx.ik_target_offset_[r]);
+          base.weight = weight;
+          base.soft_reach = p.ik_soft_reach;
+          base.start_rotation_ls_out = &base_start;
+          base.mid_rotation_ls_out = &base_mid;
+          if (!base.run()) {
+            base_start = captured_start;
+            base_mid = captured_mid;
+          }
+        }
+        // The correction (captured -> IK, in the joint's own frame): its part beyond the base arm
+        // through the 1-euro filter, then put back on the captured rotation; the wrist lands
+        // where that arm reaches. At most ik_correction_max_speed_rad_s: the IK adds at most that
+        // to a joint's speed.
         std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
         const OneEuroParams correction_filter = correction_filter_of(r);
-        const auto correct = [&](std::size_t k, const Quat& captured, const Quat& solved) {
-          return step_correction(filters[k], shown[k], log_map(captured.conjugate() * solved), dt,
-                                 correction_filter, p.ik_correction_max_speed_rad_s * dt);
+        const auto correct = [&](std::size_t k, const Quat& captured, const Quat& base,
+                                 const Quat& solved) {
+          return step_correction(filters[k], shown[k], log_map(captured.conjugate() * solved),
+                                 log_map(captured.conjugate() * base), dt, correction_filter,
+                                 p.ik_correction_max_speed_rad_s * dt);
         };
-        const Vec3 start_correction = correct(0, captured_start, ik_start);
-        const Vec3 mid_correction = correct(1, captured_mid, ik_mid);
+        const Vec3 start_correction = correct(0, captured_start, base_start, ik_start);
+        const Vec3 mid_correction = correct(1, captured_mid, base_mid, ik_mid);
         ik_start = (captured_start * exp_map(start_correction)).normalized();
         ik_mid = (captured_mid * exp_map(mid_correction)).normalized();
         reached_at = arm_end_position(chain.start_ws, chain.mid_ws, chain.end_ws, captured_start,

@@ -87,8 +87,13 @@ TEST(ServeLoad, EightViewersAt120Hz) {
   for (long long f : frames) EXPECT_GT(f, 120 * 6 / 2);
   EXPECT_GT(total["count"].get<long long>(), 120 * 4 * kViewers);
 #ifndef DUET_SANITIZED
-  // The latency bound is for optimised builds; the sanitizer build checks delivery only.
-  EXPECT_LT(total["p99"].get<long long>(), 2000) << server.log();
+  // The latency bounds are for optimised builds; the sanitizer build checks delivery only. The
+  // median is the loop's; the tail is the machine's: on the shared 2-core development VM the
+  // same binary gave a p99 of 0.5 to 3.4 ms between back-to-back runs (p50 0.33-0.51 ms), with
+  // real-time scheduling and no other load (docs/serve.md). A loop that stalls (a blocking write,
+  // an allocation storm) shows in both.
+  EXPECT_LT(total["p50"].get<long long>(), 1000) << server.log();
+  EXPECT_LT(total["p99"].get<long long>(), 5000) << server.log();
 #endif
 }
 

@@ -6,7 +6,9 @@
 #include <vector>
 
 #include "counting_new.h"
+#include "duet/live/wrists_on_user_body.h"
 #include "duet/partner/partner_synthesis.h"
+#include "features/synthetic_dancer.h"
 #include "partner/synthetic_partner.h"
 
 namespace duet {
@@ -37,6 +39,7 @@ TEST(PartnerSynthesis, PerFrameCallAllocatesNothing) {
     const test::WorldPose w = test::world_pose(leader, f);
     users.push_back(user_pose_from_world(w.positions, w.rotations, roles));
     users.back().wrist_positions_ws[0].y() += 0.05;
+    users.back().wrist_body_difference_hs[0] = Vec3(0.03, 0.0, 0.02);  // the base arm's path
   }
 
   test::g_allocations = 0;
@@ -63,6 +66,26 @@ TEST(PartnerSynthesis, PerFrameCallAllocatesNothing) {
   test::g_counting = false;
   EXPECT_TRUE(ok);
   EXPECT_EQ(test::g_allocations.load(), 0);
+}
+
+TEST(WristsOnUserBody, PerFrameCallAllocatesNothing) {
+  auto skeleton = testing::make_role_skeleton();
+  LoadedMotion dancer;
+  dancer.clip = testing::make_dance(skeleton, 60.0, 120);
+  dancer.roles = testing::daz_roles(*skeleton);
+  auto longer = std::make_shared<Skeleton>(*skeleton);
+  for (Joint& joint : longer->joints) joint.offset *= 1.1;
+  SourceSkeleton user;
+  user.skeleton = longer;
+  user.roles = testing::daz_roles(*longer);
+  WristsOnUserBody wrists = WristsOnUserBody::create({&dancer}, user).value();
+  double sum = 0.0;
+  test::g_allocations = 0;
+  test::g_counting = true;
+  for (int i = 0; i < 500; ++i) sum += wrists.wrist_difference_hs(0, 0.37 * i)[0].norm();
+  test::g_counting = false;
+  EXPECT_EQ(test::g_allocations, 0);
+  EXPECT_GT(sum, 0.0);
 }
 
 }  // namespace

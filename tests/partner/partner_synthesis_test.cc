@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -468,6 +469,52 @@ TEST(PartnerSynthesis, UnderHeavyJitterTheHandStillLearnsABodyDifference) {
   const Vec3 shifted_noisy = run_with(body_difference, 0.04);
   EXPECT_GT((shifted_clean - captured).norm(), 0.05);        // the IK follows the body difference
   EXPECT_LT((shifted_noisy - shifted_clean).norm(), 0.015);  // and under noise too, on average
+}
+
+TEST(PartnerSynthesis, ABodyDifferenceToldIsTakenWholeUnderJitter) {
+  // A user whose wrist is off the captured template's by a difference that changes with the pose
+  // (up to 8 cm, once a second: another rig's arms), with the heavy jitter above. Told the
+  // difference (UserPose::wrist_body_difference_hs, WristsOnUserBody), the partner's hand follows
+  // it as on a clean sensor; left to average it from the jittering hand, it lags and is doubted.
+  const Vec3 grip(0.0, 0.0, 0.04);
+  Duet duet(240, 0, 240, grip);
+  const std::size_t wrist = duet.wrist(Role::kRightWrist);
+  const double dt = 1.0 / 30.0;
+  const auto run_with = [&](bool told, double noise_m) {
+    Runner run(duet.model, only(true, true, true, false, false));
+    std::mt19937 rng(7);
+    std::normal_distribution<double> jitter(0.0, noise_m);
+    std::vector<Vec3> hands;
+    for (int f = 0; f < 120; ++f) {
+      UserPose user = user_from(duet.leader, 2 * f, duet.roles);
+      const double phase = 2.0 * std::numbers::pi * f * dt;
+      const Vec3 difference_hs(0.08 * std::sin(phase), 0.0, 0.04 * std::cos(phase));
+      user.wrist_positions_ws[0] +=
+          user.body_heading.rotation * difference_hs + Vec3(jitter(rng), jitter(rng), jitter(rng));
+      if (told) user.wrist_body_difference_hs[0] = difference_hs;
+      run.step(2 * f, duet.follower.translations_ls(2 * f), duet.follower.rotations_ls(2 * f), user,
+               false, dt);
+      hands.push_back(run.world().positions[wrist]);
+    }
+    return hands;
+  };
+  const std::vector<Vec3> clean = run_with(true, 0.0);
+  const std::vector<Vec3> told = run_with(true, 0.04);
+  const std::vector<Vec3> untold = run_with(false, 0.04);
+  double told_off = 0.0, untold_off = 0.0;
+  for (std::size_t f = 30; f < clean.size(); ++f) {
+    told_off += (told[f] - clean[f]).norm() / 90.0;
+    untold_off += (untold[f] - clean[f]).norm() / 90.0;
+  }
+  EXPECT_LT(told_off, 0.02);  // measured 1.1 cm; 5.2 cm untold
+  EXPECT_LT(told_off, 0.5 * untold_off) << "told " << told_off << " untold " << untold_off;
+  // Clean, told or not, the hand goes to the user's: the difference is the same either way.
+  const std::vector<Vec3> clean_untold = run_with(false, 0.0);
+  double clean_gap = 0.0;
+  for (std::size_t f = 30; f < clean.size(); ++f) {
+    clean_gap = std::max(clean_gap, (clean_untold[f] - clean[f]).norm());
+  }
+  EXPECT_LT(clean_gap, 0.02);
 }
 
 // The user's hand turns `turn` (a rotation vector in the hand's frame) off the template's, plus

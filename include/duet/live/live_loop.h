@@ -11,6 +11,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -19,6 +20,7 @@
 #include "duet/live/follow_session.h"
 #include "duet/live/partner_place.h"
 #include "duet/live/source_frame.h"
+#include "duet/live/wrists_on_user_body.h"
 #include "duet/partner/head_hands_body.h"
 #include "duet/partner/partner_synthesis.h"
 
@@ -123,6 +125,8 @@ class LiveLoop {
   std::vector<std::array<Quat, 2>> hand_frame_turns_;
   // Three-point users (head and hands only): one HeadHandsBody per take; empty for a full body.
   std::vector<HeadHandsBody> head_hands_bodies_;
+  // Full body: where the user's own body puts the wrists (the contact IK's expected difference).
+  std::optional<WristsOnUserBody> wrists_on_user_body_;
   Quat device_correction_ = Quat::Identity();  // a point's device rotation -> canonical
   ResponsePlayhead playhead_;
   Pose shown_pose_;  // the response sampled at the playhead

@@ -331,6 +331,10 @@ struct UserPose {
   double height_m = 0.0;
   std::array<Vec3, 2> wrist_positions_ws{Vec3::Zero(), Vec3::Zero()};
   std::array<Quat, 2> wrist_rotations_ws{Quat::Identity(), Quat::Identity()};
+  // Where the user's body alone puts each wrist against the template dancer's at the partner's
+  // frame, relative to the heading frame (WristsOnUserBody). The contact IK's steady difference
+  // (smooth, align) averages only what the sensed hand differs by beyond it. Zero: one body.
+  std::array<Vec3, 2> wrist_body_difference_hs{Vec3::Zero(), Vec3::Zero()};
 };
 
 // Reads a UserPose from world transforms of the user's skeleton (forward_kinematics output):
