@@ -404,39 +404,51 @@ TEST(PartnerSynthesis, AnArmLetsItsCorrectionGoAtTheSpeedLimit) {
   EXPECT_LT(run.r[elbow].angularDistance(duet.follower.rotations_ls(299)[elbow]), 1e-6);
 }
 
+// Hands held throughout, standing, 120 frames at 30 Hz: the user's left wrist as captured, moved
+// by `move(frame, user)` and then jittered by white noise of `noise_m` per axis (seed `seed`); the
+// partner's right wrist every frame.
+template <class Move>
+std::vector<Vec3> held_hands_under_jitter(const Duet& duet, const PartnerParams& params,
+                                          unsigned seed, double noise_m, Move move) {
+  const std::size_t wrist = duet.wrist(Role::kRightWrist);
+  Runner run(duet.model, params);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> jitter(0.0, noise_m);
+  std::vector<Vec3> hands;
+  for (int f = 0; f < 120; ++f) {
+    UserPose user = user_from(duet.leader, 2 * f, duet.roles);
+    move(f, user);
+    user.wrist_positions_ws[0] += Vec3(jitter(rng), jitter(rng), jitter(rng));
+    run.step(2 * f, duet.follower.translations_ls(2 * f), duet.follower.rotations_ls(2 * f), user,
+             false, 1.0 / 30.0);
+    hands.push_back(run.world().positions[wrist]);
+  }
+  return hands;
+}
+
+// The mean distance between two such runs' hands from frame `from` on.
+double mean_gap(const std::vector<Vec3>& a, const std::vector<Vec3>& b, std::size_t from) {
+  double sum = 0.0;
+  for (std::size_t f = from; f < a.size(); ++f) sum += (a[f] - b[f]).norm();
+  return sum / static_cast<double>(a.size() - from);
+}
+
 TEST(PartnerSynthesis, AHeavilyJitteringWristLeavesTheHandNearTheRealOne) {
   // Hands held throughout, standing; the sensor puts the user's wrist 4 cm per axis off its real
   // place every frame at 30 Hz (4 degrees per joint and axis do that to a salsa dancer's wrist).
   // The target's jitter is measured and what it adds to the captured wrist is averaged: the
   // partner's hand stays nearer where it is with a clean sensor than without the averaging.
-  const Vec3 grip(0.0, 0.0, 0.04);
-  Duet duet(240, 0, 240, grip);
-  const std::size_t wrist = duet.wrist(Role::kRightWrist);
-  const double dt = 1.0 / 30.0;
+  const Duet duet(240, 0, 240, Vec3(0.0, 0.0, 0.04));
   const auto run_with = [&](double reference_m, double noise_m) {
     PartnerParams params = only(true, true, true, false, false);
     params.ik_target_jitter_reference_m = reference_m;
-    Runner run(duet.model, params);
-    std::mt19937 rng(11);
-    std::normal_distribution<double> jitter(0.0, noise_m);
-    std::vector<Vec3> hands;
-    for (int f = 0; f < 120; ++f) {
-      UserPose user = user_from(duet.leader, 2 * f, duet.roles);
-      user.wrist_positions_ws[0] += Vec3(jitter(rng), jitter(rng), jitter(rng));
-      run.step(2 * f, duet.follower.translations_ls(2 * f), duet.follower.rotations_ls(2 * f), user,
-               false, dt);
-      hands.push_back(run.world().positions[wrist]);
-    }
-    return hands;
+    return held_hands_under_jitter(duet, params, 11, noise_m, [](int, UserPose&) {});
   };
   const std::vector<Vec3> clean = run_with(PartnerParams{}.ik_target_jitter_reference_m, 0.0);
   const std::vector<Vec3> adapted = run_with(PartnerParams{}.ik_target_jitter_reference_m, 0.04);
   const std::vector<Vec3> plain = run_with(0.0, 0.04);
-  double adapted_off = 0.0, plain_off = 0.0;
-  for (std::size_t f = 30; f < clean.size(); ++f) {  // after the jitter has been measured
-    adapted_off += (adapted[f] - clean[f]).norm() / 90.0;
-    plain_off += (plain[f] - clean[f]).norm() / 90.0;
-  }
+  // After the jitter has been measured:
+  const double adapted_off = mean_gap(adapted, clean, 30), plain_off = mean_gap(plain, clean, 30);
   EXPECT_LT(adapted_off, 0.025);  // measured 1.9 cm; 3.2 cm without the averaging
   EXPECT_LT(adapted_off, 0.7 * plain_off);
 }
@@ -445,23 +457,14 @@ TEST(PartnerSynthesis, UnderHeavyJitterTheHandStillLearnsABodyDifference) {
   // A user whose wrist is 8 cm off the captured template's (another rig, another body), with the
   // heavy jitter above: the averaged difference carries the 8 cm, so the partner's hand goes to
   // the user's real hand, not to where the captured partner held it.
-  const Vec3 grip(0.0, 0.0, 0.04);
-  Duet duet(240, 0, 240, grip);
-  const std::size_t wrist = duet.wrist(Role::kRightWrist);
-  const double dt = 1.0 / 30.0;
+  const Duet duet(240, 0, 240, Vec3(0.0, 0.0, 0.04));
   const Vec3 body_difference(0.08, 0.0, 0.0);
   const auto run_with = [&](const Vec3& shift, double noise_m) {
-    Runner run(duet.model, only(true, true, true, false, false));
-    std::mt19937 rng(5);
-    std::normal_distribution<double> jitter(0.0, noise_m);
+    const std::vector<Vec3> hands =
+        held_hands_under_jitter(duet, only(true, true, true, false, false), 5, noise_m,
+                                [&](int, UserPose& user) { user.wrist_positions_ws[0] += shift; });
     Vec3 mean = Vec3::Zero();
-    for (int f = 0; f < 120; ++f) {
-      UserPose user = user_from(duet.leader, 2 * f, duet.roles);
-      user.wrist_positions_ws[0] += shift + Vec3(jitter(rng), jitter(rng), jitter(rng));
-      run.step(2 * f, duet.follower.translations_ls(2 * f), duet.follower.rotations_ls(2 * f), user,
-               false, dt);
-      if (f >= 60) mean += run.world().positions[wrist] / 60.0;  // the last 2 s
-    }
+    for (std::size_t f = 60; f < hands.size(); ++f) mean += hands[f] / 60.0;  // the last 2 s
     return mean;
   };
   const Vec3 captured = run_with(Vec3::Zero(), 0.0);
@@ -476,36 +479,20 @@ TEST(PartnerSynthesis, ABodyDifferenceToldIsTakenWholeUnderJitter) {
   // (up to 8 cm, once a second: another rig's arms), with the heavy jitter above. Told the
   // difference (UserPose::wrist_body_difference_hs, WristsOnUserBody), the partner's hand follows
   // it as on a clean sensor; left to average it from the jittering hand, it lags and is doubted.
-  const Vec3 grip(0.0, 0.0, 0.04);
-  Duet duet(240, 0, 240, grip);
-  const std::size_t wrist = duet.wrist(Role::kRightWrist);
-  const double dt = 1.0 / 30.0;
+  const Duet duet(240, 0, 240, Vec3(0.0, 0.0, 0.04));
   const auto run_with = [&](bool told, double noise_m) {
-    Runner run(duet.model, only(true, true, true, false, false));
-    std::mt19937 rng(7);
-    std::normal_distribution<double> jitter(0.0, noise_m);
-    std::vector<Vec3> hands;
-    for (int f = 0; f < 120; ++f) {
-      UserPose user = user_from(duet.leader, 2 * f, duet.roles);
-      const double phase = 2.0 * std::numbers::pi * f * dt;
-      const Vec3 difference_hs(0.08 * std::sin(phase), 0.0, 0.04 * std::cos(phase));
-      user.wrist_positions_ws[0] +=
-          user.body_heading.rotation * difference_hs + Vec3(jitter(rng), jitter(rng), jitter(rng));
-      if (told) user.wrist_body_difference_hs[0] = difference_hs;
-      run.step(2 * f, duet.follower.translations_ls(2 * f), duet.follower.rotations_ls(2 * f), user,
-               false, dt);
-      hands.push_back(run.world().positions[wrist]);
-    }
-    return hands;
+    return held_hands_under_jitter(
+        duet, only(true, true, true, false, false), 7, noise_m, [&](int f, UserPose& user) {
+          const double phase = 2.0 * std::numbers::pi * f / 30.0;
+          const Vec3 difference_hs(0.08 * std::sin(phase), 0.0, 0.04 * std::cos(phase));
+          user.wrist_positions_ws[0] += user.body_heading.rotation * difference_hs;
+          if (told) user.wrist_body_difference_hs[0] = difference_hs;
+        });
   };
   const std::vector<Vec3> clean = run_with(true, 0.0);
   const std::vector<Vec3> told = run_with(true, 0.04);
   const std::vector<Vec3> untold = run_with(false, 0.04);
-  double told_off = 0.0, untold_off = 0.0;
-  for (std::size_t f = 30; f < clean.size(); ++f) {
-    told_off += (told[f] - clean[f]).norm() / 90.0;
-    untold_off += (untold[f] - clean[f]).norm() / 90.0;
-  }
+  const double told_off = mean_gap(told, clean, 30), untold_off = mean_gap(untold, clean, 30);
   EXPECT_LT(told_off, 0.02);  // measured 1.1 cm; 5.2 cm untold
   EXPECT_LT(told_off, 0.5 * untold_off) << "told " << told_off << " untold " << untold_off;
   // Clean, told or not, the hand goes to the user's: the difference is the same either way.
