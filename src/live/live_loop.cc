@@ -102,10 +102,31 @@ Result<LiveLoop> LiveLoop::create(std::shared_ptr<const DuetLibrary> library,
   return loop;
 }
 
+std::array<Vec3, 2> LiveLoop::head_hands_wrist_difference_hs(int take,
+                                                             double position) const noexcept {
+  // The template dancer's body scaled to the user's size, as the body heading assumes.
+  std::array<Vec3, 2> difference =
+      head_hands_bodies_[static_cast<std::size_t>(take)].wrist_size_difference_hs(
+          position, head_hands_size_ratio_);
+  // Told the body calibration, each hand also sits where the user's shoulders and arms hold it
+  // against the template dancers' (arms held forward, in head heights): a wider or higher
+  // shoulder moves the hand as much in any pose. (The pose cannot tell a longer arm from a
+  // shoulder further forward; both are taken as a shift.)
+  const std::optional<ArmsForward>& arms_forward = session_.arms_forward();
+  if (arms_forward && head_hands_size_ratio_ > 0.0) {
+    const ArmsForward& template_pose = library_->template_arms_forward();
+    for (std::size_t s = 0; s < 2; ++s) {
+      difference[s] +=
+          session_.head_height_m() * (arms_forward->wrists[s] - template_pose.wrists[s]);
+    }
+  }
+  return difference;
+}
 
 void LiveLoop::place_head_hands_user(int take, int frame) noexcept {
   const auto head = static_cast<std::size_t>(user_.roles[Role::kHead]);
   const Vec3& head_position = out_.user_positions_ws[head];
+  head_hands_size_ratio_ = 0.0;
   if (!head_position.allFinite()) return;
   const HeadHandsBody& body = head_hands_bodies_[static_cast<std::size_t>(take)];
   const PartnerModel& model = models_[static_cast<std::size_t>(take)];
@@ -116,6 +137,7 @@ void LiveLoop::place_head_hands_user(int take, int frame) noexcept {
                                 : 1.0;
   const Transform head_frame =
       head_heading_frame(head_position, out_.user_rotations_ws[head] * device_correction_);
+  head_hands_size_ratio_ = size_ratio;
   user_pose_.body_heading = body.body_heading(head_frame, frame, size_ratio);
   user_pose_.body_heading_valid = user_pose_.body_heading.translation.allFinite() &&
                                   user_pose_.body_heading.rotation.coeffs().allFinite();
@@ -231,6 +253,8 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   }
   if (wrists_on_user_body_ && params_.contact) {
     user_pose_.wrist_body_difference_hs = wrists_on_user_body_->wrist_difference_hs(take, position);
+  } else if (!head_hands_bodies_.empty() && params_.contact) {
+    user_pose_.wrist_body_difference_hs = head_hands_wrist_difference_hs(take, position);
   }
   job.frame = static_cast<int>(std::lround(position));
   job.frame_position = position;

@@ -25,6 +25,8 @@
 #include "duet/motion/head_hands.h"
 #include "duet/motion/retarget.h"
 #include "duet/motion/up_axis.h"
+#include "duet/partner/alignment.h"
+#include "duet/partner/head_hands_body.h"
 #include "live/salsa_library.h"
 
 namespace duet::test {
@@ -640,6 +642,53 @@ TEST(HeadHandsFollow, ThePartnerIsPlacedAsForTheFullBody) {
     EXPECT_LT(gaps[gaps.size() / 2], 0.05) << "scale " << scale;   // median under 5 cm
     EXPECT_LT(gaps[gaps.size() * 95 / 100], 0.15) << "scale " << scale;
   }
+}
+
+// A three-point user's body is taken for the template dancer's scaled to the user's size (the body
+// heading assumes it); the wrists' part of that, which the contact IK takes whole, is where such a
+// body (scaled as the evaluation scales one) holds its wrists in its own body heading frame.
+TEST(HeadHandsBody, ALargerBodyHoldsItsWristsWhereTheSizeDifferenceSays) {
+  const LoadedMotion take = load_take("60_07");
+  Result<HeadHandsBody> body = HeadHandsBody::build(take.clip, take.roles);
+  ASSERT_TRUE(body) << body.error().message;
+  Performance template_dancer;
+  template_dancer.motion = take.clip;
+  template_dancer.roles = take.roles;
+  const Performance larger = with_body_scale(template_dancer, 1.2);
+  auto wrists_hs = [](const Clip& clip, const JointRoles& roles, int f) {
+    std::vector<Vec3> positions(static_cast<std::size_t>(clip.joint_count()));
+    std::vector<Quat> rotations(positions.size());
+    forward_kinematics(clip.skeleton(), clip.translations_ls(f), clip.rotations_ls(f), positions,
+                       rotations);
+    const Transform to_body = body_heading_frame(positions, roles).inverse();
+    return std::array<Vec3, 2>{
+        to_body.apply(positions[static_cast<std::size_t>(roles[Role::kLeftWrist])]),
+        to_body.apply(positions[static_cast<std::size_t>(roles[Role::kRightWrist])])};
+  };
+  for (const int f : {0, 300, 1000, take.clip.frame_count() - 1}) {
+    const std::array<Vec3, 2> own = wrists_hs(take.clip, take.roles, f);
+    const std::array<Vec3, 2> scaled = wrists_hs(larger.motion, larger.roles, f);
+    const std::array<Vec3, 2> told = body.value().wrist_size_difference_hs(f, 1.2);
+    for (std::size_t s = 0; s < 2; ++s) {
+      EXPECT_LT((own[s] + told[s] - scaled[s]).norm(), 1e-6) << "frame " << f << " side " << s;
+      EXPECT_GT(told[s].norm(), 0.05) << "frame " << f;  // a fifth of a wrist's place: centimetres
+    }
+  }
+  // Between frames the difference is interpolated; out of the take it is the end frame's; the
+  // template dancer's own size, or no size, adds nothing.
+  const std::array<Vec3, 2> a = body.value().wrist_size_difference_hs(300, 1.2);
+  const std::array<Vec3, 2> b = body.value().wrist_size_difference_hs(301, 1.2);
+  const std::array<Vec3, 2> half = body.value().wrist_size_difference_hs(300.5, 1.2);
+  EXPECT_LT((half[0] - 0.5 * (a[0] + b[0])).norm(), 1e-12);
+  const std::array<Vec3, 2> before = body.value().wrist_size_difference_hs(-40.0, 1.2);
+  const std::array<Vec3, 2> first = body.value().wrist_size_difference_hs(0.0, 1.2);
+  EXPECT_EQ(before[1], first[1]);
+  for (const double ratio : {1.0, 0.0, std::numeric_limits<double>::quiet_NaN()}) {
+    EXPECT_TRUE(body.value().wrist_size_difference_hs(300, ratio)[0].isZero()) << ratio;
+  }
+  EXPECT_TRUE(body.value()
+                  .wrist_size_difference_hs(std::numeric_limits<double>::quiet_NaN(), 1.2)[0]
+                  .isZero());
 }
 
 }  // namespace

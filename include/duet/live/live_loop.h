@@ -110,6 +110,10 @@ class LiveLoop {
   // A user tracked by three points: their body heading frame and height, from the head and the
   // template frame `frame` of `take` (HeadHandsBody).
   void place_head_hands_user(int take, int frame) noexcept;
+  // A user tracked by three points: where their body puts each wrist beyond the template
+  // dancer's at the partner's frame `position` of `take`, in the body heading frame
+  // (UserPose::wrist_body_difference_hs): their size, and told the body calibration, their arms.
+  std::array<Vec3, 2> head_hands_wrist_difference_hs(int take, double position) const noexcept;
 
   std::shared_ptr<const DuetLibrary> library_;
   SourceSkeleton user_;
@@ -125,6 +129,7 @@ class LiveLoop {
   std::vector<std::array<Quat, 2>> hand_frame_turns_;
   // Three-point users (head and hands only): one HeadHandsBody per take; empty for a full body.
   std::vector<HeadHandsBody> head_hands_bodies_;
+  double head_hands_size_ratio_ = 0.0;  // this frame's user size against the template's; 0: none
   // Full body: where the user's own body puts the wrists (the contact IK's expected difference).
   std::optional<WristsOnUserBody> wrists_on_user_body_;
   Quat device_correction_ = Quat::Identity();  // a point's device rotation -> canonical

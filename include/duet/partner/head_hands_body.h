@@ -42,8 +42,17 @@ class HeadHandsBody {
   Transform body_heading(const Transform& user_head_heading, int frame,
                          double size_ratio) const noexcept;
 
+  // Where the same scaled body (a user `size_ratio` times the template's size, dancing it
+  // exactly) puts its wrists beyond the template's, at real frame `frame_position` (clamped to the
+  // take), each in its body heading frame, indexed by Side: (size_ratio - 1) times the template's
+  // wrists there. The contact IK takes this part of the hand's difference whole
+  // (UserPose::wrist_body_difference_hs); zero for a ratio that is not finite and positive.
+  std::array<Vec3, 2> wrist_size_difference_hs(double frame_position,
+                                               double size_ratio) const noexcept;
+
  private:
   std::vector<Transform> head_in_body_;
+  std::vector<std::array<Vec3, 2>> wrists_in_body_;  // left, right, per frame
   double template_head_height_m_ = 0.0;
   std::array<Quat, 2> rest_grips_ = {Quat::Identity(), Quat::Identity()};  // left, right
 };
