@@ -175,6 +175,25 @@ Status FollowSession::set_arms_forward(const std::optional<ArmsForward>& arms_fo
   return Ok{};
 }
 
+std::array<Vec3, 2> FollowSession::hand_offsets() const noexcept {
+  std::array<Vec3, 2> offsets = context_.hand_offsets();
+  if (extractor_.spec().input_points != InputPoints::kHeadHands) return offsets;
+  // The posture block starts with the two hands' places (FeatureExtractor: left, then right).
+  const int begin = extractor_.spec().block_begin(FeatureBlock::kPosture);
+  const std::span<const float> learnt = bias_.offset();
+  const Eigen::VectorXf& scale = library_->normalizer().scale();
+  for (std::size_t s = 0; s < 2; ++s) {
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t d = 3 * s + static_cast<std::size_t>(k);
+      const Eigen::Index at = begin + static_cast<Eigen::Index>(d);
+      if (d < learnt.size() && at < scale.size() && scale[at] > 0.0f) {
+        offsets[s][k] += static_cast<double>(learnt[d] / scale[at]);
+      }
+    }
+  }
+  return offsets;
+}
+
 void FollowSession::reset() noexcept {
   context_.reset();
   tracker_->reset();

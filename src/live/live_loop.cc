@@ -108,16 +108,15 @@ std::array<Vec3, 2> LiveLoop::head_hands_wrist_difference_hs(int take,
   std::array<Vec3, 2> difference =
       head_hands_bodies_[static_cast<std::size_t>(take)].wrist_size_difference_hs(
           position, head_hands_size_ratio_);
-  // Told the body calibration, each hand also sits where the user's shoulders and arms hold it
-  // against the template dancers' (arms held forward, in head heights): a wider or higher
-  // shoulder moves the hand as much in any pose. (The pose cannot tell a longer arm from a
-  // shoulder further forward; both are taken as a shift.)
-  const std::optional<ArmsForward>& arms_forward = session_.arms_forward();
-  if (arms_forward && head_hands_size_ratio_ > 0.0) {
-    const ArmsForward& template_pose = library_->template_arms_forward();
+  // Each hand also sits where the user's shoulders and arms hold it against the template
+  // dancers': the offset the follower takes off the hands' places (the body calibration's, told,
+  // plus what it has learnt of the rig's posture), in head heights. A wider or higher shoulder
+  // moves the hand as much in any pose, so it is taken as a shift; a longer arm looks like a
+  // shoulder further forward in the calibration's pose and is taken so too.
+  if (head_hands_size_ratio_ > 0.0) {
+    const std::array<Vec3, 2> offsets = session_.hand_offsets();
     for (std::size_t s = 0; s < 2; ++s) {
-      difference[s] +=
-          session_.head_height_m() * (arms_forward->wrists[s] - template_pose.wrists[s]);
+      difference[s] += session_.head_height_m() * offsets[s];
     }
   }
   return difference;

@@ -220,5 +220,52 @@ TEST(ArmsForward, AnotherRigCalibratedIsFollowedAsWellAsTheLibrarysOwn) {
   EXPECT_LT(untold, 0.9);                        // measured 0.42
 }
 
+TEST(ArmsForward, TheHandsOffsetIsTheCalibrationsPlusWhatTheFollowerLearns) {
+  // What the follower takes off each hand's place (FollowSession::hand_offsets, which the partner's
+  // contact IK also takes as the body's part of the hand's difference): told, the calibration's
+  // offset from the first frame; not told, the posture offset the follower learns, which on a rig
+  // with wider shoulders (the CMU handshake rig, take 60_10 as three points) moves the hands
+  // outwards as the calibration would.
+  const LoadedMotion daz = salsa_take("10");
+  const LoadedMotion rig = load({kSalsaData + "/cmu-handshake/18_01.bvh"});
+  Result<Clip> moved = retarget_clip(daz.clip, daz.roles, rig.clip.skeleton_ptr(), rig.roles);
+  ASSERT_TRUE(moved) << moved.error().message;
+  Performance performance;
+  performance.motion = std::move(moved).value();
+  performance.roles = rig.roles;
+  Result<ArmsForward> pose = arms_forward_of_body(performance.motion, performance.roles, 10);
+  ASSERT_TRUE(pose);
+  const double head_m = highest_head_m(performance.motion, performance.roles);
+  Result<Performance> points = with_head_hands(std::move(performance), PointNoiseOptions{});
+  ASSERT_TRUE(points);
+  const Clip& clip = points.value().motion;
+  const ArmsForward& library_pose = head_hands_library().template_arms_forward();
+
+  FollowSession told = hmm_session(head_hands_library(), clip.skeleton_ptr(), points.value().roles);
+  ASSERT_TRUE(told.set_arms_forward(pose.value()));
+  for (std::size_t s = 0; s < 2; ++s) {
+    EXPECT_LT((told.hand_offsets()[s] - (pose.value().wrists[s] - library_pose.wrists[s])).norm(),
+              1e-12);
+  }
+  FollowSession untold =
+      hmm_session(head_hands_library(), clip.skeleton_ptr(), points.value().roles);
+  ASSERT_TRUE(untold.set_head_height(head_m));
+  EXPECT_TRUE(untold.hand_offsets()[0].isZero());
+  for (int f = 0; f < clip.frame_count(); ++f) {
+    untold.step(clip.translations_ls(f), clip.rotations_ls(f), f / 60.0);
+  }
+  const std::array<Vec3, 2> learnt = untold.hand_offsets();
+  for (std::size_t s = 0; s < 2; ++s) {
+    const Vec3 calibration = pose.value().wrists[s] - library_pose.wrists[s];
+    // Measured: calibration (0.059, -0.007, -0.057) and (-0.051, -0.003, -0.057) head heights,
+    // learnt (0.073, 0.000, -0.044) and (-0.015, -0.005, -0.056).
+    EXPECT_LT((learnt[s] - calibration).norm(), 0.5 * calibration.norm()) << "side " << s;
+    EXPECT_GT(learnt[s].x() * calibration.x(), 0.0) << "side " << s;  // outwards, as told
+  }
+  // A full-body user has no hand places to offset.
+  FollowSession full = hmm_session(salsa_library(), daz.clip.skeleton_ptr(), daz.roles);
+  EXPECT_TRUE(full.hand_offsets()[0].isZero() && full.hand_offsets()[1].isZero());
+}
+
 }  // namespace
 }  // namespace duet::test

@@ -56,6 +56,11 @@ class FollowSession {
   // ArmsForward::check refuses.
   Status set_arms_forward(const std::optional<ArmsForward>& arms_forward);
   const std::optional<ArmsForward>& arms_forward() const noexcept { return arms_forward_; }
+  // Three points: what is taken off each hand's place (head heights, in the head's heading frame):
+  // the body calibration's offset (set_arms_forward) plus the posture offset learnt so far on the
+  // hands' places (PostureBias, in the features' units back in head heights). Zero for a
+  // full-body user. Allocates nothing.
+  std::array<Vec3, 2> hand_offsets() const noexcept;
 
   // The standardised features of the last frame, after the rig's posture offset was removed.
   std::span<const float> last_features() const { return features_; }

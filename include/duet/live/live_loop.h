@@ -112,7 +112,8 @@ class LiveLoop {
   void place_head_hands_user(int take, int frame) noexcept;
   // A user tracked by three points: where their body puts each wrist beyond the template
   // dancer's at the partner's frame `position` of `take`, in the body heading frame
-  // (UserPose::wrist_body_difference_hs): their size, and told the body calibration, their arms.
+  // (UserPose::wrist_body_difference_hs): their size, and the hands' offset the follower takes
+  // off (FollowSession::hand_offsets).
   std::array<Vec3, 2> head_hands_wrist_difference_hs(int take, double position) const noexcept;
 
   std::shared_ptr<const DuetLibrary> library_;
