@@ -177,7 +177,9 @@ Status FollowSession::set_arms_forward(const std::optional<ArmsForward>& arms_fo
 
 std::array<Vec3, 2> FollowSession::hand_offsets() const noexcept {
   std::array<Vec3, 2> offsets = context_.hand_offsets();
-  if (extractor_.spec().input_points != InputPoints::kHeadHands) return offsets;
+  if (extractor_.spec().input_points != InputPoints::kHeadHands || !bias_.params().enabled) {
+    return offsets;
+  }
   // The posture block starts with the two hands' places (FeatureExtractor: left, then right).
   const int begin = extractor_.spec().block_begin(FeatureBlock::kPosture);
   const std::span<const float> learnt = bias_.offset();
