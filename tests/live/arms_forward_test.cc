@@ -44,6 +44,32 @@ LoadedMotion on_asf_rig(const LoadedMotion& motion) {
   return out;
 }
 
+// Take 60_10 on the CMU handshake rig of 18_01 (by role directions) as three points with a
+// headset's noise, and that body's calibration pose and head height standing.
+struct ThreePointsOnRig {
+  Performance points;
+  ArmsForward pose;
+  double head_m = 0.0;
+};
+ThreePointsOnRig take_10_on_handshake_rig_as_points() {
+  const LoadedMotion daz = salsa_take("10");
+  const LoadedMotion rig = load({kSalsaData + "/cmu-handshake/18_01.bvh"});
+  Result<Clip> moved = retarget_clip(daz.clip, daz.roles, rig.clip.skeleton_ptr(), rig.roles);
+  EXPECT_TRUE(moved) << moved.error().message;
+  Performance performance;
+  performance.motion = std::move(moved).value();
+  performance.roles = rig.roles;
+  ThreePointsOnRig out;
+  Result<ArmsForward> pose = arms_forward_of_body(performance.motion, performance.roles, 10);
+  EXPECT_TRUE(pose);
+  out.pose = pose.value();
+  out.head_m = highest_head_m(performance.motion, performance.roles);
+  Result<Performance> points = with_head_hands(std::move(performance), PointNoiseOptions{});
+  EXPECT_TRUE(points);
+  out.points = std::move(points).value();
+  return out;
+}
+
 // Frame `frame` of `body` with both arms turned straight forward, as one frame: each upper arm,
 // then each forearm, turned in the world so its bone points where the head faces (a user looks
 // straight ahead in the pose; this dancer's head is turned 10 degrees from the pelvis).
@@ -188,22 +214,13 @@ TEST(ArmsForward, AnotherRigCalibratedIsFollowedAsWellAsTheLibrarysOwn) {
   // Take 60_10 on the CMU handshake rig of 18_01 as three points, with a headset's noise, its head
   // height told either way: the calibration takes the rig's head, 0.05 head heights further
   // forward of its hands, and its wider shoulders to the library rig's hand places.
-  const LoadedMotion daz = salsa_take("10");
-  const LoadedMotion rig = load({kSalsaData + "/cmu-handshake/18_01.bvh"});
-  Result<Clip> moved = retarget_clip(daz.clip, daz.roles, rig.clip.skeleton_ptr(), rig.roles);
-  ASSERT_TRUE(moved) << moved.error().message;
-  Performance performance;
-  performance.motion = std::move(moved).value();
-  performance.roles = rig.roles;
-  Result<ArmsForward> pose = arms_forward_of_body(performance.motion, performance.roles, 10);
-  ASSERT_TRUE(pose);
-  const double head_m = highest_head_m(performance.motion, performance.roles);
-  Result<Performance> points = with_head_hands(std::move(performance), PointNoiseOptions{});
-  ASSERT_TRUE(points);
-  const Clip& clip = points.value().motion;
+  const ThreePointsOnRig on_rig = take_10_on_handshake_rig_as_points();
+  const Performance& points = on_rig.points;
+  const ArmsForward& pose = on_rig.pose;
+  const double head_m = on_rig.head_m;
+  const Clip& clip = points.motion;
   auto within_100ms = [&](const std::optional<ArmsForward>& told) {
-    FollowSession session =
-        hmm_session(head_hands_library(), clip.skeleton_ptr(), points.value().roles);
+    FollowSession session = hmm_session(head_hands_library(), clip.skeleton_ptr(), points.roles);
     EXPECT_TRUE(session.set_head_height(head_m));
     EXPECT_TRUE(session.set_arms_forward(told));
     const int take = 8;  // 60_10
@@ -215,7 +232,7 @@ TEST(ArmsForward, AnotherRigCalibratedIsFollowedAsWellAsTheLibrarysOwn) {
     return static_cast<double>(right) / clip.frame_count();
   };
   const double untold = within_100ms(std::nullopt);
-  const double told = within_100ms(pose.value());
+  const double told = within_100ms(pose);
   EXPECT_GT(told, 0.98) << "untold " << untold;  // measured 0.997
   EXPECT_LT(untold, 0.9);                        // measured 0.42
 }
@@ -226,29 +243,19 @@ TEST(ArmsForward, TheHandsOffsetIsTheCalibrationsPlusWhatTheFollowerLearns) {
   // offset from the first frame; not told, the posture offset the follower learns, which on a rig
   // with wider shoulders (the CMU handshake rig, take 60_10 as three points) moves the hands
   // outwards as the calibration would.
-  const LoadedMotion daz = salsa_take("10");
-  const LoadedMotion rig = load({kSalsaData + "/cmu-handshake/18_01.bvh"});
-  Result<Clip> moved = retarget_clip(daz.clip, daz.roles, rig.clip.skeleton_ptr(), rig.roles);
-  ASSERT_TRUE(moved) << moved.error().message;
-  Performance performance;
-  performance.motion = std::move(moved).value();
-  performance.roles = rig.roles;
-  Result<ArmsForward> pose = arms_forward_of_body(performance.motion, performance.roles, 10);
-  ASSERT_TRUE(pose);
-  const double head_m = highest_head_m(performance.motion, performance.roles);
-  Result<Performance> points = with_head_hands(std::move(performance), PointNoiseOptions{});
-  ASSERT_TRUE(points);
-  const Clip& clip = points.value().motion;
+  const ThreePointsOnRig on_rig = take_10_on_handshake_rig_as_points();
+  const Performance& points = on_rig.points;
+  const ArmsForward& pose = on_rig.pose;
+  const double head_m = on_rig.head_m;
+  const Clip& clip = points.motion;
   const ArmsForward& library_pose = head_hands_library().template_arms_forward();
 
-  FollowSession told = hmm_session(head_hands_library(), clip.skeleton_ptr(), points.value().roles);
-  ASSERT_TRUE(told.set_arms_forward(pose.value()));
+  FollowSession told = hmm_session(head_hands_library(), clip.skeleton_ptr(), points.roles);
+  ASSERT_TRUE(told.set_arms_forward(pose));
   for (std::size_t s = 0; s < 2; ++s) {
-    EXPECT_LT((told.hand_offsets()[s] - (pose.value().wrists[s] - library_pose.wrists[s])).norm(),
-              1e-12);
+    EXPECT_LT((told.hand_offsets()[s] - (pose.wrists[s] - library_pose.wrists[s])).norm(), 1e-12);
   }
-  FollowSession untold =
-      hmm_session(head_hands_library(), clip.skeleton_ptr(), points.value().roles);
+  FollowSession untold = hmm_session(head_hands_library(), clip.skeleton_ptr(), points.roles);
   ASSERT_TRUE(untold.set_head_height(head_m));
   EXPECT_TRUE(untold.hand_offsets()[0].isZero());
   for (int f = 0; f < clip.frame_count(); ++f) {
@@ -256,13 +263,14 @@ TEST(ArmsForward, TheHandsOffsetIsTheCalibrationsPlusWhatTheFollowerLearns) {
   }
   const std::array<Vec3, 2> learnt = untold.hand_offsets();
   for (std::size_t s = 0; s < 2; ++s) {
-    const Vec3 calibration = pose.value().wrists[s] - library_pose.wrists[s];
+    const Vec3 calibration = pose.wrists[s] - library_pose.wrists[s];
     // Measured: calibration (0.059, -0.007, -0.057) and (-0.051, -0.003, -0.057) head heights,
     // learnt (0.073, 0.000, -0.044) and (-0.015, -0.005, -0.056).
     EXPECT_LT((learnt[s] - calibration).norm(), 0.5 * calibration.norm()) << "side " << s;
     EXPECT_GT(learnt[s].x() * calibration.x(), 0.0) << "side " << s;  // outwards, as told
   }
   // A full-body user has no hand places to offset.
+  const LoadedMotion daz = salsa_take("10");
   FollowSession full = hmm_session(salsa_library(), daz.clip.skeleton_ptr(), daz.roles);
   EXPECT_TRUE(full.hand_offsets()[0].isZero() && full.hand_offsets()[1].isZero());
 }
