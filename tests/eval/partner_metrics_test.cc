@@ -491,22 +491,27 @@ TEST(PartnerRun, ThreePointsOfAnotherBodyHaveTheirHandsMet) {
   larger.head_hands = true;
   larger.body_scale = 1.15;
   larger.told_head_height_factor = 1.0;
-  PerformanceRecipe on_asf;  // the CMU ASF rig's body, its calibration told
-  on_asf.head_hands = true;
-  on_asf.body_scale = 1.0;
-  on_asf.rig = asf.value().clip.skeleton_ptr();
-  on_asf.rig_roles = asf.value().roles;
-  on_asf.rig_name = "asf";
+  // The template dancer's size on another rig's body, as three points.
+  auto three_points_on = [](std::shared_ptr<const Skeleton> rig, const JointRoles& roles,
+                            const std::string& name) {
+    PerformanceRecipe recipe;
+    recipe.head_hands = true;
+    recipe.body_scale = 1.0;
+    recipe.rig = std::move(rig);
+    recipe.rig_roles = roles;
+    recipe.rig_name = name;
+    return recipe;
+  };
+  // The CMU ASF rig's body, its calibration told.
+  PerformanceRecipe on_asf =
+      three_points_on(asf.value().clip.skeleton_ptr(), asf.value().roles, "asf");
   on_asf.tell_arms_forward = true;
   Result<GenericRigWithRoles> avatar =
       make_generic_rig_with_roles(find_generic_rig("game-avatar")->rig);
   ASSERT_TRUE(avatar) << avatar.error().message;
-  PerformanceRecipe on_avatar;  // a game avatar's body, not told: the offset the follower learns
-  on_avatar.head_hands = true;
-  on_avatar.body_scale = 1.0;
-  on_avatar.rig = std::make_shared<Skeleton>(avatar.value().skeleton);
-  on_avatar.rig_roles = avatar.value().roles;
-  on_avatar.rig_name = "game-avatar";
+  // A game avatar's body, not told: the offset the follower learns.
+  const PerformanceRecipe on_avatar = three_points_on(
+      std::make_shared<Skeleton>(avatar.value().skeleton), avatar.value().roles, "game-avatar");
   const double larger_cm = median_hand_error(larger), asf_cm = median_hand_error(on_asf);
   const double untold_cm = median_hand_error(on_avatar);
   EXPECT_LT(larger_cm, 0.65);  // 0.53 (0.80 before)
