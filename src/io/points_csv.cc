@@ -217,9 +217,13 @@ std::string format_points_csv(const Clip& points) {
   std::string out = points_csv_header() + "\n";
   for (int f = 0; f < points.frame_count(); ++f) {
     out += fmt::format("{:.9f}", f / points.frame_rate());
+    // The points are children of the origin joint, which a turned world (turn_world) turns.
+    const Quat& origin_rotation = points.rotations_ls(f)[kPointsOrigin];
+    const Vec3& origin = points.translations_ls(f)[kPointsOrigin];
     for (int p = 1; p <= kPoints; ++p) {
-      const Vec3& x = points.translations_ls(f)[static_cast<std::size_t>(p)];
-      const Quat& q = points.rotations_ls(f)[static_cast<std::size_t>(p)];
+      const Vec3 x =
+          origin + origin_rotation * points.translations_ls(f)[static_cast<std::size_t>(p)];
+      const Quat q = origin_rotation * points.rotations_ls(f)[static_cast<std::size_t>(p)];
       out += fmt::format(",{:.5f},{:.5f},{:.5f},{:.6f},{:.6f},{:.6f},{:.6f}", x.x(), x.y(), x.z(),
                          q.x(), q.y(), q.z(), q.w());
     }

@@ -1,13 +1,15 @@
 // The three-point CSV (duet/io/points_csv.h): round trip, resampling of uneven samples, and a clear
 // error naming the line and column for every kind of bad input.
+#include "duet/io/points_csv.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
-#include "duet/io/points_csv.h"
 #include "duet/math/rotation.h"
 #include "duet/motion/head_hands.h"
+#include "duet/motion/up_axis.h"
 
 namespace duet {
 namespace {
@@ -43,6 +45,30 @@ TEST(PointsCsv, RoundTripKeepsEveryPoint) {
       EXPECT_LT((back.value().translations_ls(f)[p] - clip.translations_ls(f)[p]).norm(), 1e-5);
       EXPECT_GT(std::abs(back.value().rotations_ls(f)[p].dot(clip.rotations_ls(f)[p])), 1 - 1e-9);
     }
+  }
+}
+
+TEST(PointsCsv, AWorldTurnedOnLoadingIsWrittenAsItsPointsAreSeen) {
+  // load_motion turns a tilted or Z-up world by its origin joint (turn_world); what is written
+  // back (duet convert) is where the points are, not where they sit against the origin.
+  Clip clip(make_head_hands_skeleton(), 30.0, 2);
+  for (int f = 0; f < 2; ++f) {
+    clip.translations_ls(f)[kPointsHead] = Vec3(0.2, 1.6, -0.1 * f);
+    clip.rotations_ls(f)[kPointsHead] = Quat(Eigen::AngleAxisd(0.4 * f, Vec3::UnitY()));
+  }
+  const Quat turn(Eigen::AngleAxisd(deg_to_rad(12.0), Vec3(1.0, 0.0, 2.0).normalized()));
+  Clip turned = clip;
+  turn_world(turned, turn);
+  Result<Clip> back = parse_points_csv(format_points_csv(turned), "turned.csv");
+  ASSERT_TRUE(back) << back.error().message;
+  for (int f = 0; f < 2; ++f) {
+    EXPECT_LT(
+        (back.value().translations_ls(f)[kPointsHead] - turn * clip.translations_ls(f)[kPointsHead])
+            .norm(),
+        1e-5);
+    EXPECT_GT(std::abs(back.value().rotations_ls(f)[kPointsHead].dot(
+                  turn * clip.rotations_ls(f)[kPointsHead])),
+              1 - 1e-9);
   }
 }
 
