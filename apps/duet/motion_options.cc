@@ -22,9 +22,11 @@ void add_motion_file_options(CLI::App& app, MotionFileOptions& options, const st
                  "(see docs/skeleton-maps.md)")
       ->check(CLI::ExistingFile);
   app.add_option("--" + prefix + "up", options.up,
-                 "The file's up axis: auto (default: read from the body, feet to head), y, z, x, "
-                 "-y, -z or -x. A Z-up file (3ds Max, Motive, some Blender exports) is turned to "
-                 "Y-up for following and its outputs are written back in its own world")
+                 "The file's up axis: auto (default: read from the body, feet to head; a "
+                 "three-point CSV's is +Y), y, z, x, -y, -z or -x. A Z-up file (3ds Max, Motive, "
+                 "some Blender exports) is turned to Y-up for following and its outputs are "
+                 "written back in its own world; with auto a tilted floor is levelled (read from "
+                 "the toes, or a three-point CSV's head path)")
       ->check([](const std::string& text) -> std::string {
         UpAxis axis;
         if (text == "auto" || parse_up_axis(text, axis)) return {};

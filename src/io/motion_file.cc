@@ -127,6 +127,8 @@ double readable_metres_per_unit(const Skeleton& skeleton, double preferred) {
 
 namespace {
 
+void decide_up_axis(const MotionLoadOptions& options, bool have_roles, LoadedMotion& loaded);
+
 // A three-point recording (duet/io/points_csv.h): in metres by definition, with its own roles.
 Result<LoadedMotion> load_points_csv(const std::string& path, const MotionLoadOptions& options) {
   if (options.map) return Error{path + ": a three-point CSV takes no skeleton map"};
@@ -145,6 +147,7 @@ Result<LoadedMotion> load_points_csv(const std::string& path, const MotionLoadOp
     loaded.units_name = "metres";
   }
   loaded.roles = head_hands_roles();
+  decide_up_axis(options, false, loaded);
   loaded.role_detection.roles = loaded.roles;
   for (Role role : {Role::kHead, Role::kLeftWrist, Role::kRightWrist}) {
     loaded.role_detection.notes[static_cast<std::size_t>(role)] = "three-point CSV column";
@@ -153,12 +156,22 @@ Result<LoadedMotion> load_points_csv(const std::string& path, const MotionLoadOp
   return loaded;
 }
 
-// The file's up axis: given, else read from the body, and a tilted world levelled; the clip is
-// turned to Y-up.
+// The file's up axis: given, else read from the body (a three-point recording's is +Y by its
+// format), and a tilted world levelled; the clip is turned to Y-up.
 void decide_up_axis(const MotionLoadOptions& options, bool have_roles, LoadedMotion& loaded) {
   if (options.up_axis) {
     loaded.up_axis = *options.up_axis;
     loaded.up_source = kUpAxisGiven;
+  } else if (is_head_hands_input(loaded.roles)) {
+    // No feet: a tilted world (a camera-based tracker) is levelled from the head's path.
+    loaded.up_source = "the three-point format's";
+    loaded.level = head_path_levelling(loaded.clip, kPointsHead);
+    if (loaded.tilt_deg() > 0.0) {
+      loaded.up_source += fmt::format(
+          "; a tilted floor read from the head's path, levelled by "
+          "{:.1f} degrees",
+          loaded.tilt_deg());
+    }
   } else if (have_roles) {
     const UpAxisDetection detection = detect_up_axis(loaded.clip, loaded.roles);
     if (detection.problem.empty()) {

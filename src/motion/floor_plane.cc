@@ -21,7 +21,7 @@ constexpr double kTrimSpreads = 3.0;
 }  // namespace
 
 FloorFit fit_floor(std::span<const Vec3> points, const Vec3& prior_up, double span_s,
-                   double prior_sigma_deg) {
+                   double prior_sigma_deg, PlaneOutliers outliers) {
   FloorFit fit;
   const Vec3 prior =
       prior_up.allFinite() && prior_up.y() > 0.0 ? prior_up.normalized() : Vec3::UnitY();
@@ -43,6 +43,7 @@ FloorFit fit_floor(std::span<const Vec3> points, const Vec3& prior_up, double sp
   std::vector<double> residuals(finite.size());
   Vec3 up = prior;
   double spread = 0.02;
+  double tilt_sigma_rad = 0.0;
   bool solved = false;
   for (int pass = 0; pass < kPasses; ++pass) {
     const Quat to_local = Quat::FromTwoVectors(up, Vec3::UnitY());
@@ -70,6 +71,11 @@ FloorFit fit_floor(std::span<const Vec3> points, const Vec3& prior_up, double sp
     rhs.head<2>() += prior_weight * prior_slope;
     const Eigen::Vector3d plane = normal.ldlt().solve(rhs);
     if (!plane.allFinite()) break;
+    // The slope's covariance is the inverse of the weighted normal matrix; its larger axis.
+    const Eigen::Matrix2d slope_covariance = normal.inverse().topLeftCorner<2, 2>();
+    const double largest_variance =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(slope_covariance).eigenvalues().maxCoeff();
+    tilt_sigma_rad = std::atan(std::sqrt(std::max(0.0, largest_variance)));
     solved = true;
     for (std::size_t i = 0; i < local.size(); ++i) {
       // Signed: a toe above the floor (a foot in the air) is positive.
@@ -84,14 +90,16 @@ FloorFit fit_floor(std::span<const Vec3> points, const Vec3& prior_up, double sp
     spread = 1.4826 * upper_median(std::move(magnitudes));
     // The lower toe is on the floor or above it: points far above are feet in the air.
     const double limit = kTrimSpreads * std::max(spread, kLeastHeightSpreadM);
+    const double side = outliers == PlaneOutliers::kAbove ? 1.0 : -1.0;
     for (std::size_t i = 0; i < local.size(); ++i) {
-      inlier[i] = residuals[i] <= limit && residuals[i] >= -2.0 * limit;
+      inlier[i] = side * residuals[i] <= limit && side * residuals[i] >= -2.0 * limit;
     }
     up = (to_local.conjugate() * Vec3(-plane.x(), 1.0, -plane.y())).normalized();
   }
   if (!solved) return fit;
   fit.up = up;
   fit.height_spread_m = spread;
+  fit.tilt_sigma_deg = rad_to_deg(tilt_sigma_rad);
   return fit;
 }
 

@@ -40,6 +40,11 @@ constexpr double kMostOffAxisDeg = 35.0;
 // Least length of the mean of unit directions: below it the body pointed too many ways.
 constexpr double kLeastConsistency = 0.5;
 
+// The head's path (head_path_levelling): drawn towards +Y as the toes' floor is, and levelled
+// only when its tilt is this many of its standard errors from level.
+constexpr double kHeadPathPriorSigmaDeg = 3.0;
+constexpr double kHeadPathSignificance = 3.0;
+
 // The middle of both feet: ankles and toes, or the ankles alone.
 Vec3 mid_foot(std::span<const Vec3> positions, const JointRoles& roles, bool with_toes) {
   const auto at = [&](Role role) { return positions[static_cast<std::size_t>(roles[role])]; };
@@ -203,6 +208,33 @@ Quat levelling_rotation(const UpAxisDetection& detection) {
     return Quat::Identity();
   }
   return levelling_rotation(detection.floor_up);
+}
+
+Quat head_path_levelling(const Clip& clip, int head, int max_frames) {
+  const int joints = clip.joint_count();
+  if (head < 0 || head >= joints || clip.frame_count() == 0 ||
+      !(clip.duration() >= kLevelLeastSpanS)) {
+    return Quat::Identity();
+  }
+  const int samples = std::clamp(clip.frame_count(), 1, std::max(max_frames, 1));
+  std::vector<Vec3> positions(static_cast<std::size_t>(joints));
+  std::vector<Quat> rotations(static_cast<std::size_t>(joints));
+  std::vector<Vec3> heads;
+  heads.reserve(static_cast<std::size_t>(samples));
+  for (int s = 0; s < samples; ++s) {
+    const int f = static_cast<int>(static_cast<long long>(s) * clip.frame_count() / samples);
+    forward_kinematics(clip.skeleton(), clip.translations_ls(f), clip.rotations_ls(f), positions,
+                       rotations);
+    heads.push_back(positions[static_cast<std::size_t>(head)]);
+  }
+  const FloorFit path = fit_floor(heads, Vec3::UnitY(), clip.duration(), kHeadPathPriorSigmaDeg,
+                                  PlaneOutliers::kBelow);
+  // A head's height also changes with the dance (a bend held at one end of the room): a tilt
+  // within kHeadPathSignificance standard errors of level is left.
+  if (!(tilt_from_vertical_deg(path.up) > kHeadPathSignificance * path.tilt_sigma_deg)) {
+    return Quat::Identity();
+  }
+  return levelling_rotation(path.up);
 }
 
 void turn_to_file_world(Clip& clip, const Quat& file_to_y_up) {

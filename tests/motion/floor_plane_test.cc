@@ -75,5 +75,29 @@ TEST(FloorPlane, FeetInTheAirAndBadPointsAreSetAside) {
   EXPECT_LT((fit_floor({}, Vec3::Zero(), 30.0).up - Vec3::UnitY()).norm(), 1e-12);
 }
 
+TEST(FloorPlane, AHeadsDipsAreSetAsideBelowItsPath) {
+  // A head's path 1.5 m above a floor tilted 8 degrees, and a tenth of the frames a bend held at
+  // one end of the room, 40-50 cm lower: the outliers are below the plane, not above it.
+  const Vec3 floor_up = Quat(Eigen::AngleAxisd(deg_to_rad(8.0), Vec3::UnitX())) * Vec3::UnitY();
+  std::vector<Vec3> path = toes_on_floor(floor_up, 1.2, 1.2, 216, 5);
+  for (Vec3& p : path) p += 1.5 * floor_up;
+  const Quat tilt = Quat::FromTwoVectors(Vec3::UnitY(), floor_up);
+  for (int i = 0; i < 24; ++i) {
+    path.push_back(tilt * Vec3(0.1 + 0.01 * i, 1.05 - 0.004 * i, -0.6) + Vec3(2.0, 0.0, -1.0));
+  }
+  const FloorFit head = fit_floor(path, Vec3::UnitY(), 40.0, 3.0, PlaneOutliers::kBelow);
+  EXPECT_LT(degrees_between(head.up, floor_up), 1.0);
+  // Read as toes (outliers above), the bend drew the plane towards it.
+  EXPECT_GT(degrees_between(fit_floor(path, Vec3::UnitY(), 40.0).up, floor_up), 5.0);
+
+  // The tilt's standard error: small where the points spread over the room, large where they
+  // keep to the spot (and never past the prior's 3 degrees).
+  EXPECT_GT(head.tilt_sigma_deg, 0.0);
+  EXPECT_LT(head.tilt_sigma_deg, 1.0);
+  const FloorFit spot = fit_floor(toes_on_floor(floor_up, 0.05, 0.05, 240, 6), Vec3::UnitY(), 40.0);
+  EXPECT_GT(spot.tilt_sigma_deg, 5.0 * head.tilt_sigma_deg);
+  EXPECT_LT(spot.tilt_sigma_deg, 3.0);
+}
+
 }  // namespace
 }  // namespace duet

@@ -11,9 +11,16 @@
 
 namespace duet {
 
+// Which side of the plane the points' outliers lie on: a foot in the air is above the floor, a
+// head that dips is below the plane its path keeps to.
+enum class PlaneOutliers { kAbove, kBelow };
+
 struct FloorFit {
   Vec3 up = Vec3::UnitY();       // the floor's normal (unit, +Y side)
   double height_spread_m = 0.0;  // robust spread of the points about the plane
+  // The standard error of the plane's tilt, degrees, along its least determined direction (from
+  // the last pass's weights: samples half a second apart counted independent, the prior included).
+  double tilt_sigma_deg = 0.0;
 };
 
 // The floor through `points` (world, nearly Y-up: one lower-toe position per sampled frame,
@@ -24,6 +31,6 @@ struct FloorFit {
 // foot in the air on every frame of a jump) are set aside (3 robust spreads). Non-finite points
 // are skipped; with fewer than 3 points, `prior_up` normalised.
 FloorFit fit_floor(std::span<const Vec3> points, const Vec3& prior_up, double span_s,
-                   double prior_sigma_deg = 3.0);
+                   double prior_sigma_deg = 3.0, PlaneOutliers outliers = PlaneOutliers::kAbove);
 
 }  // namespace duet
