@@ -670,6 +670,12 @@ Quat level_as_loaded(Performance& performance) {
   return level;
 }
 
+Quat level_head_path_as_loaded(Performance& performance) {
+  const Quat level = head_path_levelling(performance.motion, performance.roles[Role::kHead]);
+  if (level.vec().squaredNorm() > 0.0) turn_world(performance.motion, level);
+  return level;
+}
+
 Result<Performance> with_rig(Performance performance, std::shared_ptr<const Skeleton> rig,
                              const JointRoles& rig_roles) {
   Result<Clip> moved = retarget_clip(performance.motion, performance.roles, rig, rig_roles);
@@ -779,14 +785,18 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     // docs/evaluation.md, "The sensor's errors on the body, not the rig".
     Result<Performance> truth = delivered(performance, recipe);  // noise-free, for the scores
     if (!truth) return truth.error();
-    record_true_wrists(truth.value());
-    if (recipe.head_hands) record_true_headings(truth.value());
     SensorNoiseOptions options = recipe.noise;
     options.seed = derive_seed(seed, 12);
     Result<Performance> noisy =
         delivered(with_sensor_noise(std::move(performance), options), recipe);
     if (!noisy) return noisy.error();
     performance = std::move(noisy).value();
+    if (recipe.head_hands) {
+      const Quat level = level_head_path_as_loaded(performance);
+      if (level.vec().squaredNorm() > 0.0) turn_world(truth.value().motion, level);
+    }
+    record_true_wrists(truth.value());
+    if (recipe.head_hands) record_true_headings(truth.value());
     performance.true_wrists_ws = std::move(truth.value().true_wrists_ws);
     performance.true_headings_ws = std::move(truth.value().true_headings_ws);
   } else {
@@ -794,6 +804,7 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     if (!moved) return moved.error();
     performance = std::move(moved).value();
     if (recipe.head_hands) {
+      level_head_path_as_loaded(performance);
       record_true_wrists(performance);
       record_true_headings(performance);
     }

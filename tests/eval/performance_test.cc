@@ -11,7 +11,9 @@
 #include "duet/io/motion_file.h"
 #include "duet/math/rotation.h"
 #include "duet/motion/forward_kinematics.h"
+#include "duet/motion/head_hands.h"
 #include "duet/motion/rig_variants.h"
+#include "duet/motion/up_axis.h"
 #include "features/synthetic_dancer.h"
 
 namespace duet {
@@ -896,6 +898,48 @@ TEST(MakePerformance, ThreePointsCarryTheToldHeadHeightThroughLostFrames) {
   const double highest = highest_head_m(f.clip, f.roles);
   ASSERT_GT(highest, 0.5);
   EXPECT_NEAR(told.value().told_head_height_m, 1.05 * 0.9 * highest, 1e-6 * highest);
+}
+
+TEST(MakePerformance, ThreePointsInATiltedWorldAreLevelledAsTheirRecordingIsTruthsAndAll) {
+  // A camera-based three-point tracker pitched down: the points are levelled from the head's
+  // path as loading their CSV levels them (level_head_path_as_loaded), and the scores' real
+  // wrists, body headings and the told head height are in that level world too. A real take,
+  // whose dancer travels the room (the evidence of the head's path).
+  MotionLoadOptions load;
+  load.frame_rate = 60.0;
+  Result<LoadedMotion> take =
+      load_motion({std::string(DUET_DATA_DIR) + "/cmu-salsa/bvh/60/60_10_scaled.bvh"}, load);
+  ASSERT_TRUE(take) << take.error().message;
+  const SourceTake source{0, &take.value().clip, take.value().roles};
+  PerformanceRecipe recipe;
+  recipe.head_hands = true;
+  recipe.told_head_height_factor = 1.0;
+  Result<Performance> level = make_performance(std::span(&source, 1), recipe, 3);
+  ASSERT_TRUE(level) << level.error().message;
+  recipe.world_tilt_deg = 12.0;
+  Result<Performance> tilted = make_performance(std::span(&source, 1), recipe, 3);
+  ASSERT_TRUE(tilted) << tilted.error().message;
+  const Performance& p = tilted.value();
+
+  EXPECT_TRUE(head_path_levelling(p.motion, kPointsHead).vec().isZero(0.0)) << "levelled";
+  EXPECT_NEAR(p.told_head_height_m, level.value().told_head_height_m, 0.03);
+  ASSERT_EQ(p.true_wrists_ws.size(), static_cast<std::size_t>(p.frame_count()));
+  ASSERT_EQ(p.true_headings_ws.size(), static_cast<std::size_t>(p.frame_count()));
+  double wrist_off = 0.0, most_lean_deg = 0.0;
+  std::vector<Vec3> positions(static_cast<std::size_t>(p.motion.joint_count()));
+  std::vector<Quat> rotations(positions.size());
+  for (int f = 0; f < p.frame_count(); ++f) {
+    forward_kinematics(p.motion.skeleton(), p.motion.translations_ls(f), p.motion.rotations_ls(f),
+                       positions, rotations);
+    const auto k = static_cast<std::size_t>(f);
+    wrist_off += (positions[kPointsLeftHand] - p.true_wrists_ws[k][0]).norm();
+    most_lean_deg = std::max(
+        most_lean_deg, tilt_from_vertical_deg(p.true_headings_ws[k].rotation * Vec3::UnitY()));
+  }
+  // The hands are the wrists plus 5 mm of tracking noise; left tilted, the real wrists would be a
+  // 12-degree turn (about 20 cm a metre from the origin) away.
+  EXPECT_LT(wrist_off / p.frame_count(), 0.03) << "metres, mean";
+  EXPECT_LT(most_lean_deg, 3.0) << "a body heading frame stands upright";
 }
 
 TEST(Improvise, RealTakeKeepsTheRootPathContinuous) {

@@ -213,6 +213,10 @@ Performance with_world_tilt(Performance performance, double tilt_deg);
 // nothing was levelled, and for a performance with no feet and head, as a three-point CSV has
 // none).
 Quat level_as_loaded(Performance& performance);
+// The same for a performance to be delivered as three points (load_motion levels a three-point
+// CSV from its head's path, head_path_levelling): read from the head joint's path, before the
+// devices' offsets and tracking noise, and turned before any truth is recorded.
+Quat level_head_path_as_loaded(Performance& performance);
 
 // The same performance danced on another rig (a user's suit, avatar or another studio's skeleton):
 // retargeted (duet::retarget_clip: role directions, stride-scaled root, feet on the floor) onto
