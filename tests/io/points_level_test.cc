@@ -103,12 +103,25 @@ TEST_F(PointsLevel, ACameraPitchedDownIsLevelledFromTheHeadsPathAndALevelWorldIs
   EXPECT_LT(farthest, 0.08) << "metres (left tilted, a head a metre from the origin is 20 cm off)";
   EXPECT_LT(rad_to_deg(log_map(levelled.level * tilt).norm()), 2.5);
 
-  // An up axis given is taken as exact, as for a body; so is a short recording's level.
+  // An up axis given is taken as exact, as for a body.
   MotionLoadOptions given;
   given.up_axis = UpAxis::kPosY;
   const LoadedMotion exact = written_and_loaded(tilted, "given.csv", given);
   EXPECT_EQ(exact.tilt_deg(), 0.0);
   EXPECT_EQ(exact.up_source, kUpAxisGiven);
+  // A Z-up recording told so is turned to Y up (a three-point CSV's --up was ignored before).
+  Clip z_up = level;
+  turn_world(z_up, rotation_to_y_up(UpAxis::kPosZ).conjugate());
+  MotionLoadOptions told_z;
+  told_z.up_axis = UpAxis::kPosZ;
+  const LoadedMotion from_z = written_and_loaded(z_up, "z-up.csv", told_z);
+  EXPECT_EQ(from_z.up_axis, UpAxis::kPosZ);
+  const std::vector<Vec3> from_z_heads = heads(from_z.clip);
+  ASSERT_EQ(from_z_heads.size(), level_heads.size());
+  for (std::size_t f = 0; f < level_heads.size(); f += 97) {
+    EXPECT_LT((from_z_heads[f] - level_heads[f]).norm(), 1e-4) << f;
+  }
+  // Under kLevelLeastSpanS the head's path is no evidence: left as it is.
   Clip short_tilted = tilted;
   short_tilted.keep_first_frames(static_cast<int>(kLevelLeastSpanS * 60.0) - 1);
   EXPECT_EQ(written_and_loaded(short_tilted, "short.csv").tilt_deg(), 0.0);
