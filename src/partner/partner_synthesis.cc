@@ -348,6 +348,11 @@ std::string PartnerParams::validate() const {
       return std::string(name) + " must be finite and >= 0 (got " + std::to_string(value) + ")";
     }
   }
+  if (!(ik_correction_speed_budget_rad_s > 0.0) || !(ik_correction_min_speed_rad_s > 0.0)) {
+    return "ik_correction_speed_budget_rad_s and ik_correction_min_speed_rad_s must be > 0 (got " +
+           std::to_string(ik_correction_speed_budget_rad_s) + " and " +
+           std::to_string(ik_correction_min_speed_rad_s) + ")";
+  }
   if (!(ik_correction_max_speed_rad_s > 0.0)) {
     return "ik_correction_max_speed_rad_s must be > 0 (infinity for no limit; got " +
            std::to_string(ik_correction_max_speed_rad_s) + ")";
@@ -585,6 +590,14 @@ Quat PartnerContext::steady_hand_turn(std::size_t hand, const Quat& sensed, cons
       .normalized();
 }
 
+double ik_correction_step_limit(const PartnerParams& p, double dt_s,
+                                double captured_move_rad) noexcept {
+  const double most = p.ik_correction_max_speed_rad_s * dt_s;
+  if (!std::isfinite(captured_move_rad)) return most;
+  const double least = std::min(p.ik_correction_min_speed_rad_s * dt_s, most);
+  return std::clamp(p.ik_correction_speed_budget_rad_s * dt_s - captured_move_rad, least, most);
+}
+
 void PartnerContext::reset() noexcept {
   primed_ = false;
   inertializer_.reset();
@@ -607,6 +620,7 @@ void PartnerContext::reset() noexcept {
   for (auto& arm : ik_correction_filter_) {
     for (OneEuroFilter3& filter : arm) filter.reset();
   }
+  ik_captured_previous_valid_ = {false, false};
   ik_ramp_ = {0.0, 0.0};
   ik_pair_ = {-1, -1};
   ik_target_valid_ = {false, false};
@@ -821,6 +835,7 @@ bool PartnerSynthesisJob::run() const noexcept {
     // swung the forearm of a partner of a user of other proportions at up to 2500 deg/s
     // (docs/evaluation.md, "The IK's correction let go"). At a blended jump the blend takes it.
     const auto release_correction = [&](std::size_t r) {
+      ctx.ik_captured_previous_valid_[r] = false;
       std::array<OneEuroFilter3, 2>& filters = ctx.ik_correction_filter_[r];
       std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
       constexpr double kReleasedRad = 1e-4;
@@ -983,12 +998,18 @@ bool PartnerSynthesisJob::run() const noexcept {
         const OneEuroParams correction_filter = correction_filter_of(r);
         const auto correct = [&](std::size_t k, const Quat& captured, const Quat& base,
                                  const Quat& solved) {
+          const double captured_move =
+              ctx.ik_captured_previous_valid_[r]
+                  ? log_map(ctx.ik_captured_previous_[r][k].conjugate() * captured).norm()
+                  : 0.0;
+          const double most = ik_correction_step_limit(p, dt, captured_move);
+          ctx.ik_captured_previous_[r][k] = captured;
           return step_correction(filters[k], shown[k], log_map(captured.conjugate() * solved),
-                                 log_map(captured.conjugate() * base), dt, correction_filter,
-                                 p.ik_correction_max_speed_rad_s * dt);
+                                 log_map(captured.conjugate() * base), dt, correction_filter, most);
         };
         const Vec3 start_correction = correct(0, captured_start, base_start, ik_start);
         const Vec3 mid_correction = correct(1, captured_mid, base_mid, ik_mid);
+        ctx.ik_captured_previous_valid_[r] = true;
         ik_start = (captured_start * exp_map(start_correction)).normalized();
         ik_mid = (captured_mid * exp_map(mid_correction)).normalized();
         reached_at = arm_end_position(chain.start_ws, chain.mid_ws, chain.end_ws, captured_start,

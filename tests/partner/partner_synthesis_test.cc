@@ -404,6 +404,32 @@ TEST(PartnerSynthesis, AnArmLetsItsCorrectionGoAtTheSpeedLimit) {
   EXPECT_LT(run.r[elbow].angularDistance(duet.follower.rotations_ls(299)[elbow]), 1e-6);
 }
 
+TEST(PartnerSynthesis, TheIkCorrectionTakesWhatTheCapturedSwingLeavesOfItsBudget) {
+  // Per frame the correction of an arm joint moves at most 4 rad/s, and no more than the captured
+  // joint's own swing leaves of 8 rad/s, but at least 1 rad/s (a persistent correction arrives).
+  const PartnerParams p;
+  ASSERT_EQ(p.ik_correction_max_speed_rad_s, 4.0);
+  ASSERT_EQ(p.ik_correction_speed_budget_rad_s, 8.0);
+  ASSERT_EQ(p.ik_correction_min_speed_rad_s, 1.0);
+  const double dt = 1.0 / 60.0;
+  EXPECT_NEAR(ik_correction_step_limit(p, dt, 0.0) / dt, 4.0, 1e-12);       // a still arm
+  EXPECT_NEAR(ik_correction_step_limit(p, dt, 3.0 * dt) / dt, 4.0, 1e-12);  // 3 + 4 < 8
+  EXPECT_NEAR(ik_correction_step_limit(p, dt, 5.0 * dt) / dt, 3.0, 1e-12);  // 5 + 3 = 8
+  EXPECT_NEAR(ik_correction_step_limit(p, dt, 7.5 * dt) / dt, 1.0, 1e-12);  // at least 1
+  EXPECT_NEAR(ik_correction_step_limit(p, dt, 20.0 * dt) / dt, 1.0, 1e-12);
+  PartnerParams no_budget = p;
+  no_budget.ik_correction_speed_budget_rad_s = std::numeric_limits<double>::infinity();
+  EXPECT_NEAR(ik_correction_step_limit(no_budget, dt, 20.0 * dt) / dt, 4.0, 1e-12);
+  PartnerParams slow = p;
+  slow.ik_correction_max_speed_rad_s = 0.5;  // the least never exceeds the most
+  EXPECT_NEAR(ik_correction_step_limit(slow, dt, 20.0 * dt) / dt, 0.5, 1e-12);
+  // Not a finite swing (a first frame): the most.
+  EXPECT_NEAR(ik_correction_step_limit(p, dt, std::nan("")) / dt, 4.0, 1e-12);
+  PartnerParams bad = p;
+  bad.ik_correction_speed_budget_rad_s = 0.0;
+  EXPECT_NE(bad.validate(), "");
+}
+
 // Hands held throughout, standing, 120 frames at 30 Hz: the user's left wrist as captured, moved
 // by `move(frame, user)` and then jittered by white noise of `noise_m` per axis (seed `seed`); the
 // partner's right wrist every frame.

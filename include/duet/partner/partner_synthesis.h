@@ -181,6 +181,14 @@ struct PartnerParams {
   // speed is about what it is with the IK off; 2 rad/s was as steady but slowed a persistent
   // correction (`body-size`: median hand error 1.25 cm, 0.99 at 4 rad/s).
   double ik_correction_max_speed_rad_s = 4.0;
+  // smooth: and by no more than the captured arm joint's own speed leaves of this budget (rad/s),
+  // but at least ik_correction_min_speed_rad_s: where the captured arm already swings fast the
+  // correction waits for it. Added at its full 4 rad/s on top of a fast swing it raised the p99
+  // largest joint speed of a user of another body to 1.2x the captured partner's (`partner-role`
+  // on the ASF rig and a game avatar; docs/evaluation.md, "The IK's correction waits for a fast
+  // swing"). Infinity: no budget.
+  double ik_correction_speed_budget_rad_s = 8.0;
+  double ik_correction_min_speed_rad_s = 1.0;
   // smooth: the correction filter's cutoff falls as the IK target's measured jitter grows:
   // this on a clean sensor, ik_correction_filter.min_cutoff_hz * ik_target_jitter_reference_m /
   // jitter between, ik_correction_filter's own from the reference up. 0 (or at most
@@ -315,6 +323,14 @@ Status parse_corrections(std::string_view list, PartnerParams& params);
 // The switches that are on, as a list parse_corrections() accepts ("none" when all are off).
 std::string corrections_string(const PartnerParams& params);
 
+// How far the contact IK's correction of an arm joint may turn in a frame of dt_s seconds
+// (radians), the captured joint having turned by captured_move_rad since the frame before: at
+// most ik_correction_max_speed_rad_s, no more than what the captured turn leaves of
+// ik_correction_speed_budget_rad_s, at least ik_correction_min_speed_rad_s (never over the most).
+// A captured turn that is not a finite number counts as none.
+double ik_correction_step_limit(const PartnerParams& p, double dt_s,
+                                double captured_move_rad) noexcept;
+
 // ---------------------------------------------------------------------------------------------
 // Run time
 
@@ -396,6 +412,9 @@ class PartnerContext {
   // Per response hand, per arm joint (shoulder, elbow): the IK's correction (smooth).
   std::array<std::array<OneEuroFilter3, 2>, 2> ik_correction_filter_;
   std::array<std::array<Vec3, 2>, 2> ik_correction_{};  // their outputs last frame
+  // The captured arm joints' rotations the last frame the IK corrected them (the budget).
+  std::array<std::array<Quat, 2>, 2> ik_captured_previous_{};
+  std::array<bool, 2> ik_captured_previous_valid_{};
   // The IK target under a noisy sensor: the captured wrist plus the average, in the user's body
   // frame, of what the sensed target adds to it, trusted by its real share (steady_difference.h).
   Vec3 steady_ik_target(std::size_t hand, const Vec3& target, const Vec3& captured_wrist,
