@@ -900,17 +900,27 @@ TEST(MakePerformance, ThreePointsCarryTheToldHeadHeightThroughLostFrames) {
   EXPECT_NEAR(told.value().told_head_height_m, 1.05 * 0.9 * highest, 1e-6 * highest);
 }
 
+// Salsa take 60_10's leader at 60 Hz, loaded once: a real dancer who travels the room.
+const LoadedMotion& take_60_10() {
+  static const LoadedMotion take = [] {
+    MotionLoadOptions load;
+    load.frame_rate = 60.0;
+    Result<LoadedMotion> loaded =
+        load_motion({std::string(DUET_DATA_DIR) + "/cmu-salsa/bvh/60/60_10_scaled.bvh"}, load);
+    EXPECT_TRUE(loaded) << loaded.error().message;
+    return loaded ? std::move(loaded).value() : LoadedMotion{};
+  }();
+  return take;
+}
+
 TEST(MakePerformance, ThreePointsInATiltedWorldAreLevelledAsTheirRecordingIsTruthsAndAll) {
   // A camera-based three-point tracker pitched down: the points are levelled from the head's
   // path as loading their CSV levels them (level_head_path_as_loaded), and the scores' real
   // wrists, body headings and the told head height are in that level world too. A real take,
   // whose dancer travels the room (the evidence of the head's path).
-  MotionLoadOptions load;
-  load.frame_rate = 60.0;
-  Result<LoadedMotion> take =
-      load_motion({std::string(DUET_DATA_DIR) + "/cmu-salsa/bvh/60/60_10_scaled.bvh"}, load);
-  ASSERT_TRUE(take) << take.error().message;
-  const SourceTake source{0, &take.value().clip, take.value().roles};
+  const LoadedMotion& take = take_60_10();
+  ASSERT_GT(take.clip.frame_count(), 0);
+  const SourceTake source{0, &take.clip, take.roles};
   PerformanceRecipe recipe;
   recipe.head_hands = true;
   recipe.told_head_height_factor = 1.0;
@@ -943,14 +953,11 @@ TEST(MakePerformance, ThreePointsInATiltedWorldAreLevelledAsTheirRecordingIsTrut
 }
 
 TEST(Improvise, RealTakeKeepsTheRootPathContinuous) {
-  MotionLoadOptions load;
-  load.frame_rate = 60.0;
-  Result<LoadedMotion> take =
-      load_motion({std::string(DUET_DATA_DIR) + "/cmu-salsa/bvh/60/60_10_scaled.bvh"}, load);
-  ASSERT_TRUE(take) << take.error().message;
-  const SourceTake source{0, &take.value().clip, take.value().roles};
+  const LoadedMotion& take = take_60_10();
+  ASSERT_GT(take.clip.frame_count(), 0);
+  const SourceTake source{0, &take.clip, take.roles};
   double max_step = 0.0, max_turn = 0.0;
-  take_steps(take.value().clip, max_step, max_turn);
+  take_steps(take.clip, max_step, max_turn);
   for (const double pause : {0.0, 1.0}) {
     const Performance p = improvise(std::span(&source, 1), improv_options(pause)).value();
     for (int k = 1; k < p.frame_count(); ++k) {
@@ -958,7 +965,7 @@ TEST(Improvise, RealTakeKeepsTheRootPathContinuous) {
       step.y() = 0.0;
       EXPECT_LE(step.norm(), 1.05 * max_step + 0.002) << "frame " << k;
       if (!p.truth[static_cast<std::size_t>(k)].in_pause) {
-        expect_same_pose_up_to_rigid(p, take.value().clip, k);
+        expect_same_pose_up_to_rigid(p, take.clip, k);
       }
     }
   }
