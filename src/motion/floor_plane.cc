@@ -88,7 +88,8 @@ FloorFit fit_floor(std::span<const Vec3> points, const Vec3& prior_up, double sp
       if (inlier[i]) magnitudes.push_back(std::abs(residuals[i]));
     }
     spread = 1.4826 * upper_median(std::move(magnitudes));
-    // The lower toe is on the floor or above it: points far above are feet in the air.
+    // Points far out on the outliers' side are set aside (feet in the air above the toes' floor,
+    // a head's dips below its path), and points far out on the other side are doubted too.
     const double limit = kTrimSpreads * std::max(spread, kLeastHeightSpreadM);
     const double side = outliers == PlaneOutliers::kAbove ? 1.0 : -1.0;
     for (std::size_t i = 0; i < local.size(); ++i) {

@@ -53,6 +53,22 @@ Vec3 mid_foot(std::span<const Vec3> positions, const JointRoles& roles, bool wit
                    : ankles;
 }
 
+// Runs visit(positions) on the world positions of up to max_frames frames spread evenly over
+// the clip (every frame of a shorter one): what the up axis and the head's path are read from.
+template <typename Visit>
+void for_each_sampled_pose(const Clip& clip, int max_frames, Visit&& visit) {
+  const int joints = clip.joint_count();
+  const int samples = std::clamp(clip.frame_count(), 1, std::max(max_frames, 1));
+  std::vector<Vec3> positions(static_cast<std::size_t>(joints));
+  std::vector<Quat> rotations(static_cast<std::size_t>(joints));
+  for (int s = 0; s < samples && s < clip.frame_count(); ++s) {
+    const int f = static_cast<int>(static_cast<long long>(s) * clip.frame_count() / samples);
+    forward_kinematics(clip.skeleton(), clip.translations_ls(f), clip.rotations_ls(f), positions,
+                       rotations);
+    visit(std::span<const Vec3>(positions));
+  }
+}
+
 }  // namespace
 
 std::string_view up_axis_name(UpAxis axis) { return info(axis).name; }
@@ -124,28 +140,21 @@ UpAxisDetection detect_up_axis(const Clip& clip, const JointRoles& roles, int ma
   }
   const bool with_toes = roles[Role::kLeftToe] >= 0 && roles[Role::kLeftToe] < joints &&
                          roles[Role::kRightToe] >= 0 && roles[Role::kRightToe] < joints;
-  const int samples = std::clamp(clip.frame_count(), 1, std::max(max_frames, 1));
-  std::vector<Vec3> positions(static_cast<std::size_t>(joints));
-  std::vector<Quat> rotations(static_cast<std::size_t>(joints));
   Vec3 sum = Vec3::Zero();
   int counted = 0;
   std::vector<std::array<Vec3, 2>> toes;  // the floor's evidence (fit_floor), in the file's world
-  toes.reserve(static_cast<std::size_t>(samples));
   const std::array<Role, 2> toe_roles = with_toes ? std::array{Role::kLeftToe, Role::kRightToe}
                                                   : std::array{Role::kLeftAnkle, Role::kRightAnkle};
-  for (int s = 0; s < samples; ++s) {
-    const int f = static_cast<int>(static_cast<long long>(s) * clip.frame_count() / samples);
-    forward_kinematics(clip.skeleton(), clip.translations_ls(f), clip.rotations_ls(f), positions,
-                       rotations);
+  for_each_sampled_pose(clip, max_frames, [&](std::span<const Vec3> positions) {
     const Vec3 up = positions[static_cast<std::size_t>(roles[Role::kHead])] -
                     mid_foot(positions, roles, with_toes);
     const double length = up.norm();
-    if (!(length > 0.0) || !std::isfinite(length)) continue;
+    if (!(length > 0.0) || !std::isfinite(length)) return;
     sum += up / length;
     ++counted;
     toes.push_back({positions[static_cast<std::size_t>(roles[toe_roles[0]])],
                     positions[static_cast<std::size_t>(roles[toe_roles[1]])]});
-  }
+  });
   if (counted == 0) {
     result.problem = "the head and the ankles are at the same place on every frame";
     return result;
@@ -216,17 +225,10 @@ Quat head_path_levelling(const Clip& clip, int head, int max_frames) {
       !(clip.duration() >= kLevelLeastSpanS)) {
     return Quat::Identity();
   }
-  const int samples = std::clamp(clip.frame_count(), 1, std::max(max_frames, 1));
-  std::vector<Vec3> positions(static_cast<std::size_t>(joints));
-  std::vector<Quat> rotations(static_cast<std::size_t>(joints));
   std::vector<Vec3> heads;
-  heads.reserve(static_cast<std::size_t>(samples));
-  for (int s = 0; s < samples; ++s) {
-    const int f = static_cast<int>(static_cast<long long>(s) * clip.frame_count() / samples);
-    forward_kinematics(clip.skeleton(), clip.translations_ls(f), clip.rotations_ls(f), positions,
-                       rotations);
+  for_each_sampled_pose(clip, max_frames, [&](std::span<const Vec3> positions) {
     heads.push_back(positions[static_cast<std::size_t>(head)]);
-  }
+  });
   const FloorFit path = fit_floor(heads, Vec3::UnitY(), clip.duration(), kHeadPathPriorSigmaDeg,
                                   PlaneOutliers::kBelow);
   // A head's height also changes with the dance (a bend held at one end of the room): a tilt
