@@ -234,6 +234,29 @@ SteadyDifferenceParams steady_difference_params(const PartnerParams& p) {
   return {p.ik_difference_time_constant_s, p.ik_difference_power_time_constant_s};
 }
 
+// The q-quantile over the clip's frames of the largest angular speed of any joint's local
+// rotation since the frame before (End Sites left out), rad/s at the clip's rate: how fast the
+// captured dancer's fastest joint turns, bar its rarest moments.
+double largest_joint_speed_quantile(const Clip& clip, double q) {
+  const int frames = clip.frame_count();
+  if (frames < 2) return 0.0;
+  const Skeleton& skeleton = clip.skeleton();
+  std::vector<double> largest(static_cast<std::size_t>(frames - 1), 0.0);
+  for (int f = 1; f < frames; ++f) {
+    const std::span<const Quat> before = clip.rotations_ls(f - 1);
+    const std::span<const Quat> now = clip.rotations_ls(f);
+    double& most = largest[static_cast<std::size_t>(f - 1)];
+    for (std::size_t j = 0; j < now.size(); ++j) {
+      if (skeleton.joints[j].end_site) continue;
+      most = std::max(most, before[j].angularDistance(now[j]));
+    }
+  }
+  const auto k = static_cast<std::size_t>(std::floor(q * static_cast<double>(largest.size() - 1)));
+  std::nth_element(largest.begin(), largest.begin() + static_cast<std::ptrdiff_t>(k),
+                   largest.end());
+  return largest[k] * clip.frame_rate();
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -298,6 +321,7 @@ Result<PartnerModel> PartnerModel::build(const Clip& template_clip,
           static_cast<float>(horizontal_distance(here, there) * response_clip.frame_rate());
     }
   }
+  model.captured_speed_p99_rad_s_ = largest_joint_speed_quantile(response_clip, 0.99);
   return model;
 }
 
@@ -598,6 +622,25 @@ double ik_correction_step_limit(const PartnerParams& p, double dt_s,
   return std::clamp(p.ik_correction_speed_budget_rad_s * dt_s - captured_move_rad, least, most);
 }
 
+Vec3 step_within_turn(const Vec3& shown, const Vec3& wanted, double most_rad, const Quat& base,
+                      const Quat& previous, double budget_rad, double least_rad) noexcept {
+  const Vec3 full = step_towards(shown, wanted, most_rad);
+  const auto turn = [&](const Vec3& correction) {
+    return previous.angularDistance((base * exp_map(correction)).normalized());
+  };
+  // Kept as it was, the joint turns as the base does; the step may take it up to the budget,
+  // or the base's own turn and the least more.
+  const double allowed = std::max(budget_rad, turn(shown) + least_rad);
+  if (!(turn(full) > allowed)) return full;
+  // The turn grows with the share of the step taken near the answer: bisected.
+  double lo = 0.0, hi = 1.0;
+  for (int i = 0; i < 12; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (turn(shown + mid * (full - shown)) > allowed ? hi : lo) = mid;
+  }
+  return shown + lo * (full - shown);
+}
+
 void PartnerContext::reset() noexcept {
   primed_ = false;
   inertializer_.reset();
@@ -621,6 +664,7 @@ void PartnerContext::reset() noexcept {
     for (OneEuroFilter3& filter : arm) filter.reset();
   }
   ik_captured_previous_valid_ = {false, false};
+  reach_shown_previous_valid_ = {false, false};
   ik_ramp_ = {0.0, 0.0};
   ik_pair_ = {-1, -1};
   ik_target_valid_ = {false, false};
@@ -834,8 +878,9 @@ bool PartnerSynthesisJob::run() const noexcept {
     // instead of in one frame: the correction lags the fading IK, and dropping what was left
     // swung the forearm of a partner of a user of other proportions at up to 2500 deg/s
     // (docs/evaluation.md, "The IK's correction let go"). At a blended jump the blend takes it.
+    // Like the correction held, it takes only what the captured joint's own turn leaves of
+    // the speed budget (ik_correction_step_limit).
     const auto release_correction = [&](std::size_t r) {
-      ctx.ik_captured_previous_valid_[r] = false;
       std::array<OneEuroFilter3, 2>& filters = ctx.ik_correction_filter_[r];
       std::array<Vec3, 2>& shown = ctx.ik_correction_[r];
       constexpr double kReleasedRad = 1e-4;
@@ -844,18 +889,25 @@ bool PartnerSynthesisJob::run() const noexcept {
           !holding) {
         for (OneEuroFilter3& filter : filters) filter.reset();
         shown = {Vec3::Zero(), Vec3::Zero()};
+        ctx.ik_captured_previous_valid_[r] = false;
         return;
       }
       const ArmRoles& arm = kArms[r];
       const std::array<std::size_t, 2> joints = {static_cast<std::size_t>(roles[arm.shoulder]),
                                                  static_cast<std::size_t>(roles[arm.elbow])};
-      const double most = p.ik_correction_max_speed_rad_s * dt;
       const OneEuroParams filter = correction_filter_of(r);
       for (std::size_t k = 0; k < 2; ++k) {
-        const Vec3 c =
-            step_correction(filters[k], shown[k], Vec3::Zero(), Vec3::Zero(), dt, filter, most);
+        const Quat& captured = out_r[joints[k]];
+        Quat& previous = ctx.ik_captured_previous_[r][k];
+        const double captured_move = ctx.ik_captured_previous_valid_[r]
+                                         ? log_map(previous.conjugate() * captured).norm()
+                                         : 0.0;
+        previous = captured;
+        const Vec3 c = step_correction(filters[k], shown[k], Vec3::Zero(), Vec3::Zero(), dt, filter,
+                                       ik_correction_step_limit(p, dt, captured_move));
         out_r[joints[k]] = (out_r[joints[k]] * exp_map(c)).normalized();
       }
+      ctx.ik_captured_previous_valid_[r] = true;
     };
     for (std::size_t r = 0; r < 2; ++r) {
       // The template hand in contact with this response hand; the closer one if both are.
@@ -1111,9 +1163,13 @@ bool PartnerSynthesisJob::run() const noexcept {
   //     moved the partner. A second IK on the blended pose, its weight rising from 0 at the jump
   //     over reach_s (so the arm does not snap) and falling with the distance the blend still
   //     holds the wrist from where the contact stage put it (so it fades out with the blend).
-  //     What it adds to each arm joint changes at most reach_max_speed_rad_s, also when it ends.
+  //     What it adds to each arm joint changes at most reach_max_speed_rad_s, also when it ends,
+  //     and turns the joint no faster than the captured partner's p99 speed (step_within_turn).
   if (p.contact && p.blend && p.reach_s > 0.0) {
     const double rise = dt / p.reach_s;
+    // The arm turns no faster than the captured partner's fastest joint on 99 % of its frames
+    // (the blend's own turn aside): a reach along the blend no longer adds its whole speed to it.
+    const double reach_budget = model->captured_speed_p99_rad_s();
     const bool blending = ctx.blend_carrying_;
     bool posed = false;
     for (std::size_t r = 0; r < 2; ++r) {
@@ -1121,17 +1177,23 @@ bool PartnerSynthesisJob::run() const noexcept {
       // A jump restarts the reach; the blend's transition (from the pose shown, reach included)
       // takes what it had added.
       if (jumped) shown.fill(Vec3::Zero());
+      const ArmRoles& arm = kArms[r];
+      const std::array<std::size_t, 2> joints = {static_cast<std::size_t>(roles[arm.shoulder]),
+                                                 static_cast<std::size_t>(roles[arm.elbow])};
+      const bool turned_before = ctx.reach_shown_previous_valid_[r];
+      ctx.reach_shown_previous_valid_[r] = true;
       ctx.reach_ramp_[r] = jumped ? 0.0 : std::min(1.0, ctx.reach_ramp_[r] + rise);
       const bool reaching = blending && diagnostics.ik_weight[r] > 0.0 && ctx.reach_ramp_[r] > 0.0;
-      if (!reaching && shown[0].isZero(0.0) && shown[1].isZero(0.0)) continue;
+      if (!reaching && shown[0].isZero(0.0) && shown[1].isZero(0.0)) {
+        for (std::size_t k = 0; k < 2; ++k) ctx.reach_shown_previous_[r][k] = out_r[joints[k]];
+        continue;
+      }
       if (!posed) {
         forward_kinematics(skeleton, out_t, out_r, ctx.positions_ws_, ctx.rotations_ws_);
         posed = true;
       }
-      const ArmRoles& arm = kArms[r];
       const TwoBoneChain chain =
           chain_of(roles, arm.shoulder, arm.elbow, arm.wrist, ctx.positions_ws_, ctx.rotations_ws_);
-      const std::array<std::size_t, 2> joints = {chain.start, chain.mid};
       std::array<Quat, 2> solved = {out_r[chain.start], out_r[chain.mid]};
       if (reaching) {
         const Vec3& target = ctx.ik_shown_target_[r];
@@ -1152,14 +1214,21 @@ bool PartnerSynthesisJob::run() const noexcept {
         }
       }
       for (std::size_t k = 0; k < 2; ++k) {
-        shown[k] = step_towards(shown[k], log_map(out_r[joints[k]].conjugate() * solved[k]),
-                                p.reach_max_speed_rad_s * dt);
+        const Vec3 wanted = log_map(out_r[joints[k]].conjugate() * solved[k]);
+        const double most = p.reach_max_speed_rad_s * dt;
+        shown[k] = turned_before
+                       ? step_within_turn(shown[k], wanted, most, out_r[joints[k]],
+                                          ctx.reach_shown_previous_[r][k], reach_budget * dt,
+                                          p.ik_correction_min_speed_rad_s * dt)
+                       : step_towards(shown[k], wanted, most);
         out_r[joints[k]] = (out_r[joints[k]] * exp_map(shown[k])).normalized();
         ctx.blend_rotations_[joints[k]] = out_r[joints[k]];  // the pose shown
+        ctx.reach_shown_previous_[r][k] = out_r[joints[k]];
       }
     }
   } else {
     ctx.reach_ramp_ = {1.0, 1.0};
+    ctx.reach_shown_previous_valid_ = {false, false};
     for (auto& arm : ctx.reach_correction_) arm.fill(Vec3::Zero());
   }
 

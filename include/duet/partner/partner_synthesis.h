@@ -91,6 +91,9 @@ class PartnerModel {
   // Whether the response's legs are chains thigh (hip role) -> knee -> ankle -> toe, which the
   // foot hold (foot_hold.h) needs; without them it stays off.
   bool has_legs() const noexcept { return has_legs_; }
+  // The 99th percentile over the captured partner's frames of its fastest joint's angular speed
+  // (local rotations, End Sites left out), rad/s at the clip's rate.
+  double captured_speed_p99_rad_s() const noexcept { return captured_speed_p99_rad_s_; }
 
  private:
   std::shared_ptr<const Skeleton> response_skeleton_;
@@ -101,6 +104,7 @@ class PartnerModel {
   double response_height_m_ = 0.0;
   std::array<double, 2> ground_heights_{0.0, 0.0};
   bool has_legs_ = false;
+  double captured_speed_p99_rad_s_ = 0.0;
   // Per frame and foot (frame * 2 + side): the captured toe's height above its ground height and
   // its horizontal speed, m and m/s.
   struct CapturedFoot {
@@ -330,6 +334,13 @@ std::string corrections_string(const PartnerParams& params);
 // A captured turn that is not a finite number counts as none.
 double ik_correction_step_limit(const PartnerParams& p, double dt_s,
                                 double captured_move_rad) noexcept;
+// A correction (rotation vector) put on a joint's base rotation as base * exp(correction), last
+// shown as `previous`: `shown` stepped towards `wanted` by at most most_rad, and no further than
+// keeps the joint's turn since `previous` within budget_rad, or within what it turns with the
+// correction kept plus least_rad where that is more. A correction against the base's own turn is
+// free; one along it takes what the turn leaves of the budget (the reach through a jump's blend).
+Vec3 step_within_turn(const Vec3& shown, const Vec3& wanted, double most_rad, const Quat& base,
+                      const Quat& previous, double budget_rad, double least_rad) noexcept;
 
 // ---------------------------------------------------------------------------------------------
 // Run time
@@ -456,6 +467,9 @@ class PartnerContext {
   double detour_peak_ = 0.5;  // the blend's progress at which the detour is fullest
   std::array<Vec3, 2> ik_reached_ws_{Vec3::Zero(), Vec3::Zero()};  // wrist after the contact IK
   std::array<double, 2> reach_ramp_{1.0, 1.0};  // per response hand, since the last jump
+  // Per response hand, the arm joints (shoulder, elbow) as shown last frame (the reach's budget).
+  std::array<std::array<Quat, 2>, 2> reach_shown_previous_{};
+  std::array<bool, 2> reach_shown_previous_valid_{};
   std::array<std::array<Vec3, 2>, 2> reach_correction_{
       {{Vec3::Zero(), Vec3::Zero()},
        {Vec3::Zero(), Vec3::Zero()}}};  // per hand, shoulder and elbow
