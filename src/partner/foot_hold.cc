@@ -48,6 +48,10 @@ std::string FootHoldParams::validate() const {
       return std::string(name) + " must be finite and >= 0 (got " + std::to_string(value) + ")";
     }
   }
+  if (!(speed_budget_rad_s > 0.0) || !(least_speed_rad_s > 0.0)) {
+    return "foot_hold.speed_budget_rad_s and foot_hold.least_speed_rad_s must be > 0 (got " +
+           std::to_string(speed_budget_rad_s) + " and " + std::to_string(least_speed_rad_s) + ")";
+  }
   return {};
 }
 

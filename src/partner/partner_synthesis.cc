@@ -665,6 +665,8 @@ void PartnerContext::reset() noexcept {
   }
   ik_captured_previous_valid_ = {false, false};
   reach_shown_previous_valid_ = {false, false};
+  hold_previous_valid_ = {false, false};
+  for (auto& leg : hold_correction_) leg.fill(Vec3::Zero());
   ik_ramp_ = {0.0, 0.0};
   ik_pair_ = {-1, -1};
   ik_target_valid_ = {false, false};
@@ -1253,6 +1255,13 @@ bool PartnerSynthesisJob::run() const noexcept {
     const bool blending = ctx.blend_carrying_;
     ctx.foot_hold_.update(ankles, ankle_rotations, hips, leg_lengths, planted, blending,
                           jumped && blending, p.foot_hold, dt);
+    std::array<std::array<Quat, 3>, 2> leg_base;
+    for (std::size_t side = 0; side < 2; ++side) {
+      const LegRoles& leg = kLegs[side];
+      leg_base[side] = {out_r[static_cast<std::size_t>(roles[leg.hip])],
+                        out_r[static_cast<std::size_t>(roles[leg.knee])],
+                        out_r[static_cast<std::size_t>(roles[leg.ankle])]};
+    }
     bool any = false;
     for (std::size_t side = 0; side < 2; ++side) {
       const FootHoldTarget& target = ctx.foot_hold_.target(static_cast<int>(side));
@@ -1278,9 +1287,33 @@ bool PartnerSynthesisJob::run() const noexcept {
                         .normalized();
       }
     }
+    // What the hold changed on each leg joint, shown within the speed budget (step_within_turn):
+    // a step no longer swings the leg faster than the capture does.
+    const double most = std::numeric_limits<double>::infinity();
+    for (std::size_t side = 0; side < 2; ++side) {
+      const LegRoles& leg = kLegs[side];
+      const std::array<std::size_t, 3> joints = {static_cast<std::size_t>(roles[leg.hip]),
+                                                 static_cast<std::size_t>(roles[leg.knee]),
+                                                 static_cast<std::size_t>(roles[leg.ankle])};
+      for (std::size_t k = 0; k < 3; ++k) {
+        const Quat& base = leg_base[side][k];
+        const Vec3 wanted = log_map(base.conjugate() * out_r[joints[k]]);
+        Vec3& shown = ctx.hold_correction_[side][k];
+        shown = ctx.hold_previous_valid_[side]
+                    ? step_within_turn(shown, wanted, most, base, ctx.hold_previous_[side][k],
+                                       p.foot_hold.speed_budget_rad_s * dt,
+                                       p.foot_hold.least_speed_rad_s * dt)
+                    : wanted;
+        out_r[joints[k]] = (base * exp_map(shown)).normalized();
+        ctx.hold_previous_[side][k] = out_r[joints[k]];
+      }
+      ctx.hold_previous_valid_[side] = true;
+    }
     diagnostics.foot_held = {ctx.foot_hold_.held(0), ctx.foot_hold_.held(1)};
   } else {
     ctx.foot_hold_.reset();
+    ctx.hold_previous_valid_ = {false, false};
+    for (auto& leg : ctx.hold_correction_) leg.fill(Vec3::Zero());
   }
 
   ctx.primed_ = true;

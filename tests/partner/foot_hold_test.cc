@@ -211,6 +211,17 @@ TEST(FootHoldParams, ValidateNamesTheField) {
   p = FootHoldParams{};
   p.step_height_m = std::numeric_limits<double>::infinity();
   EXPECT_NE(p.validate().find("foot_hold.step_height_m"), std::string::npos);
+  p = FootHoldParams{};
+  p.speed_budget_rad_s = std::numeric_limits<double>::infinity();  // no budget: valid
+  EXPECT_EQ(p.validate(), "");
+  for (const double bad : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    p.speed_budget_rad_s = bad;
+    EXPECT_NE(p.validate().find("foot_hold.speed_budget_rad_s"), std::string::npos) << bad;
+    p = FootHoldParams{};
+    p.least_speed_rad_s = bad;
+    EXPECT_NE(p.validate().find("least_speed_rad_s"), std::string::npos) << bad;
+    p = FootHoldParams{};
+  }
 }
 
 }  // namespace

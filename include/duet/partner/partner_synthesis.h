@@ -470,6 +470,11 @@ class PartnerContext {
   // Per response hand, the arm joints (shoulder, elbow) as shown last frame (the reach's budget).
   std::array<std::array<Quat, 2>, 2> reach_shown_previous_{};
   std::array<bool, 2> reach_shown_previous_valid_{};
+  // Per foot, what the foot hold adds to the leg joints (hip, knee, ankle) as shown, and the
+  // joints as shown last frame (its speed budget).
+  std::array<std::array<Vec3, 3>, 2> hold_correction_{};
+  std::array<std::array<Quat, 3>, 2> hold_previous_{};
+  std::array<bool, 2> hold_previous_valid_{};
   std::array<std::array<Vec3, 2>, 2> reach_correction_{
       {{Vec3::Zero(), Vec3::Zero()},
        {Vec3::Zero(), Vec3::Zero()}}};  // per hand, shoulder and elbow
