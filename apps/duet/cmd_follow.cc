@@ -273,11 +273,10 @@ int run_follow(const FollowArgs& args) {
   const LostSummary summary = summarise_lost(results);
   fmt::print(
       "followed {} frames ({:.1f} s) against {} take(s), {} states: {} jumps, {} lost "
-      "frames{}; corrections: {}{}\n",
+      "frames{}; corrections: {}\n",
       user.frame_count(), user.duration(), library->takes().size(), library->model().num_states(),
       summary.jumps, summary.lost, describe_set_aside(summary),
-      corrections_string(loop.value().params()),
-      loop.value().params().foot_hold.enabled ? ", foot hold" : "");
+      corrections_string(loop.value().params()));
   if (truth) print_accuracy_summary(*truth, results, library->frame_rate());
   if (points.value() == InputPoints::kHeadHands && args.head_height_m == 0.0 && !calibration) {
     if (std::optional<std::string> note = head_height_note(

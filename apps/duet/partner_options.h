@@ -1,5 +1,5 @@
 // Command-line switches for the partner corrections (method.md 5): --no-align, --no-contact,
-// --no-smooth, --no-footlock, --no-blend, --foot-hold, --ik-target.
+// --no-smooth, --no-footlock, --no-blend, --no-foot-hold, --ik-target.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -15,7 +15,7 @@ struct PartnerArgs {
   bool no_smooth = false;
   bool no_footlock = false;
   bool no_blend = false;
-  bool foot_hold = false;
+  bool foot_hold = true;
   std::string ik_target = "offset";
 };
 

@@ -64,10 +64,11 @@ std::vector<PartnerConfig> standard_partner_configs(const PartnerParams& base) {
   // Each configuration names the corrections that are on, in parse_corrections()'s syntax.
   static constexpr std::pair<const char*, const char*> kConfigs[] = {
       {"all", "all"},
-      {"no-contact", "align,smooth,footlock,blend"},
+      {"no-foothold", "align,contact,smooth,footlock,blend"},
+      {"no-contact", "align,smooth,footlock,blend,foothold"},
       {"no-footlock", "align,contact,smooth,blend"},
       {"no-blend", "align,contact,smooth,footlock"},
-      {"no-smooth", "align,contact,footlock,blend"},
+      {"no-smooth", "align,contact,footlock,blend,foothold"},
       {"align-only", "align"},
       {"none", "none"}};
   std::vector<PartnerConfig> configs;
@@ -78,13 +79,6 @@ std::vector<PartnerConfig> standard_partner_configs(const PartnerParams& base) {
     (void)parsed;
     configs.push_back({name, params});
   }
-  // The foot hold through a jump's blend (foot_hold.h), off by default: all corrections and it.
-  PartnerParams foot_hold = base;
-  const Status all = parse_corrections("all", foot_hold);
-  assert(all.ok());
-  (void)all;
-  foot_hold.foot_hold.enabled = true;
-  configs.insert(configs.begin() + 1, {"foothold", foot_hold});
   return configs;
 }
 

@@ -11,15 +11,6 @@ namespace duet {
 
 namespace {
 
-bool* correction_switch(PartnerParams& params, std::string_view name) noexcept {
-  if (name == "align") return &params.align;
-  if (name == "contact") return &params.contact;
-  if (name == "smooth") return &params.smooth;
-  if (name == "footlock") return &params.foot_lock;
-  if (name == "blend") return &params.blend;
-  return nullptr;
-}
-
 // Same joints (names and parents) in the same order.
 bool same_joints(const Skeleton& a, const Skeleton& b) {
   if (a.joint_count() != b.joint_count()) return false;
@@ -32,19 +23,6 @@ bool same_joints(const Skeleton& a, const Skeleton& b) {
 }
 
 }  // namespace
-
-bool set_correction(PartnerParams& params, std::string_view name, bool enabled) noexcept {
-  bool* value = correction_switch(params, name);
-  if (value == nullptr) return false;
-  *value = enabled;
-  return true;
-}
-
-bool correction_enabled(const PartnerParams& params, std::string_view name) noexcept {
-  PartnerParams copy = params;
-  const bool* value = correction_switch(copy, name);
-  return value != nullptr && *value;
-}
 
 Result<LiveLoop> LiveLoop::create(std::shared_ptr<const DuetLibrary> library,
                                   const SourceSkeleton& user, std::unique_ptr<Tracker> tracker,

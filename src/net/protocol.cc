@@ -227,16 +227,14 @@ void format_frame(const LiveOutput& output, const PartnerParams& params, std::in
   append_pose(text, output.user_positions_ws, output.user_rotations_ws);
   text += ",\"partner\":";
   append_pose(text, output.partner_positions_ws, output.partner_rotations_ws);
-  text += ",\"corrections\":{\"align\":";
-  append_bool(text, params.align);
-  text += ",\"contact\":";
-  append_bool(text, params.contact);
-  text += ",\"smooth\":";
-  append_bool(text, params.smooth);
-  text += ",\"footlock\":";
-  append_bool(text, params.foot_lock);
-  text += ",\"blend\":";
-  append_bool(text, params.blend);
+  text += ",\"corrections\":{";
+  for (const std::string_view name : kCorrectionNames) {
+    if (name != kCorrectionNames[0]) text += ',';
+    text += '"';
+    text += name;
+    text += "\":";
+    append_bool(text, correction_enabled(params, name));
+  }
   text += "},\"contact\":{\"left\":";
   append_bool(text, output.contact_left);
   text += ",\"right\":";
@@ -348,14 +346,13 @@ std::optional<std::string> parse_client_message(std::string_view text, ClientMes
     const auto correction = doc.find("correction");
     const auto enabled = doc.find("enabled");
     if (correction == doc.end() || !correction->is_string()) {
-      return "set: needs \"correction\" (align, contact, smooth, footlock or blend)";
+      return "set: needs \"correction\" (" + correction_names_list() + ")";
     }
     if (enabled == doc.end() || !enabled->is_boolean()) return "set: needs \"enabled\": true|false";
     const std::string& name = correction->get_ref<const std::string&>();
     PartnerParams probe;
     if (!set_correction(probe, name, true)) {
-      return "unknown correction '" + name.substr(0, 64) +
-             "' (align, contact, smooth, footlock, blend)";
+      return "unknown correction '" + name.substr(0, 64) + "' (" + correction_names_list() + ")";
     }
     message.type = ClientMessage::Type::kSet;
     message.correction = name;

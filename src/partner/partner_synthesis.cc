@@ -418,30 +418,55 @@ std::string PartnerParams::validate() const {
   return {};
 }
 
+namespace {
+
+// The switch behind a correction's name; nullptr for an unknown name.
+template <typename Params>
+auto* correction_switch(Params& params, std::string_view name) noexcept {
+  if (name == "align") return &params.align;
+  if (name == "contact") return &params.contact;
+  if (name == "smooth") return &params.smooth;
+  if (name == "footlock") return &params.foot_lock;
+  if (name == "blend") return &params.blend;
+  if (name == "foothold") return &params.foot_hold.enabled;
+  return static_cast<decltype(&params.align)>(nullptr);
+}
+
+}  // namespace
+
+bool set_correction(PartnerParams& params, std::string_view name, bool enabled) noexcept {
+  bool* value = correction_switch(params, name);
+  if (value == nullptr) return false;
+  *value = enabled;
+  return true;
+}
+
+bool correction_enabled(const PartnerParams& params, std::string_view name) noexcept {
+  const bool* value = correction_switch(params, name);
+  return value != nullptr && *value;
+}
+
+std::string correction_names_list() {
+  std::string s;
+  for (const std::string_view name : kCorrectionNames) {
+    if (!s.empty()) s += ", ";
+    s += name;
+  }
+  return s;
+}
+
 Status parse_corrections(std::string_view list, PartnerParams& params) {
   PartnerParams out = params;
-  out.align = out.contact = out.smooth = out.foot_lock = out.blend = false;
+  for (const std::string_view name : kCorrectionNames) set_correction(out, name, false);
   while (!list.empty()) {
     const std::size_t comma = list.find(',');
     const std::string_view name = list.substr(0, comma);
     list = comma == std::string_view::npos ? std::string_view() : list.substr(comma + 1);
-    if (name == "align") {
-      out.align = true;
-    } else if (name == "contact") {
-      out.contact = true;
-    } else if (name == "smooth") {
-      out.smooth = true;
-    } else if (name == "footlock") {
-      out.foot_lock = true;
-    } else if (name == "blend") {
-      out.blend = true;
-    } else if (name == "all") {
-      out.align = out.contact = out.smooth = out.foot_lock = out.blend = true;
-    } else if (name == "none") {
-      // nothing on
-    } else {
+    if (name == "all") {
+      for (const std::string_view each : kCorrectionNames) set_correction(out, each, true);
+    } else if (name != "none" && !set_correction(out, name, true)) {
       return Error{"unknown correction '" + std::string(name) +
-                   "' (known: align, contact, smooth, footlock, blend, all, none)"};
+                   "' (known: " + correction_names_list() + ", all, none)"};
     }
   }
   params = out;
@@ -450,13 +475,8 @@ Status parse_corrections(std::string_view list, PartnerParams& params) {
 
 std::string corrections_string(const PartnerParams& params) {
   std::string s;
-  const std::pair<bool, const char*> switches[] = {{params.align, "align"},
-                                                   {params.contact, "contact"},
-                                                   {params.smooth, "smooth"},
-                                                   {params.foot_lock, "footlock"},
-                                                   {params.blend, "blend"}};
-  for (const auto& [on, name] : switches) {
-    if (!on) continue;
+  for (const std::string_view name : kCorrectionNames) {
+    if (!correction_enabled(params, name)) continue;
     if (!s.empty()) s += ',';
     s += name;
   }

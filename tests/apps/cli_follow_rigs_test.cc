@@ -54,22 +54,24 @@ TEST(CliFollowRigs, AsfInputFollowsAndThePartnerIsWrittenOnAnotherRig) {
   std::filesystem::remove(out);
 }
 
-TEST(CliFollowRigs, FootHoldIsSwitchedOnAndSaid) {
-  // --foot-hold (docs/partner.md, "Feet through a jump"): the partner is written and the summary
-  // names it; without the flag it is off.
+TEST(CliFollowRigs, FootHoldIsOnByDefaultAndSwitchedOff) {
+  // The foot hold (docs/partner.md, "Feet through a jump") is on by default and the summary names
+  // it; --no-foot-hold switches it off.
   const std::filesystem::path out = temp_file("foothold.bvh");
   const std::string input = data_path("cmu-salsa/bvh/60/60_03_scaled.bvh");
-  const testing::CommandResult on = run_duet("follow" + two_pairs() + " --input " + input +
-                                             " --input-fps 60 --foot-hold -o " + out.string());
+  const testing::CommandResult on =
+      run_duet("follow" + two_pairs() + " --input " + input + " --input-fps 60 -o " + out.string());
   ASSERT_EQ(on.exit_code, 0) << on.output;
-  EXPECT_NE(on.output.find("corrections: align,contact,smooth,footlock,blend, foot hold"),
+  EXPECT_NE(on.output.find("corrections: align,contact,smooth,footlock,blend,foothold\n"),
             std::string::npos)
       << on.output;
   EXPECT_TRUE(std::filesystem::exists(out));
-  const testing::CommandResult off =
-      run_duet("follow" + two_pairs() + " --input " + input + " --input-fps 60 -o " + out.string());
+  const testing::CommandResult off = run_duet("follow" + two_pairs() + " --input " + input +
+                                              " --input-fps 60 --no-foot-hold -o " + out.string());
   ASSERT_EQ(off.exit_code, 0) << off.output;
-  EXPECT_EQ(off.output.find("foot hold"), std::string::npos) << off.output;
+  EXPECT_NE(off.output.find("corrections: align,contact,smooth,footlock,blend\n"),
+            std::string::npos)
+      << off.output;
   std::filesystem::remove(out);
 }
 

@@ -85,7 +85,7 @@ TEST(Serve, ServesFramesSurvivesBadClientsAndRecordsEverything) {
   EXPECT_EQ((*hello)["takes"][0]["name"], "60_03_scaled");
   EXPECT_EQ((*hello)["takes"][0]["frames"], 1830);
   EXPECT_TRUE((*hello)["takes"][0]["contacts"].is_array());
-  for (const char* c : {"align", "contact", "smooth", "footlock", "blend"}) {
+  for (const char* c : {"align", "contact", "smooth", "footlock", "blend", "foothold"}) {
     EXPECT_EQ((*hello)["corrections"][c], true) << c;
   }
 

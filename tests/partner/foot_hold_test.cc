@@ -196,7 +196,8 @@ TEST(FootHold, NonFiniteInputLeavesTheFootAlone) {
 
 TEST(FootHold, DisabledHoldsNothing) {
   FootHold hold;
-  const FootHoldParams params;  // off by default
+  FootHoldParams params;
+  params.enabled = false;
   const Pose pose(0.0);
   hold.update(pose.ankles, pose.rotations, pose.hips, pose.legs, {true, true}, true, true, params,
               kDt);

@@ -30,7 +30,6 @@ TEST(PartnerSynthesis, PerFrameCallAllocatesNothing) {
   }
   const PartnerModel model = PartnerModel::build(leader, roles, follower, roles).value();
   PartnerParams params;  // everything on, the foot hold too
-  params.foot_hold.enabled = true;
   PartnerContext context(skeleton->joint_count());
   std::vector<Vec3> t(skeleton->joints.size());
   std::vector<Quat> r(skeleton->joints.size());

@@ -1533,17 +1533,23 @@ TEST(PartnerParams, ValidateAndParse) {
   }
 
   p = PartnerParams();
-  EXPECT_EQ(corrections_string(p), "align,contact,smooth,footlock,blend");
+  EXPECT_EQ(corrections_string(p), "align,contact,smooth,footlock,blend,foothold");
   ASSERT_TRUE(parse_corrections("align,blend", p).ok());
-  EXPECT_TRUE(p.align && p.blend && !p.contact && !p.smooth && !p.foot_lock);
+  EXPECT_TRUE(p.align && p.blend && !p.contact && !p.smooth && !p.foot_lock &&
+              !p.foot_hold.enabled);
   EXPECT_EQ(corrections_string(p), "align,blend");
   ASSERT_TRUE(parse_corrections("none", p).ok());
   EXPECT_EQ(corrections_string(p), "none");
   ASSERT_TRUE(parse_corrections("all", p).ok());
-  EXPECT_EQ(corrections_string(p), "align,contact,smooth,footlock,blend");
+  EXPECT_EQ(corrections_string(p), "align,contact,smooth,footlock,blend,foothold");
+  EXPECT_TRUE(p.foot_hold.enabled);
+  ASSERT_TRUE(parse_corrections("footlock,blend,foothold", p).ok());
+  EXPECT_TRUE(p.foot_lock && p.blend && p.foot_hold.enabled && !p.align && !p.contact);
+  ASSERT_TRUE(parse_corrections("all", p).ok());
   const Status bad = parse_corrections("align,ik", p);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().message.find("'ik'"), std::string::npos);
+  EXPECT_NE(bad.error().message.find("foothold"), std::string::npos);
   EXPECT_TRUE(p.contact);  // untouched on error
 
   IkTarget target = IkTarget::kCapturedOffset;

@@ -14,7 +14,7 @@ import { HeightCalibration } from './height_calibration.js';
 import { adviceText } from './advice.js';
 import { AdviceHud } from './advice_hud.js';
 
-const kCorrections = ['align', 'contact', 'smooth', 'footlock', 'blend'];
+const kCorrections = ['align', 'contact', 'smooth', 'footlock', 'blend', 'foothold'];
 const kPendingToggle_s = 1.5; // how long a clicked switch waits for the server to confirm it
 const kOrbitFollowHalfLife_s = 0.4; // the orbit target trails the couple's midpoint
 const kFirstPersonFov = 70;

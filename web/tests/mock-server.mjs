@@ -16,7 +16,7 @@ import { WebSocketServer } from 'ws';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const kDefaultDist = path.resolve(here, '..', 'dist');
-const kCorrections = ['align', 'contact', 'smooth', 'footlock', 'blend'];
+const kCorrections = ['align', 'contact', 'smooth', 'footlock', 'blend', 'foothold'];
 const kMaxMessageBytes = 1 << 20;
 const kSlowClientBytes = 256 * 1024; // drop frames for a client with this much unsent
 

@@ -26,13 +26,6 @@
 
 namespace duet {
 
-// The five switchable corrections by their protocol names (docs/protocol.md `set`).
-inline constexpr std::string_view kCorrectionNames[] = {"align", "contact", "smooth", "footlock",
-                                                        "blend"};
-// Sets one switch of `params` by name; false (and params untouched) for an unknown name.
-bool set_correction(PartnerParams& params, std::string_view name, bool enabled) noexcept;
-bool correction_enabled(const PartnerParams& params, std::string_view name) noexcept;
-
 // What one frame of the loop produced. Buffers are sized once and overwritten by every step().
 struct LiveOutput {
   long long seq = -1;   // frames processed since the loop was created (0 for the first)

@@ -9,7 +9,7 @@
 //   -> blend     inertialization of the finished pose when the follower jumped (5.3); last, so
 //                a jump's change made by any stage is blended (the IK would snap the arms)
 //   -> reach     through that blend, a held hand reaches for the user's (contact and blend)
-//   -> foothold  through that blend, planted feet held by leg IK (off by default)
+//   -> foothold  through that blend, planted feet held by leg IK (footlock and blend)
 //   -> partner pose, root in the user's world frame
 //
 // Offline: PartnerModel (per duet take; may allocate and fail with a message).
@@ -312,17 +312,28 @@ struct PartnerParams {
   // improvised and noisy cases on five rigs rose 350 -> 389 of 938 (docs/evaluation.md, "Feet
   // free while the blend carries them", session 29). true: the earlier behaviour.
   bool foot_lock_through_blend = false;
-  // footlock with blend: planted feet held by leg IK through a jump's blend, catching up by
-  // steps (foot_hold.h). enabled = false: the blend slides them (before issue 11's last target).
+  // foothold (with footlock and blend): planted feet held by leg IK through a jump's blend,
+  // catching up by steps (foot_hold.h). enabled = false: the blend slides them.
   FootHoldParams foot_hold;
 
   // Empty when valid; otherwise which parameter is wrong (negative or non-finite times, ...).
   std::string validate() const;
 };
 
-// Sets the five switches from a comma-separated list of the corrections to turn on:
-// "align,contact,smooth,footlock,blend", "all" or "none". Unknown names are an error that lists
-// the known ones; params is untouched on error.
+// The six switchable corrections by name, in the order corrections_string() lists them (the
+// names of `--corrections`, `duet eval`'s rows and the protocol's `set`, docs/protocol.md).
+inline constexpr std::string_view kCorrectionNames[] = {"align",    "contact", "smooth",
+                                                        "footlock", "blend",   "foothold"};
+// Sets one switch of `params` by name; false (and params untouched) for an unknown name.
+bool set_correction(PartnerParams& params, std::string_view name, bool enabled) noexcept;
+// Whether the switch `name` is on; false for an unknown name.
+bool correction_enabled(const PartnerParams& params, std::string_view name) noexcept;
+// The known names joined by ", " (for messages that list them).
+std::string correction_names_list();
+
+// Sets the six switches from a comma-separated list of the corrections to turn on:
+// "align,contact,smooth,footlock,blend,foothold", "all" or "none". Unknown names are an error that
+// lists the known ones; params is untouched on error.
 Status parse_corrections(std::string_view list, PartnerParams& params);
 // The switches that are on, as a list parse_corrections() accepts ("none" when all are off).
 std::string corrections_string(const PartnerParams& params);
