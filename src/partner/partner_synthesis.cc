@@ -562,6 +562,15 @@ void PartnerContext::resize(int joint_count) {
 // The jitter (radians) of the yaw of the facing the filter smooths (the user's raw facing, or with
 // smooth_relative_to_template its turn from the template's), unwrapped so a turn through +-pi is
 // no step.
+double PartnerContext::captured_arm_turn(std::size_t hand, std::size_t joint,
+                                         const Quat& captured) noexcept {
+  Quat& previous = ik_captured_previous_[hand][joint];
+  const double turn =
+      ik_captured_previous_valid_[hand] ? log_map(previous.conjugate() * captured).norm() : 0.0;
+  previous = captured;
+  return turn;
+}
+
 double PartnerContext::facing_jitter(const Vec3& facing, double dt) noexcept {
   const double yaw = std::atan2(facing.x(), facing.z());
   if (!std::isfinite(yaw)) return user_facing_jitter_.rms();
@@ -919,12 +928,7 @@ bool PartnerSynthesisJob::run() const noexcept {
                                                  static_cast<std::size_t>(roles[arm.elbow])};
       const OneEuroParams filter = correction_filter_of(r);
       for (std::size_t k = 0; k < 2; ++k) {
-        const Quat& captured = out_r[joints[k]];
-        Quat& previous = ctx.ik_captured_previous_[r][k];
-        const double captured_move = ctx.ik_captured_previous_valid_[r]
-                                         ? log_map(previous.conjugate() * captured).norm()
-                                         : 0.0;
-        previous = captured;
+        const double captured_move = ctx.captured_arm_turn(r, k, out_r[joints[k]]);
         const Vec3 c = step_correction(filters[k], shown[k], Vec3::Zero(), Vec3::Zero(), dt, filter,
                                        ik_correction_step_limit(p, dt, captured_move));
         out_r[joints[k]] = (out_r[joints[k]] * exp_map(c)).normalized();
@@ -1072,12 +1076,8 @@ bool PartnerSynthesisJob::run() const noexcept {
         const OneEuroParams correction_filter = correction_filter_of(r);
         const auto correct = [&](std::size_t k, const Quat& captured, const Quat& base,
                                  const Quat& solved) {
-          const double captured_move =
-              ctx.ik_captured_previous_valid_[r]
-                  ? log_map(ctx.ik_captured_previous_[r][k].conjugate() * captured).norm()
-                  : 0.0;
-          const double most = ik_correction_step_limit(p, dt, captured_move);
-          ctx.ik_captured_previous_[r][k] = captured;
+          const double most =
+              ik_correction_step_limit(p, dt, ctx.captured_arm_turn(r, k, captured));
           return step_correction(filters[k], shown[k], log_map(captured.conjugate() * solved),
                                  log_map(captured.conjugate() * base), dt, correction_filter, most);
         };
@@ -1275,12 +1275,15 @@ bool PartnerSynthesisJob::run() const noexcept {
     const bool blending = ctx.blend_carrying_;
     ctx.foot_hold_.update(ankles, ankle_rotations, hips, leg_lengths, planted, blending,
                           jumped && blending, p.foot_hold, dt);
+    // Per leg, its joints (hip, knee, ankle) and their rotations before the hold.
+    std::array<std::array<std::size_t, 3>, 2> leg_joints;
     std::array<std::array<Quat, 3>, 2> leg_base;
     for (std::size_t side = 0; side < 2; ++side) {
       const LegRoles& leg = kLegs[side];
-      leg_base[side] = {out_r[static_cast<std::size_t>(roles[leg.hip])],
-                        out_r[static_cast<std::size_t>(roles[leg.knee])],
-                        out_r[static_cast<std::size_t>(roles[leg.ankle])]};
+      leg_joints[side] = {static_cast<std::size_t>(roles[leg.hip]),
+                          static_cast<std::size_t>(roles[leg.knee]),
+                          static_cast<std::size_t>(roles[leg.ankle])};
+      for (std::size_t k = 0; k < 3; ++k) leg_base[side][k] = out_r[leg_joints[side][k]];
     }
     bool any = false;
     for (std::size_t side = 0; side < 2; ++side) {
@@ -1311,10 +1314,7 @@ bool PartnerSynthesisJob::run() const noexcept {
     // a step no longer swings the leg faster than the capture does.
     const double most = std::numeric_limits<double>::infinity();
     for (std::size_t side = 0; side < 2; ++side) {
-      const LegRoles& leg = kLegs[side];
-      const std::array<std::size_t, 3> joints = {static_cast<std::size_t>(roles[leg.hip]),
-                                                 static_cast<std::size_t>(roles[leg.knee]),
-                                                 static_cast<std::size_t>(roles[leg.ankle])};
+      const std::array<std::size_t, 3>& joints = leg_joints[side];
       for (std::size_t k = 0; k < 3; ++k) {
         const Quat& base = leg_base[side][k];
         const Vec3 wanted = log_map(base.conjugate() * out_r[joints[k]]);

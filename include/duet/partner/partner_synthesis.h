@@ -437,6 +437,9 @@ class PartnerContext {
   // The captured arm joints' rotations the last frame the IK corrected them (the budget).
   std::array<std::array<Quat, 2>, 2> ik_captured_previous_{};
   std::array<bool, 2> ik_captured_previous_valid_{};
+  // How far the captured arm joint `joint` (0 shoulder, 1 elbow) of `hand` turned since it was
+  // last corrected (0 the first frame), remembering `captured` for the next frame.
+  double captured_arm_turn(std::size_t hand, std::size_t joint, const Quat& captured) noexcept;
   // The IK target under a noisy sensor: the captured wrist plus the average, in the user's body
   // frame, of what the sensed target adds to it, trusted by its real share (steady_difference.h).
   Vec3 steady_ik_target(std::size_t hand, const Vec3& target, const Vec3& captured_wrist,
