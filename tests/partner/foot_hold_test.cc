@@ -122,6 +122,38 @@ TEST(FootHold, AFootTheNewFrameHasInTheAirStepsFromWhereItStood) {
   EXPECT_LT(horizontal(hold.target(0).position_ws, pose.ankles[0]), 1e-12);
 }
 
+TEST(FootHold, AFloorLevelStepWhoseCapturedFootPlantsAgainLiftsInstead) {
+  // The left foot is in the air in the new frame: it steps at once, lands while the capture still
+  // swings it and follows the pose at floor level; at frame 20 the capture plants it again, far
+  // from where the pose has gone. Crossing on along the floor would slide it at the pose's speed
+  // (1.8 m/s); it steps instead.
+  FootHold hold;
+  const FootHoldParams params = on();
+  Vec3 previous = Vec3::Zero();
+  double highest_after = 0.0;
+  for (int f = 0; f < 40; ++f) {
+    const Pose pose(f * 0.03);
+    const bool planted_again = f >= 20;
+    hold.update(pose.ankles, pose.rotations, pose.hips, pose.legs, {planted_again, true}, true,
+                f == 0, params, kDt);
+    const FootHoldTarget& t = hold.target(0);
+    const Vec3 at = t.active ? t.position_ws : pose.ankles[0];
+    if (f == 19) {
+      ASSERT_TRUE(hold.stepping(0));  // the step at floor level is under way
+      EXPECT_LT(at.y() - 0.08, 1e-9);
+    }
+    if (planted_again) {
+      const double lifted = at.y() - 0.08;
+      highest_after = std::max(highest_after, lifted);
+      if (lifted < 0.01) {
+        EXPECT_LT(horizontal(at, previous) / kDt, 0.3) << "frame " << f;
+      }
+    }
+    previous = at;
+  }
+  EXPECT_GT(highest_after, 0.5 * params.step_height_m);
+}
+
 TEST(FootHold, AHeldFootKeepsItsHeadingWhileThePoseTurns) {
   FootHold hold;
   const FootHoldParams params = on();

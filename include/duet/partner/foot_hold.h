@@ -21,9 +21,10 @@
 // - when it is further from its hip than `reach_fraction` of the leg and than the pose has it (a
 //   straight leg drags it).
 // A step that lands while the captured foot is in the air goes on, without lift, to where the
-// pose has it, and the foot is free. Holds start only while the blend is under way; once it is
-// over, a held foot is let go when the pose has caught up with it (within 5 mm) or steps when the
-// captured foot lifts.
+// pose has it, and the foot is free; should the captured foot plant again first, it is held
+// where it is and the rest is a step of its own (crossing on along the floor slid it). Holds start
+// only while the blend is under way; once it is over, a held foot is let go when the pose has
+// caught up with it (within 5 mm) or steps when the captured foot lifts.
 //
 // This class decides where each ankle goes; PartnerSynthesisJob runs the leg IK. Allocation-
 // free and noexcept.
