@@ -72,6 +72,14 @@ TEST(CliFollowRigs, FootHoldIsOnByDefaultAndSwitchedOff) {
   EXPECT_NE(off.output.find("corrections: align,contact,smooth,footlock,blend\n"),
             std::string::npos)
       << off.output;
+  // --foot-hold, its switch before it was on by default, is still accepted and changes nothing.
+  const testing::CommandResult explicit_on =
+      run_duet("follow" + two_pairs() + " --input " + input + " --input-fps 60 --foot-hold -o " +
+               out.string());
+  ASSERT_EQ(explicit_on.exit_code, 0) << explicit_on.output;
+  EXPECT_NE(explicit_on.output.find("corrections: align,contact,smooth,footlock,blend,foothold\n"),
+            std::string::npos)
+      << explicit_on.output;
   std::filesystem::remove(out);
 }
 
