@@ -559,9 +559,6 @@ void PartnerContext::resize(int joint_count) {
   reset();
 }
 
-// The jitter (radians) of the yaw of the facing the filter smooths (the user's raw facing, or with
-// smooth_relative_to_template its turn from the template's), unwrapped so a turn through +-pi is
-// no step.
 double PartnerContext::captured_arm_turn(std::size_t hand, std::size_t joint,
                                          const Quat& captured) noexcept {
   Quat& previous = ik_captured_previous_[hand][joint];
@@ -571,6 +568,9 @@ double PartnerContext::captured_arm_turn(std::size_t hand, std::size_t joint,
   return turn;
 }
 
+// The jitter (radians) of the yaw of the facing the filter smooths (the user's raw facing, or with
+// smooth_relative_to_template its turn from the template's), unwrapped so a turn through +-pi is
+// no step.
 double PartnerContext::facing_jitter(const Vec3& facing, double dt) noexcept {
   const double yaw = std::atan2(facing.x(), facing.z());
   if (!std::isfinite(yaw)) return user_facing_jitter_.rms();
@@ -1259,13 +1259,19 @@ bool PartnerSynthesisJob::run() const noexcept {
   //    (which carries the root and every leg joint to the new frame's pose, sliding the feet).
   if (p.foot_lock && p.blend && p.foot_hold.enabled && model->has_legs()) {
     forward_kinematics(skeleton, out_t, out_r, ctx.positions_ws_, ctx.rotations_ws_);
+    // Per leg, its joints (hip, knee, ankle).
+    std::array<std::array<std::size_t, 3>, 2> leg_joints;
+    for (std::size_t side = 0; side < 2; ++side) {
+      const LegRoles& leg = kLegs[side];
+      leg_joints[side] = {static_cast<std::size_t>(roles[leg.hip]),
+                          static_cast<std::size_t>(roles[leg.knee]),
+                          static_cast<std::size_t>(roles[leg.ankle])};
+    }
     std::array<Vec3, 2> ankles, hips;
     std::array<Quat, 2> ankle_rotations;
     std::array<double, 2> leg_lengths;
     for (std::size_t side = 0; side < 2; ++side) {
-      const auto ankle = static_cast<std::size_t>(roles[kLegs[side].ankle]);
-      const auto knee = static_cast<std::size_t>(roles[kLegs[side].knee]);
-      const auto hip = static_cast<std::size_t>(roles[kLegs[side].hip]);
+      const auto [hip, knee, ankle] = leg_joints[side];
       ankles[side] = ctx.positions_ws_[ankle];
       ankle_rotations[side] = ctx.rotations_ws_[ankle];
       hips[side] = ctx.positions_ws_[hip];
@@ -1275,14 +1281,9 @@ bool PartnerSynthesisJob::run() const noexcept {
     const bool blending = ctx.blend_carrying_;
     ctx.foot_hold_.update(ankles, ankle_rotations, hips, leg_lengths, planted, blending,
                           jumped && blending, p.foot_hold, dt);
-    // Per leg, its joints (hip, knee, ankle) and their rotations before the hold.
-    std::array<std::array<std::size_t, 3>, 2> leg_joints;
+    // Per leg, its joints' rotations before the hold.
     std::array<std::array<Quat, 3>, 2> leg_base;
     for (std::size_t side = 0; side < 2; ++side) {
-      const LegRoles& leg = kLegs[side];
-      leg_joints[side] = {static_cast<std::size_t>(roles[leg.hip]),
-                          static_cast<std::size_t>(roles[leg.knee]),
-                          static_cast<std::size_t>(roles[leg.ankle])};
       for (std::size_t k = 0; k < 3; ++k) leg_base[side][k] = out_r[leg_joints[side][k]];
     }
     bool any = false;
