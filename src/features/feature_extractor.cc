@@ -104,6 +104,33 @@ Vec3 FeatureExtractor::body_point(std::span<const Vec3> positions_ws, Role role)
   return at(role);
 }
 
+Vec3 FeatureExtractor::standard_hand(std::span<const Vec3> positions_ws,
+                                     std::size_t side) const noexcept {
+  using A = StandardArm;
+  struct Link {
+    Role from, to;
+    double length;
+  };
+  // Each hand's chain from the pelvis centre (BodySegment's canonical kHips and kChest).
+  static constexpr std::array<std::array<Link, 4>, 2> kArms = {{
+      {{{Role::kHips, Role::kChest, A::kTrunk},
+        {Role::kChest, Role::kLeftShoulder, A::kHalfShoulders},
+        {Role::kLeftShoulder, Role::kLeftElbow, A::kUpperArm},
+        {Role::kLeftElbow, Role::kLeftWrist, A::kForearm}}},
+      {{{Role::kHips, Role::kChest, A::kTrunk},
+        {Role::kChest, Role::kRightShoulder, A::kHalfShoulders},
+        {Role::kRightShoulder, Role::kRightElbow, A::kUpperArm},
+        {Role::kRightElbow, Role::kRightWrist, A::kForearm}}},
+  }};
+  Vec3 hand = Vec3::Zero();
+  for (const Link& link : kArms[side]) {
+    const Vec3 delta = body_point(positions_ws, link.to) - body_point(positions_ws, link.from);
+    const double length = delta.norm();
+    if (length > 1e-9) hand += (link.length / length) * delta;
+  }
+  return hand;
+}
+
 void FeatureExtractor::extract(Context& context, std::span<const Vec3> translations_ls,
                                std::span<const Quat> rotations_ls, double time_s,
                                std::span<float> out) const noexcept {
@@ -130,6 +157,11 @@ FeatureExtractor::Context::Sample FeatureExtractor::extract_full_body(
   now.yaw = body_heading_yaw(positions, roles_);
   for (std::size_t e = 0; e < 4; ++e) {
     now.effectors[e] = positions[static_cast<std::size_t>(effector_joints_[e])];
+  }
+  if (spec_.standard_arm_speeds) {
+    for (std::size_t side = 0; side < 2; ++side) {
+      now.effectors[side] = now.root + leg_length_m_ * standard_hand(positions, side);
+    }
   }
   const Quat to_heading = yaw_rotation(-now.yaw);
   const double per_leg = 1.0 / leg_length_m_;

@@ -324,7 +324,9 @@ TEST(CliEval, BeamModeFindsTheDanceWhereTheExactStepFindsIt) {
   // start spreads the posterior over many takes' standing frames (88.9 % within 100 ms against
   // the exact step's 96.7 %; BeamParams::deep_prune_ratio until settled), and take 60_13 on the
   // CMU ASF rig, followed on 60_06's standing start until 60_13's fitted better (89.1 against
-  // 92.0 %; BeamParams::well_fitting_ratio).
+  // 92.0 %; BeamParams::well_fitting_ratio). The beam may do better than the exact step, not worse:
+  // since the hands' speeds are measured on a standard arm (session 48) the suit's take 60_02 is
+  // 94.3 % within 100 ms by the exact step (96.7 before) and 95.9 % by the beam.
   const auto dir = scratch_dir("beam");
   const std::string library = std::string(DUET_TESTDATA_DIR) + "/../../libraries/cmu-salsa.toml";
   const std::string base = "eval --library " + library + " --data-dir " + data_path("") +
@@ -332,7 +334,7 @@ TEST(CliEval, BeamModeFindsTheDanceWhereTheExactStepFindsIt) {
   const struct {
     std::string options, row;
     double exact_at_least;
-  } cases[] = {{"--takes 1 --cases suit-drift", "suit-drift", 0.95},
+  } cases[] = {{"--takes 1 --cases suit-drift", "suit-drift", 0.94},
                {"--takes 11 --cases clean --rigs asf", "clean@asf", 0.9}};
   for (const auto& c : cases) {
     std::map<std::string, double> accuracy;
@@ -346,8 +348,27 @@ TEST(CliEval, BeamModeFindsTheDanceWhereTheExactStepFindsIt) {
       accuracy[mode] = std::stod(rows.at({c.row, "hmm"}).at("acc_100ms"));
     }
     EXPECT_GT(accuracy["exact"], c.exact_at_least) << c.options;
-    EXPECT_NEAR(accuracy["beam"], accuracy["exact"], 0.005) << c.options;
+    EXPECT_GE(accuracy["beam"], accuracy["exact"] - 0.005) << c.options;
   }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliEval, AStandingStartOnAnotherRigIsFollowedOnItsOwnTake) {
+  // Takes 60_13 and 60_15 retargeted onto the CMU ASF rig (seed 1): their standing starts were
+  // followed on other takes' for 2-3 s (91.8 and 94.0 % within 100 ms) while the hands' speeds
+  // were measured on the rig's hands, whose shoulders stand twice as wide; on a standard arm
+  // (FeatureSpec::standard_arm_speeds) 99.96 and 99.91 %.
+  const auto dir = scratch_dir("standing-start");
+  const std::string csv = (dir / "asf.csv").string();
+  const std::string library = std::string(DUET_TESTDATA_DIR) + "/../../libraries/cmu-salsa.toml";
+  const auto r = run_duet("eval --library " + library + " --data-dir " + data_path("") +
+                          " --trackers hmm --seed 1 --no-partner-metrics --non-dance none "
+                          "--takes 11,13 --cases clean --rigs asf --csv " +
+                          csv);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto rows = pooled_rows(read_text(csv));
+  ASSERT_EQ(rows.count({"clean@asf", "hmm"}), 1u) << read_text(csv);
+  EXPECT_GT(std::stod(rows.at({"clean@asf", "hmm"}).at("acc_100ms")), 0.995);
   std::filesystem::remove_all(dir);
 }
 

@@ -222,6 +222,46 @@ TEST_F(FeatureExtractorTest, SameMotionOnAnotherRigGivesTheSameFeatures) {
   EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-4f);
 }
 
+// Another body's proportions: shoulders 1.8x as wide, arms 1.3x as long, every joint turned the
+// same way (each segment's direction kept). A hand's speed is measured along a standard arm
+// (FeatureSpec::standard_arm_speeds), so the hands' speeds are the same; measured on the rig's own
+// hands they are not.
+TEST_F(FeatureExtractorTest, WiderShouldersAndLongerArmsGiveTheSameHandSpeeds) {
+  const Clip clip = make_dance(skeleton_, 60.0, 240);
+  auto rig = std::make_shared<Skeleton>(*skeleton_);
+  const auto joint = [&](Role role) -> Joint& {
+    return rig->joints[static_cast<std::size_t>(static_cast<int>(role))];
+  };
+  for (Role shoulder : {Role::kLeftShoulder, Role::kRightShoulder})
+    joint(shoulder).offset.x() *= 1.8;
+  for (Role bone : {Role::kLeftElbow, Role::kLeftWrist, Role::kRightElbow, Role::kRightWrist}) {
+    joint(bone).offset *= 1.3;
+  }
+  Clip moved(rig, clip.frame_rate(), clip.frame_count());
+  for (int f = 0; f < clip.frame_count(); ++f) {
+    std::ranges::copy(clip.rotations_ls(f), moved.rotations_ls(f).begin());
+    moved.translations_ls(f)[0] = clip.translations_ls(f)[0];
+    for (int j = 1; j < rig->joint_count(); ++j) {
+      moved.translations_ls(f)[static_cast<std::size_t>(j)] =
+          rig->joints[static_cast<std::size_t>(j)].offset;
+    }
+  }
+  const int hands = spec_.block_begin(FeatureBlock::kEffectorSpeed);
+  const auto largest_hand_speed_difference = [&](const FeatureSpec& spec) {
+    const FeatureExtractor mine =
+        FeatureExtractor::create(skeleton_, daz_roles(*skeleton_), spec).value();
+    const FeatureExtractor theirs = FeatureExtractor::create(rig, daz_roles(*rig), spec).value();
+    const FeatureMatrix a = mine.extract_clip(clip);
+    const FeatureMatrix b = theirs.extract_clip(moved);
+    return (a.middleCols(hands, 2) - b.middleCols(hands, 2)).cwiseAbs().maxCoeff();
+  };
+  ASSERT_TRUE(spec_.standard_arm_speeds);
+  EXPECT_LT(largest_hand_speed_difference(spec_), 1e-4f);
+  FeatureSpec measured = spec_;
+  measured.standard_arm_speeds = false;
+  EXPECT_GT(largest_hand_speed_difference(measured), 0.1f);
+}
+
 TEST(FeatureNormalizer, FloorsTinyDeviationsAndWeighsBlocks) {
   FeatureSpec spec;
   spec.posture_segments = {{Role::kHips, Role::kChest}};  // 3 + 4 + 4 = 11 dims

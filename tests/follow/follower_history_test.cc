@@ -40,12 +40,12 @@ TEST(FollowerHistory, LostByDistanceOnlyAfterItHoldsForTheConfirmTime) {
 }
 
 TEST(FollowerHistory, AfterALongSpellLostTheInputMustHoldLongerToBeFollowed) {
-  const FollowParams params;  // 0.25 s per second lost, at most 0.5 s
+  const FollowParams params;  // 0.25 s per second lost, at most 0.75 s
   ASSERT_FLOAT_EQ(params.found_confirm_per_lost_s, 0.25f);
-  ASSERT_FLOAT_EQ(params.found_confirm_max_s, 0.5f);
+  ASSERT_FLOAT_EQ(params.found_confirm_max_s, 0.75f);
   EXPECT_DOUBLE_EQ(params.found_confirm_s(0.0), params.lost_confirm_s);
   EXPECT_DOUBLE_EQ(params.found_confirm_s(1.0), 0.25);
-  EXPECT_DOUBLE_EQ(params.found_confirm_s(10.0), 0.5);
+  EXPECT_DOUBLE_EQ(params.found_confirm_s(10.0), 0.75);
 
   // One second lost (3 frames to turn lost, 60 more): followed again after 0.25 s = 15 frames
   // within the distance, not after 14.
@@ -62,10 +62,10 @@ TEST(FollowerHistory, AfterALongSpellLostTheInputMustHoldLongerToBeFollowed) {
   EXPECT_TRUE(feed(history, params, false, 2));
   EXPECT_FALSE(feed(history, params, false, 1));
 
-  // Half a minute lost asks for found_confirm_max_s: 15 frames at 30 Hz, not 14.
+  // Half a minute lost asks for found_confirm_max_s: 23 frames at 30 Hz, not 22.
   FollowerHistory slow;
   EXPECT_TRUE(feed(slow, params, true, 900, k30Hz));
-  EXPECT_TRUE(feed(slow, params, false, 14, k30Hz));
+  EXPECT_TRUE(feed(slow, params, false, 22, k30Hz));
   EXPECT_FALSE(feed(slow, params, false, 1, k30Hz));
 
   // 0 per second lost: lost_confirm_s after any spell.

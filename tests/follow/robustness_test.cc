@@ -148,16 +148,16 @@ TEST_F(RobustnessTest, FeaturesFarFromEveryTemplateFrame) {
     }
     expect_valid_alpha(hmm);
     // Back to the template: the estimate is there within a few frames, and after 5 s lost it is
-    // reported followed once the input has held it for found_confirm_max_s (0.5 s: 30 frames).
+    // reported followed once the input has held it for found_confirm_max_s (0.75 s: 45 frames).
     FollowResult r;
     for (int i = 100; i < 106; ++i) r = hmm.step(template_frame(i), kDt);
     EXPECT_EQ(r.state, 105);
     EXPECT_TRUE(r.lost);
-    for (int i = 106; i < 129; ++i) r = hmm.step(template_frame(i), kDt);
-    EXPECT_EQ(r.state, 128);
+    for (int i = 106; i < 144; ++i) r = hmm.step(template_frame(i), kDt);
+    EXPECT_EQ(r.state, 143);
     EXPECT_TRUE(r.lost);
-    for (int i = 129; i < 131; ++i) r = hmm.step(template_frame(i), kDt);
-    EXPECT_EQ(r.state, 130);
+    for (int i = 144; i < 146; ++i) r = hmm.step(template_frame(i), kDt);
+    EXPECT_EQ(r.state, 145);
     EXPECT_FALSE(r.lost);
   }
 }

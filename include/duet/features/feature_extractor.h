@@ -95,6 +95,9 @@ class FeatureExtractor {
   // A role's point in the canonical body (see BodySegment): the pelvis centre for kHips, the
   // shoulder centre for kChest, else the role's joint.
   Vec3 body_point(std::span<const Vec3> positions_ws, Role role) const noexcept;
+  // A hand (side 0 left, 1 right) relative to the pelvis centre, in leg lengths and world axes,
+  // rebuilt along StandardArm from the directions of its chain (FeatureSpec::standard_arm_speeds).
+  Vec3 standard_hand(std::span<const Vec3> positions_ws, std::size_t side) const noexcept;
   // The two layouts of FeatureSpec::InputPoints, from the world pose of `context`; both return
   // the sample to remember.
   Context::Sample extract_full_body(const Context& context, double time_s,

@@ -143,9 +143,11 @@ struct FollowParams {
   // holds the dance. 0: lost_confirm_s after any spell. Three points take 0
   // (follow_params_for): their input is lost and found again often within a dance, and waiting
   // doubled their improvised cases' frames lost although followed (docs/evaluation.md, "Found
-  // again after a spell lost").
+  // again after a spell lost"). 0.5 s at most until session 48: with the hands' speeds on a
+  // standard arm (FeatureSpec::standard_arm_speeds) the looped wave was 94.3 % lost at 0.5, 97.4 at
+  // 0.75 (97.2 before), 99.6 at 1.5 (docs/evaluation.md, "A hand's speed on a standard arm").
   float found_confirm_per_lost_s = 0.25f;
-  float found_confirm_max_s = 0.5f;
+  float found_confirm_max_s = 0.75f;
   double found_confirm_s(double lost_spell_s) const noexcept {
     const double grown = std::min(static_cast<double>(found_confirm_per_lost_s) * lost_spell_s,
                                   static_cast<double>(found_confirm_max_s));
