@@ -1016,10 +1016,14 @@ TEST(PartnerSynthesis, AJumpOutOfAContactDropsTheIkAndTheBlendTakesIt) {
     std::vector<double> weights;
     Vec3 previous = Vec3::Zero();
     double fastest = 0.0;
+    EXPECT_FALSE(run.context.arm_ik_weighted());
     for (int i = 0; i < 100; ++i) {
       const int frame = i < 50 ? i : 100 + i;
       run.step(duet.follower, frame, user_from(duet.leader, i, duet.roles), i == 50);
       weights.push_back(run.info.ik_weight[1]);
+      // What LiveLoop asks before it measures the bodies' part of the hand's difference.
+      EXPECT_EQ(run.context.arm_ik_weighted(), run.info.ik_weight[0] > 0.0 || weights.back() > 0.0)
+          << i;
       const Vec3 now = run.world().positions[duet.wrist(Role::kRightWrist)];
       if (i > 20) fastest = std::max(fastest, (now - previous).norm());
       previous = now;

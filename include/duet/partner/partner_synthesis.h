@@ -404,6 +404,8 @@ class PartnerContext {
   // locks, IK weights at 0).
   void reset() noexcept;
   int joint_count() const noexcept { return static_cast<int>(blend_rotations_.size()); }
+  // An arm's contact IK still has weight (a contact held or fading out) after the last frame.
+  bool arm_ik_weighted() const noexcept { return ik_ramp_[0] > 0.0 || ik_ramp_[1] > 0.0; }
 
  private:
   friend struct PartnerSynthesisJob;
