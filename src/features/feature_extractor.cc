@@ -156,12 +156,10 @@ FeatureExtractor::Context::Sample FeatureExtractor::extract_full_body(
   now.root = pelvis_centre(positions, roles_);
   now.yaw = body_heading_yaw(positions, roles_);
   for (std::size_t e = 0; e < 4; ++e) {
-    now.effectors[e] = positions[static_cast<std::size_t>(effector_joints_[e])];
-  }
-  if (spec_.standard_arm_speeds) {
-    for (std::size_t side = 0; side < 2; ++side) {
-      now.effectors[side] = now.root + leg_length_m_ * standard_hand(positions, side);
-    }
+    const bool hand = e < 2;
+    now.effectors[e] = spec_.standard_arm_speeds && hand
+                           ? Vec3(now.root + leg_length_m_ * standard_hand(positions, e))
+                           : positions[static_cast<std::size_t>(effector_joints_[e])];
   }
   const Quat to_heading = yaw_rotation(-now.yaw);
   const double per_leg = 1.0 / leg_length_m_;

@@ -228,11 +228,11 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   } else {
     playhead_.reset();
   }
-  // The bodies' part of the hand's difference feeds only an arm the contact IK holds or lets go:
-  // a frame with no contact and no fading arm needs no retargeting (BM_WristsOnUserBody, ~5 us).
-  const bool arm_held = model.contacts().mask(static_cast<int>(std::lround(position))) != 0 ||
-                        context_.arm_ik_weighted();
   if (wrists_on_user_body_ && params_.contact) {
+    // The bodies' part of the hand's difference feeds only an arm the contact IK holds or lets
+    // go: a frame with no contact and no fading arm needs no retargeting (BM_WristsOnUserBody).
+    const bool arm_held = model.contacts().mask(static_cast<int>(std::lround(position))) != 0 ||
+                          context_.arm_ik_weighted();
     if (arm_held) {
       user_pose_.wrist_body_difference_hs =
           wrists_on_user_body_->wrist_difference_hs(take, position);
