@@ -7,6 +7,9 @@
 // BM_FollowSessionStepScalar/*: the same on the scalar kernels (DUET_SIMD=scalar), same run.
 // BM_FollowSessionStepHeadHands: take 01 as a headset's three points (head and hands) against the
 // library built from the same three points (16 dims).
+// BM_FeatureExtract: the full body's features of one frame of take 01 (forward kinematics, the
+// canonical body space, the velocity window), with the effector speeds raw (/0) and less the
+// sensor's noise (/1, FeatureSpec::debiased_speeds, the default).
 // BM_DevicePointsToJoints: one headset pose moved from the devices to the joints (duet serve
 // --source xr does it to every xr_pose before the step above).
 // BM_WristsOnUserBody: where the user's body puts the wrists at the partner's frame (the live
@@ -20,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "duet/features/feature_extractor.h"
 #include "duet/follow/hmm_follower.h"
 #include "duet/follow/simd.h"
 #include "duet/io/motion_file.h"
@@ -122,6 +126,37 @@ void BM_FollowSessionStepHeadHands(benchmark::State& state) {
   follow_session_step(state, detect_simd_level(), InputPoints::kHeadHands);
 }
 BENCHMARK(BM_FollowSessionStepHeadHands)->Arg(0)->Unit(benchmark::kMicrosecond)->MinTime(3.0);
+
+void BM_FeatureExtract(benchmark::State& state) {
+  MotionLoadOptions load;
+  load.frame_rate = 60.0;
+  Result<LoadedMotion> input = load_motion({kSalsa + "/bvh/60/60_01_scaled.bvh"}, load);
+  if (!input) {
+    state.SkipWithError(input.error().message.c_str());
+    return;
+  }
+  const Clip& clip = input.value().clip;
+  FeatureSpec spec;
+  spec.debiased_speeds = state.range(0) == 1;
+  Result<FeatureExtractor> extractor =
+      FeatureExtractor::create(clip.skeleton_ptr(), input.value().roles, spec);
+  if (!extractor) {
+    state.SkipWithError(extractor.error().message.c_str());
+    return;
+  }
+  FeatureExtractor::Context context = extractor.value().make_context();
+  std::vector<float> features(static_cast<std::size_t>(extractor.value().dimension()));
+  int f = 0;
+  double time_s = 0.0;
+  for (auto _ : state) {
+    extractor.value().extract(context, clip.translations_ls(f), clip.rotations_ls(f), time_s,
+                              features);
+    benchmark::DoNotOptimize(features.data());
+    f = (f + 1) % clip.frame_count();
+    time_s += 1.0 / 60.0;
+  }
+}
+BENCHMARK(BM_FeatureExtract)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 void BM_DevicePointsToJoints(benchmark::State& state) {
   const DevicePointOffsets offsets = typical_headset_offsets();

@@ -33,6 +33,9 @@ bool all_finite(std::span<const Quat> values) {
 void FeatureExtractor::Context::reset() noexcept {
   newest_ = -1;
   count_ = 0;
+  place_noise_ = {};
+  place_noise_time_s_ = 0.0;
+  place_noise_known_ = false;
   head_height_max_m_ = 0.0;
 }
 
@@ -146,6 +149,22 @@ void FeatureExtractor::extract(Context& context, std::span<const Vec3> translati
                                   ? extract_head_hands(context, time_s, out)
                                   : extract_full_body(context, time_s, out);
   remember(context, now);
+  refresh_place_noise(context);
+}
+
+void FeatureExtractor::refresh_place_noise(Context& context) const noexcept {
+  if (!spec_.debiased_speeds || spec_.input_points != InputPoints::kFullBody) return;
+  // The noise changes slowly, and its median costs more than the rest of the frame's features:
+  // read again every kEveryS once known, on every frame until then.
+  constexpr double kEveryS = 0.1;
+  const double newest_s = context.history_[static_cast<std::size_t>(context.newest_)].time_s;
+  if (context.place_noise_known_ && newest_s - context.place_noise_time_s_ < kEveryS &&
+      newest_s >= context.place_noise_time_s_) {
+    return;
+  }
+  context.place_noise_ = place_noise_energies(context, 4);
+  context.place_noise_time_s_ = newest_s;
+  context.place_noise_known_ = context.place_noise_ != std::array<double, 4>{};
 }
 
 FeatureExtractor::Context::Sample FeatureExtractor::extract_full_body(
@@ -161,6 +180,7 @@ FeatureExtractor::Context::Sample FeatureExtractor::extract_full_body(
                            ? Vec3(now.root + leg_length_m_ * standard_hand(positions, e))
                            : positions[static_cast<std::size_t>(effector_joints_[e])];
   }
+  if (spec_.debiased_speeds) note_second_differences(context, now);
   const Quat to_heading = yaw_rotation(-now.yaw);
   const double per_leg = 1.0 / leg_length_m_;
 
@@ -223,12 +243,20 @@ void FeatureExtractor::put_velocities(const Context& context, const Context::Sam
   Vec3 root_velocity_heading = Vec3::Zero();
   double yaw_rate = 0.0;
   std::array<double, 4> effector_speed{};
+  const bool debias = spec_.debiased_speeds && spec_.input_points == InputPoints::kFullBody;
   if (const Context::Sample* reference = velocity_reference(context, now.time_s)) {
     const double dt = now.time_s - reference->time_s;
     root_velocity_heading = to_heading * ((now.root - reference->root) * (per_unit / dt));
     yaw_rate = wrap_angle(now.yaw - reference->yaw) / dt;
+    const std::array<double, 4>& noise = context.place_noise_;
+    const double allowance = spec_.speed_noise_allowance_m * spec_.speed_noise_allowance_m;
     for (std::size_t e = 0; e < static_cast<std::size_t>(effectors); ++e) {
-      effector_speed[e] = (now.effectors[e] - reference->effectors[e]).norm() * per_unit / dt;
+      double squared = (now.effectors[e] - reference->effectors[e]).squaredNorm();
+      // A speed is a length, so a sensor's white noise only ever adds to it: its expected share
+      // of the squared difference, less what a clean capture reads, is taken off
+      // (FeatureSpec::debiased_speeds).
+      if (debias) squared = std::max(0.0, squared - std::max(0.0, noise[e] - allowance));
+      effector_speed[e] = std::sqrt(squared) * per_unit / dt;
     }
   }
   std::size_t d = 0;
@@ -239,6 +267,63 @@ void FeatureExtractor::put_velocities(const Context& context, const Context::Sam
   for (int e = 0; e < effectors; ++e) {
     out[d++] = static_cast<float>(effector_speed[static_cast<std::size_t>(e)]);
   }
+}
+
+void FeatureExtractor::note_second_differences(const Context& context,
+                                               Context::Sample& now) noexcept {
+  // p(t) - 2 p(t - 1) + p(t - 2) over three evenly spaced frames (intervals within 10 % of each
+  // other): white noise of sigma per axis gives it 18 sigma^2 in expectation, a dance's own
+  // acceleration a dt^2 (about 3 mm at 60 Hz for a hand turning fast), so it reads the noise.
+  constexpr double kEvenSpacing = 0.1;
+  now.second_differences.fill(std::numeric_limits<double>::quiet_NaN());
+  if (context.count_ < 2) return;
+  const Context::Sample& middle = context.history_[static_cast<std::size_t>(context.newest_)];
+  const Context::Sample& older = context.history_[static_cast<std::size_t>(
+      (context.newest_ - 1 + Context::kHistory) % Context::kHistory)];
+  const double later = now.time_s - middle.time_s;
+  const double earlier = middle.time_s - older.time_s;
+  if (!(later > 0.0 && earlier > 0.0 && std::abs(later - earlier) <= kEvenSpacing * earlier)) {
+    return;
+  }
+  for (std::size_t e = 0; e < now.effectors.size(); ++e) {
+    now.second_differences[e] =
+        (now.effectors[e] - 2.0 * middle.effectors[e] + older.effectors[e]).squaredNorm();
+  }
+}
+
+std::array<double, 4> FeatureExtractor::place_noise_energies(const Context& context,
+                                                             int effectors) noexcept {
+  // The median of the second differences over the last kWindowS, which a sharp turn of the hand
+  // does not move; a chi-square of 3 degrees of freedom has its median at 0.789 of its mean.
+  constexpr double kWindowS = 0.5;
+  constexpr double kMedianToMean = 1.0 / 0.789;
+  // Too few to tell the noise from a take's first frames (the salsa BVHs ramp in from a rest
+  // pose over four frames): nothing is read.
+  constexpr std::size_t kFewest = 5;
+  const auto count = static_cast<std::size_t>(effectors);
+  std::array<std::array<double, Context::kHistory>, 4> energies;
+  std::array<std::size_t, 4> n{};
+  const double newest_s = context.history_[static_cast<std::size_t>(context.newest_)].time_s;
+  for (int age = 0; age < context.count_; ++age) {
+    const int index = (context.newest_ - age + Context::kHistory) % Context::kHistory;
+    const Context::Sample& sample = context.history_[static_cast<std::size_t>(index)];
+    if (!(newest_s - sample.time_s <= kWindowS)) break;
+    for (std::size_t e = 0; e < count; ++e) {
+      if (std::isfinite(sample.second_differences[e])) {
+        energies[e][n[e]++] = sample.second_differences[e];
+      }
+    }
+  }
+  std::array<double, 4> noise{};
+  for (std::size_t e = 0; e < count; ++e) {
+    if (n[e] < kFewest) continue;
+    const auto begin = energies[e].begin();
+    const auto mid = begin + static_cast<std::ptrdiff_t>(n[e] / 2);
+    std::nth_element(begin, mid, begin + static_cast<std::ptrdiff_t>(n[e]));
+    // 18 sigma^2 in a second difference, 6 sigma^2 in a plain one.
+    noise[e] = *mid * kMedianToMean / 3.0;
+  }
+  return noise;
 }
 
 const FeatureExtractor::Context::Sample* FeatureExtractor::velocity_reference(

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <random>
+
 #include "features/synthetic_dancer.h"
 
 namespace duet {
@@ -260,6 +263,68 @@ TEST_F(FeatureExtractorTest, WiderShouldersAndLongerArmsGiveTheSameHandSpeeds) {
   FeatureSpec measured = spec_;
   measured.standard_arm_speeds = false;
   EXPECT_GT(largest_hand_speed_difference(measured), 0.1f);
+}
+
+// A speed is a length, so a sensor's white noise only adds to it (FeatureSpec::debiased_speeds):
+// the same dance with 3 degrees of noise per joint and axis, and the dancer standing still with
+// it. Kept, the noise's share makes every speed higher than the clean one on average (a dancer
+// standing still moves the hands and feet at a dancing pace); taken off, a dancing speed is the
+// clean one on average, and a still one less than half as far from zero (a length cannot go below
+// it, so what is left of the noise there stays positive); every speed is nearer the clean one
+// frame by frame. Clean input keeps its speeds.
+TEST_F(FeatureExtractorTest, ASensorsNoiseIsTakenOffTheEffectorsSpeeds) {
+  const Clip dance = make_dance(skeleton_, 60.0, 600);
+  Clip still = dance;
+  for (int f = 0; f < still.frame_count(); ++f) {
+    std::ranges::copy(dance.rotations_ls(0), still.rotations_ls(f).begin());
+    std::ranges::copy(dance.translations_ls(0), still.translations_ls(f).begin());
+  }
+  std::mt19937 random(11);
+  std::normal_distribution<double> noise_rad(0.0, deg_to_rad(3.0));
+  const auto noisy = [&](const Clip& clean) {
+    Clip out = clean;
+    for (int f = 0; f < out.frame_count(); ++f) {
+      for (Quat& q : out.rotations_ls(f)) {
+        const Vec3 turn(noise_rad(random), noise_rad(random), noise_rad(random));
+        q = (q * Quat(Eigen::AngleAxisd(turn.norm(), turn.normalized()))).normalized();
+      }
+    }
+    return out;
+  };
+  const int speeds = spec_.block_begin(FeatureBlock::kEffectorSpeed);
+  FeatureSpec raw_spec = spec_;
+  raw_spec.debiased_speeds = false;
+  const FeatureExtractor raw =
+      FeatureExtractor::create(skeleton_, daz_roles(*skeleton_), raw_spec).value();
+  ASSERT_TRUE(spec_.debiased_speeds);
+  // Over effectors and frames (after the first second): the mean of speed - the clean speed
+  // (the bias) and of its size.
+  struct Error {
+    double bias, size;
+  };
+  const auto speed_error = [&](const FeatureExtractor& extractor, const Clip& clean,
+                               const Clip& sensed) {
+    const FeatureMatrix truth = extractor.extract_clip(clean);
+    const FeatureMatrix measured = extractor.extract_clip(sensed);
+    const int from = 60;
+    const Eigen::MatrixXf error = (measured.middleCols(speeds, 4) - truth.middleCols(speeds, 4))
+                                      .bottomRows(truth.rows() - from);
+    return Error{error.mean(), error.cwiseAbs().mean()};
+  };
+  for (const Clip* clean : std::array<const Clip*, 2>{&dance, &still}) {
+    const Clip sensed = noisy(*clean);
+    const Error kept = speed_error(raw, *clean, sensed);
+    const Error taken_off = speed_error(*extractor_, *clean, sensed);
+    const bool standing = clean == &still;
+    SCOPED_TRACE(standing ? "standing still" : "dancing");
+    EXPECT_GT(kept.bias, 0.5);  // leg lengths per second
+    EXPECT_LT(std::abs(taken_off.bias), (standing ? 0.5 : 0.1) * kept.bias);
+    EXPECT_LT(taken_off.size, kept.size);
+  }
+
+  const FeatureMatrix a = raw.extract_clip(dance);
+  const FeatureMatrix b = extractor_->extract_clip(dance);
+  EXPECT_EQ((a - b).cwiseAbs().maxCoeff(), 0.0f);
 }
 
 TEST(FeatureNormalizer, FloorsTinyDeviationsAndWeighsBlocks) {

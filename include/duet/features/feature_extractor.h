@@ -54,11 +54,19 @@ class FeatureExtractor {
       Vec3 root = Vec3::Zero();  // the pelvis centre (full body) or the head (head and hands)
       double yaw = 0.0;
       std::array<Vec3, 4> effectors;  // left hand, right hand, left foot, right foot
+      // Per effector: the squared second difference of its place ending at this frame
+      // (note_second_differences); NaN where the frames were not evenly spaced.
+      std::array<double, 4> second_differences{};
     };
     static constexpr int kHistory = 64;  // enough for a 0.1 s window at 600 Hz
     std::array<Sample, kHistory> history_{};
     int newest_ = -1;
     int count_ = 0;
+    // FeatureSpec::debiased_speeds: each effector's place noise (place_noise_energies) as last
+    // read, at place_noise_time_s_; known once non-zero.
+    std::array<double, 4> place_noise_{};
+    double place_noise_time_s_ = 0.0;
+    bool place_noise_known_ = false;
     // Head and hands: the highest the head has held (metres; held_head_height), the unit of
     // lengths there, since a headset says nothing of the body's size.
     double head_height_max_m_ = 0.0;
@@ -111,6 +119,17 @@ class FeatureExtractor {
   // The level the head holds: the median of its height at `time_s` (head_y) and at the
   // remembered frames of the last 0.3 s (the last Context::kHistory frames above 213 Hz).
   static double held_head_height(const Context& context, double head_y, double time_s) noexcept;
+  // FeatureSpec::debiased_speeds: the squared second difference of each effector's place over
+  // `now` and the two newest remembered frames, when the three are evenly spaced.
+  static void note_second_differences(const Context& context, Context::Sample& now) noexcept;
+  // The white noise the first `effectors` effectors' places carry, over the remembered frames: the
+  // expected squared length it adds to the difference of two of an effector's places (metres^2), 6
+  // sigma^2 for a sigma per axis, from the median second difference over the last 0.5 s; 0 with
+  // fewer than five.
+  static std::array<double, 4> place_noise_energies(const Context& context, int effectors) noexcept;
+  // Context::place_noise_ from the remembered frames (the newest is the frame just extracted), at
+  // most every 0.1 s once known.
+  void refresh_place_noise(Context& context) const noexcept;
   // The velocity blocks: the root's velocity in the heading frame and the yaw rate, then the
   // speeds of the first `effectors` effectors, lengths times per_unit (FeatureSpec).
   void put_velocities(const Context& context, const Context::Sample& now, const Quat& to_heading,
