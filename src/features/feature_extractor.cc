@@ -35,7 +35,6 @@ void FeatureExtractor::Context::reset() noexcept {
   count_ = 0;
   place_noise_ = {};
   place_noise_time_s_ = 0.0;
-  place_noise_known_ = false;
   head_height_max_m_ = 0.0;
 }
 
@@ -153,18 +152,18 @@ void FeatureExtractor::extract(Context& context, std::span<const Vec3> translati
 }
 
 void FeatureExtractor::refresh_place_noise(Context& context) const noexcept {
-  if (!spec_.debiased_speeds || spec_.input_points != InputPoints::kFullBody) return;
+  if (!debiases_speeds()) return;
   // The noise changes slowly, and its median costs more than the rest of the frame's features:
   // read again every kEveryS once known, on every frame until then.
   constexpr double kEveryS = 0.1;
-  const double newest_s = context.history_[static_cast<std::size_t>(context.newest_)].time_s;
-  if (context.place_noise_known_ && newest_s - context.place_noise_time_s_ < kEveryS &&
+  const double newest_s = context.sample(0).time_s;
+  const bool known = context.place_noise_ != std::array<double, 4>{};
+  if (known && newest_s - context.place_noise_time_s_ < kEveryS &&
       newest_s >= context.place_noise_time_s_) {
     return;
   }
   context.place_noise_ = place_noise_energies(context, 4);
   context.place_noise_time_s_ = newest_s;
-  context.place_noise_known_ = context.place_noise_ != std::array<double, 4>{};
 }
 
 FeatureExtractor::Context::Sample FeatureExtractor::extract_full_body(
@@ -243,7 +242,7 @@ void FeatureExtractor::put_velocities(const Context& context, const Context::Sam
   Vec3 root_velocity_heading = Vec3::Zero();
   double yaw_rate = 0.0;
   std::array<double, 4> effector_speed{};
-  const bool debias = spec_.debiased_speeds && spec_.input_points == InputPoints::kFullBody;
+  const bool debias = debiases_speeds();
   if (const Context::Sample* reference = velocity_reference(context, now.time_s)) {
     const double dt = now.time_s - reference->time_s;
     root_velocity_heading = to_heading * ((now.root - reference->root) * (per_unit / dt));
@@ -277,9 +276,8 @@ void FeatureExtractor::note_second_differences(const Context& context,
   constexpr double kEvenSpacing = 0.1;
   now.second_differences.fill(std::numeric_limits<double>::quiet_NaN());
   if (context.count_ < 2) return;
-  const Context::Sample& middle = context.history_[static_cast<std::size_t>(context.newest_)];
-  const Context::Sample& older = context.history_[static_cast<std::size_t>(
-      (context.newest_ - 1 + Context::kHistory) % Context::kHistory)];
+  const Context::Sample& middle = context.sample(0);
+  const Context::Sample& older = context.sample(1);
   const double later = now.time_s - middle.time_s;
   const double earlier = middle.time_s - older.time_s;
   if (!(later > 0.0 && earlier > 0.0 && std::abs(later - earlier) <= kEvenSpacing * earlier)) {
@@ -303,10 +301,9 @@ std::array<double, 4> FeatureExtractor::place_noise_energies(const Context& cont
   const auto count = static_cast<std::size_t>(effectors);
   std::array<std::array<double, Context::kHistory>, 4> energies;
   std::array<std::size_t, 4> n{};
-  const double newest_s = context.history_[static_cast<std::size_t>(context.newest_)].time_s;
+  const double newest_s = context.sample(0).time_s;
   for (int age = 0; age < context.count_; ++age) {
-    const int index = (context.newest_ - age + Context::kHistory) % Context::kHistory;
-    const Context::Sample& sample = context.history_[static_cast<std::size_t>(index)];
+    const Context::Sample& sample = context.sample(age);
     if (!(newest_s - sample.time_s <= kWindowS)) break;
     for (std::size_t e = 0; e < count; ++e) {
       if (std::isfinite(sample.second_differences[e])) {
@@ -330,8 +327,7 @@ const FeatureExtractor::Context::Sample* FeatureExtractor::velocity_reference(
     const Context& context, double time_s) const noexcept {
   const Context::Sample* reference = nullptr;
   for (int age = 0; age < context.count_; ++age) {
-    const int index = (context.newest_ - age + Context::kHistory) % Context::kHistory;
-    const Context::Sample& sample = context.history_[static_cast<std::size_t>(index)];
+    const Context::Sample& sample = context.sample(age);
     if (sample.time_s >= time_s) continue;  // out-of-order timestamps carry no velocity
     reference = &sample;
     if (time_s - sample.time_s >= spec_.velocity_window_s) break;
@@ -349,8 +345,7 @@ double FeatureExtractor::held_head_height(const Context& context, double head_y,
   std::size_t n = 0;
   if (std::isfinite(head_y)) heights[n++] = head_y;
   for (int age = 0; age < context.count_; ++age) {
-    const int index = (context.newest_ - age + Context::kHistory) % Context::kHistory;
-    const Context::Sample& sample = context.history_[static_cast<std::size_t>(index)];
+    const Context::Sample& sample = context.sample(age);
     if (!(time_s - sample.time_s < kHeldS)) break;
     if (std::isfinite(sample.root.y())) heights[n++] = sample.root.y();
   }

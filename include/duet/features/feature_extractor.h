@@ -59,14 +59,17 @@ class FeatureExtractor {
       std::array<double, 4> second_differences{};
     };
     static constexpr int kHistory = 64;  // enough for a 0.1 s window at 600 Hz
+    // The remembered sample `age` frames before the newest (0: the newest; age < count_).
+    const Sample& sample(int age) const noexcept {
+      return history_[static_cast<std::size_t>((newest_ - age + kHistory) % kHistory)];
+    }
     std::array<Sample, kHistory> history_{};
     int newest_ = -1;
     int count_ = 0;
     // FeatureSpec::debiased_speeds: each effector's place noise (place_noise_energies) as last
-    // read, at place_noise_time_s_; known once non-zero.
+    // read, at place_noise_time_s_; all zero until known.
     std::array<double, 4> place_noise_{};
     double place_noise_time_s_ = 0.0;
-    bool place_noise_known_ = false;
     // Head and hands: the highest the head has held (metres; held_head_height), the unit of
     // lengths there, since a headset says nothing of the body's size.
     double head_height_max_m_ = 0.0;
@@ -130,6 +133,10 @@ class FeatureExtractor {
   // Context::place_noise_ from the remembered frames (the newest is the frame just extracted), at
   // most every 0.1 s once known.
   void refresh_place_noise(Context& context) const noexcept;
+  // FeatureSpec::debiased_speeds, which applies to the full body only.
+  bool debiases_speeds() const noexcept {
+    return spec_.debiased_speeds && spec_.input_points == InputPoints::kFullBody;
+  }
   // The velocity blocks: the root's velocity in the heading frame and the yaw rate, then the
   // speeds of the first `effectors` effectors, lengths times per_unit (FeatureSpec).
   void put_velocities(const Context& context, const Context::Sample& now, const Quat& to_heading,

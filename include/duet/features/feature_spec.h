@@ -87,7 +87,7 @@ struct FeatureSpec {
   // difference over the velocity window is 57 / 81 mm in the median, more than a dancing hand
   // moves (76 mm) and three times a foot (27 mm), so a dancer standing still looked like one
   // stepping. That share, read from the effector's own second differences over the last 0.5 s
-  // (FeatureExtractor::place_noise_energy), is taken off the squared difference before the root.
+  // (FeatureExtractor::place_noise_energies), is taken off the squared difference before the root.
   // Signed velocities are left as they are: noise widens them but does not move them. Three
   // points' hands are the controllers' own places, millimetres of noise, and stay raw (measured:
   // no gain; docs/evaluation.md, "Speeds less the sensor's noise"). false: the raw speeds.
