@@ -54,6 +54,14 @@ const std::vector<FloatRow>& float_rows() {
       {"--found-confirm-max-s", &FollowParams::found_confirm_max_s,
        "found_confirm_max_s: the longest --found-confirm-per-lost asks for",
        number_between(0.0, 10.0, "s")},
+      {"--held-place-lost-s", &FollowParams::held_place_lost_s,
+       "held_place_lost_s: an estimate held within --held-place-reach-s of one place for longer "
+       "than this is reported lost (input seconds; 0 for never; all HMM variants)",
+       number_between(0.0, 600.0, "s")},
+      {"--held-place-reach-s", &FollowParams::held_place_reach_s,
+       "held_place_reach_s: how far (template seconds) the estimate must move to start a new "
+       "hold",
+       number_between(0.001, 10.0, "s")},
       {"--lost-velocity-cap-per-dim", &FollowParams::lost_velocity_cap_per_dim,
        "lost_velocity_cap_per_dim: most the velocity blocks add to the lost test's distance, per "
        "dimension of the model (and at most --velocity-cap; inf: the emission's); all HMM "

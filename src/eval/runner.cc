@@ -418,6 +418,8 @@ Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const Templ
       params.found_confirm_per_lost_s = options.hmm.found_confirm_per_lost_s;
       params.found_confirm_max_s = options.hmm.found_confirm_max_s;
       params.pause_reported_lost = options.hmm.pause_reported_lost;
+      params.held_place_lost_s = options.hmm.held_place_lost_s;
+      params.held_place_reach_s = options.hmm.held_place_reach_s;
       params.confidence_window_frames = options.hmm.confidence_window_frames;
       params.max_steps_per_frame = options.hmm.max_steps_per_frame;
       return hmm_tracker(model, params, options, std::move(index));

@@ -43,6 +43,7 @@ FollowParams FollowParams::paper() {
   params.lost_confirm_s = 0.0f;
   params.found_confirm_per_lost_s = 0.0f;
   params.pause_reported_lost = true;
+  params.held_place_lost_s = 0.0f;
   return params;
 }
 
@@ -96,6 +97,14 @@ Status FollowParams::validate(int num_states) const {
   if (!(lost_distance_per_dim >= 0.0f)) {  // +inf allowed: never lost by distance
     return params_error("lost_distance_per_dim must be >= 0, got " +
                         std::to_string(lost_distance_per_dim));
+  }
+  if (!(held_place_lost_s >= 0.0f && std::isfinite(held_place_lost_s))) {
+    return params_error("held_place_lost_s must be finite and >= 0, got " +
+                        std::to_string(held_place_lost_s));
+  }
+  if (!(held_place_reach_s > 0.0f && std::isfinite(held_place_reach_s))) {
+    return params_error("held_place_reach_s must be finite and > 0, got " +
+                        std::to_string(held_place_reach_s));
   }
   if (!(sensor_noise_time_constant_s > 0.0 && std::isfinite(sensor_noise_time_constant_s))) {
     return params_error("sensor_noise_time_constant_s must be finite and > 0, got " +

@@ -1,6 +1,7 @@
 #include "duet/follow/follower_history.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "duet/follow/confidence_calibration.h"
 #include "forward_common.h"
@@ -29,6 +30,7 @@ void FollowerHistory::reset() noexcept {
   sensor_noise.reset();
   noise_filter.reset();
   explained_residual.reset();
+  held_place.reset();
 }
 
 void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams& params,
@@ -65,6 +67,12 @@ void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams
                             moved_far ? 0 : advanced, dt_s, model.frame_rate_hz());
   result.lost = report_lost(params, result.lost, past_ceiling, unexplained, result.missing,
                             result.steps / model.frame_rate_hz());
+  held_place.update(result.state, result.jumped, dt_s,
+                    std::max(1, static_cast<int>(std::lround(params.held_place_reach_s *
+                                                             model.frame_rate_hz()))));
+  if (params.held_place_lost_s > 0.0f && held_place.held_s() > params.held_place_lost_s) {
+    result.lost = true;
+  }
 }
 
 }  // namespace duet

@@ -136,5 +136,47 @@ TEST(FollowerHistory, TheConfirmTimeIsChecked) {
   EXPECT_TRUE(FollowParams{}.validate(10));
 }
 
+TEST(HeldPlace, CountsTheTimeTheEstimateStaysWithinReachOfWhereItBegan) {
+  HeldPlace held;
+  constexpr int kReach = 12;
+  held.update(100, false, k60Hz, kReach);  // the hold begins
+  EXPECT_DOUBLE_EQ(held.held_s(), 0.0);
+  for (int f = 0; f < 60; ++f) held.update(100 + f % 11 - 5, false, k60Hz, kReach);  // jitter
+  EXPECT_NEAR(held.held_s(), 1.0, 1e-9);
+  held.update(112, false, k60Hz, kReach);  // a move of the reach: a new hold there
+  EXPECT_DOUBLE_EQ(held.held_s(), 0.0);
+  held.update(101, false, k60Hz, kReach);  // within reach of 112, not of the old place
+  EXPECT_NEAR(held.held_s(), k60Hz, 1e-12);
+  held.update(101, true, k60Hz, kReach);  // a jump starts over, even to the same place
+  EXPECT_DOUBLE_EQ(held.held_s(), 0.0);
+  held.update(101, false, std::numeric_limits<double>::quiet_NaN(), kReach);
+  held.update(101, false, -1.0, kReach);
+  EXPECT_DOUBLE_EQ(held.held_s(), 0.0);   // no time from a bad interval
+  held.update(-1, false, k60Hz, kReach);  // no estimate
+  held.update(101, false, k60Hz, kReach);
+  EXPECT_DOUBLE_EQ(held.held_s(), 0.0);
+  held.update(101, false, k30Hz, kReach);
+  held.reset();
+  EXPECT_DOUBLE_EQ(held.held_s(), 0.0);
+}
+
+TEST(FollowerHistory, TheHeldPlaceLimitsAreChecked) {
+  for (const float bad :
+       {-1.0f, std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN()}) {
+    FollowParams params;
+    params.held_place_lost_s = bad;
+    EXPECT_FALSE(params.validate(10)) << bad;
+    params = FollowParams{};
+    params.held_place_reach_s = bad;
+    EXPECT_FALSE(params.validate(10)) << bad;
+  }
+  FollowParams zero_reach;
+  zero_reach.held_place_reach_s = 0.0f;
+  EXPECT_FALSE(zero_reach.validate(10));
+  FollowParams never;
+  never.held_place_lost_s = 0.0f;
+  EXPECT_TRUE(never.validate(10));
+}
+
 }  // namespace
 }  // namespace duet

@@ -229,6 +229,29 @@ TEST_F(TrackingTest, LateAndIrregularFrames) {
   EXPECT_EQ(misses(replay(hmm, model_, frames, 0.05f), 1), 0);
 }
 
+TEST_F(TrackingTest, APlaceHeldForSecondsIsLostUntilTheDanceMovesOn) {
+  // Two seconds of dance, the pose of frame 120 held still for 5 s (a person standing, a dance
+  // stopped: it matches that frame exactly), then the dance again from there.
+  const std::vector<Frame> frames = perform({{0, 120}, {120, 300, 0.0}, {120, 180}}, 1.0 / 60);
+  const FollowParams params;
+  ASSERT_FLOAT_EQ(params.held_place_lost_s, 3.0f);
+  HmmFollower hmm = HmmFollower::create(model_, params).value();
+  const Trace r = replay(hmm, model_, frames);
+  for (std::size_t t = 3; t < r.results.size(); ++t) {
+    const double held_s = t < 120 || t >= 420 ? 0.0 : (static_cast<double>(t) - 120.0) / 60.0;
+    // Within a few frames of the hold's start and end: when the estimate settles is the HMM's.
+    if (std::abs(held_s - 3.0) < 0.1 || (t >= 420 && t < 440)) continue;
+    EXPECT_EQ(r.results[t].lost, held_s > 3.0) << t;
+    EXPECT_LE(std::abs(r.results[t].state - r.truth[t]), 1) << t;  // the estimate itself holds
+  }
+
+  FollowParams never = params;
+  never.held_place_lost_s = 0.0f;
+  HmmFollower patient = HmmFollower::create(model_, never).value();
+  const Trace held = replay(patient, model_, frames);
+  for (std::size_t t = 3; t < held.results.size(); ++t) EXPECT_FALSE(held.results[t].lost) << t;
+}
+
 class LibraryTest : public ::testing::Test {
  protected:
   TemplateModel model_ = test::make_model({400, 300, 500}, kDims, 4);

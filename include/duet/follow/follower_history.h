@@ -7,6 +7,7 @@
 #include "duet/follow/ceiling_lost_report.h"
 #include "duet/follow/explained_residual.h"
 #include "duet/follow/follow_params.h"
+#include "duet/follow/held_place.h"
 #include "duet/follow/jump_gate.h"
 #include "duet/follow/noise_filter.h"
 #include "duet/follow/sensor_noise.h"
@@ -93,6 +94,8 @@ struct FollowerHistory {
   SensorNoiseEstimator sensor_noise;
   NoiseFilter noise_filter;
   ExplainedResidual explained_residual;
+  HeldPlace
+      held_place;  // how long the estimate has held one place (FollowParams::held_place_lost_s)
 };
 
 }  // namespace duet
