@@ -70,8 +70,10 @@ void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams
   held_place.update(result.state, result.jumped, dt_s,
                     std::max(1, static_cast<int>(std::lround(params.held_place_reach_s *
                                                              model.frame_rate_hz()))));
-  if (params.held_place_lost_s > 0.0f && held_place.held_s() > params.held_place_lost_s) {
+  if (params.held_place_lost_s > 0.0f && held_place.held_s() > params.held_place_lost_s &&
+      !result.lost) {
     result.lost = true;
+    result.held_still = true;
   }
 }
 

@@ -20,8 +20,10 @@ PartnerPlaceStep PartnerPlace::next(const FollowResult& result, double dt_s,
   const bool timed = std::isfinite(dt_s) && dt_s > 0.0;
   const double tempo = std::isfinite(result.tempo) && result.tempo > 0.0f ? result.tempo : 1.0;
   // Between places (the pause state holding the mass) the estimate is not yet decided either,
-  // although the follower does not report it lost (FollowParams::pause_reported_lost).
-  const bool undecided = result.lost || result.in_pause;
+  // although the follower does not report it lost (FollowParams::pause_reported_lost). A dancer
+  // lost only for standing still (FollowResult::held_still) is where the estimate holds: the
+  // partner waits there with them.
+  const bool undecided = (result.lost && !result.held_still) || result.in_pause;
   lost_s_ = undecided ? lost_s_ + (timed ? dt_s : 0.0) : 0.0;
   step.coasting = undecided && take_ >= 0 && (coasting_ || lost_s_ >= params.coast_after_lost_s);
   if (step.coasting) {

@@ -242,6 +242,7 @@ TEST_F(TrackingTest, APlaceHeldForSecondsIsLostUntilTheDanceMovesOn) {
     // Within a few frames of the hold's start and end: when the estimate settles is the HMM's.
     if (std::abs(held_s - 3.0) < 0.1 || (t >= 420 && t < 440)) continue;
     EXPECT_EQ(r.results[t].lost, held_s > 3.0) << t;
+    EXPECT_EQ(r.results[t].held_still, held_s > 3.0) << t;         // and for that reason only
     EXPECT_LE(std::abs(r.results[t].state - r.truth[t]), 1) << t;  // the estimate itself holds
   }
 

@@ -74,6 +74,28 @@ TEST(PartnerPlace, FollowsTheEstimateAndCoastsThroughALossAfterItsDelay) {
   EXPECT_TRUE(found.jumped);
 }
 
+TEST(PartnerPlace, ADancerLostForStandingStillIsWaitedWith) {
+  const std::vector<PartnerModel> models = two_takes();
+  const PlayheadParams params;
+  PartnerPlace place;
+  for (int f = 100; f < 110; ++f) place.next(estimate(0, f), kDt, models, params);
+  // Lost for a second only because the estimate holds frame 110 (FollowResult::held_still): the
+  // partner holds it too, where a spell lost by distance would have it dance on.
+  FollowResult held = estimate(0, 110, true);
+  held.held_still = true;
+  for (int k = 0; k < 60; ++k) {
+    const PartnerPlaceStep step = place.next(held, kDt, models, params);
+    EXPECT_FALSE(step.coasting) << k;
+    EXPECT_FALSE(step.jumped) << k;
+    EXPECT_EQ(step.frame, 110) << k;
+  }
+  PartnerPlace lost = place;
+  PartnerPlaceStep step{};
+  for (int k = 0; k < 60; ++k) step = lost.next(estimate(0, 110, true), kDt, models, params);
+  EXPECT_TRUE(step.coasting);
+  EXPECT_GT(step.frame, 150);
+}
+
 TEST(PartnerPlace, AFarMoveTheFollowerDoesNotCallAJumpRestartsThePartner) {
   const std::vector<PartnerModel> models = two_takes();
   PlayheadParams params;

@@ -23,6 +23,10 @@ struct FollowResult {
   // jump (jitter back, a catch-up forward within the take, the first placement, a burst).
   bool jumped = false;
   bool lost = false;      // no template frame explains the input (see FollowParams)
+  // Lost only because the estimate has held one place longer than a dance holds a pose
+  // (FollowParams::held_place_lost_s): a dancer standing still, whom the partner waits with
+  // instead of dancing on as through a spell the library does not explain.
+  bool held_still = false;
   bool in_pause = false;  // the pause state holds most of the posterior mass
   bool missing = false;   // the input held NaN/inf: transition only, no emission
   // An outlier frame (FollowParams::gate_outliers): its evidence would have handed the pause
