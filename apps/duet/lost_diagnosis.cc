@@ -8,15 +8,17 @@
 
 namespace duet::app {
 
-LostSummary summarise_lost(std::span<const FollowResult> results) {
+LostSummary summarise_lost(std::span<const FollowResult> results, double frame_rate_hz) {
   LostSummary summary;
   for (const FollowResult& r : results) {
+    summary.held_still += r.held_still ? 1 : 0;
     ++summary.frames;
     summary.lost += r.lost ? 1 : 0;
     summary.jumps += r.jumped ? 1 : 0;
     summary.missing += r.missing ? 1 : 0;
     summary.outliers += r.outlier ? 1 : 0;
   }
+  if (frame_rate_hz > 0.0) summary.held_still_s = summary.held_still / frame_rate_hz;
   return summary;
 }
 
@@ -30,6 +32,7 @@ float median_followed_tempo(std::span<const FollowResult> results) {
   std::vector<float> followed;
   std::vector<float> all;
   for (const FollowResult& r : results) {
+    if (r.held_still) continue;  // a dancer standing still says nothing of the input's clock
     all.push_back(r.tempo);
     if (!r.lost) followed.push_back(r.tempo);
   }
@@ -116,6 +119,14 @@ std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostCon
     causes.push_back(fmt::format(
         "rate: the input runs at {:g} fps and the library at {:g} fps (fine if both are right)",
         context.input_rate_hz, context.library_rate_hz));
+  }
+  // Standing still: a dance moves on, so seconds held at one place are lost (HeldPlace).
+  if (summary.held_still > 0 && 10 * summary.held_still >= summary.lost) {
+    causes.push_back(fmt::format(
+        "still: {:.1f} s of the input held one place of the dance for seconds at a time (the "
+        "dancer standing still: lost, since a dance moves on); trim the waiting from the "
+        "recording, or pass --allow-lost",
+        summary.held_still_s));
   }
   causes.push_back(
       "dance: the input may not be any part of the library's dance (another dance, a walk, a "

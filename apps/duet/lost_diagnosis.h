@@ -24,9 +24,12 @@ struct LostSummary {
   int jumps = 0;
   int missing = 0;   // no usable pose, or the sensor repeated the last one (FollowResult::missing)
   int outliers = 0;  // evidence set aside (FollowResult::outlier)
+  int held_still = 0;  // lost only for holding one place for seconds (FollowResult::held_still)
+  double held_still_s = 0.0;  // their input time
   double lost_fraction() const { return frames > 0 ? static_cast<double>(lost) / frames : 0.0; }
 };
-LostSummary summarise_lost(std::span<const FollowResult> results);
+// results: one per input frame at frame_rate_hz.
+LostSummary summarise_lost(std::span<const FollowResult> results, double frame_rate_hz);
 // " (frames without evidence: M missing or repeated, K outliers set aside)", or "" when none.
 std::string describe_set_aside(const LostSummary& summary);
 
@@ -42,7 +45,7 @@ struct LostContext {
 };
 
 // The follower's median tempo over the frames it did not flag lost (over every frame when fewer
-// than a tenth were followed); 1 without frames.
+// than a tenth were followed), leaving out frames lost for standing still; 1 without frames.
 float median_followed_tempo(std::span<const FollowResult> results);
 
 // A dancer's own tempo stays within these of the library's (method.md 7 performs 0.7x-1.4x);

@@ -96,6 +96,17 @@ TEST(CliFollowRigs, MostlyLostInputExitsThreeWithCausesUnlessAllowed) {
   EXPECT_EQ(allowed.exit_code, 0) << allowed.output;
 }
 
+TEST(CliFollowRigs, AnInputMostlyStandingStillIsLostAndSaid) {
+  // The Bandai dance as three points against the salsa library: its first 8.5 s stand, hands
+  // hanging, like a salsa take's standing start; a dance moves on, so that is lost too, and named
+  // as a cause.
+  const std::string dance = data_path("bandai/dataset-1_dance-short_normal_001.bvh");
+  const testing::CommandResult lost = run_duet("follow --library " + testing::kSalsaLibrary +
+                                               " --input " + dance + " --input-points head,hands");
+  EXPECT_EQ(lost.exit_code, 3) << lost.output;
+  EXPECT_NE(lost.output.find("still: "), std::string::npos) << lost.output;
+}
+
 TEST(CliFollowRigs, AnInputAtTheWrongRateIsFollowedInFastMotionAndSaid) {
   // A 60 Hz take read at its header's 120 fps: followed at twice the tempo, no frame lost, so the
   // lost diagnosis never runs; the rate alone is warned of, with the rate to pass.
