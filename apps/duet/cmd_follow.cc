@@ -270,7 +270,7 @@ int run_follow(const FollowArgs& args) {
       return kExitFailure;
     }
   }
-  const LostSummary summary = summarise_lost(results, user.frame_rate());
+  const LostSummary summary = summarise_lost(results);
   fmt::print(
       "followed {} frames ({:.1f} s) against {} take(s), {} states: {} jumps, {} lost "
       "frames{}; corrections: {}\n",

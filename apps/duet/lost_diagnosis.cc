@@ -8,7 +8,7 @@
 
 namespace duet::app {
 
-LostSummary summarise_lost(std::span<const FollowResult> results, double frame_rate_hz) {
+LostSummary summarise_lost(std::span<const FollowResult> results) {
   LostSummary summary;
   for (const FollowResult& r : results) {
     summary.held_still += r.held_still ? 1 : 0;
@@ -18,7 +18,6 @@ LostSummary summarise_lost(std::span<const FollowResult> results, double frame_r
     summary.missing += r.missing ? 1 : 0;
     summary.outliers += r.outlier ? 1 : 0;
   }
-  if (frame_rate_hz > 0.0) summary.held_still_s = summary.held_still / frame_rate_hz;
   return summary;
 }
 
@@ -126,7 +125,7 @@ std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostCon
         "still: {:.1f} s of the input held one place of the dance for seconds at a time (the "
         "dancer standing still: lost, since a dance moves on); trim the waiting from the "
         "recording, or pass --allow-lost",
-        summary.held_still_s));
+        context.input_rate_hz > 0.0 ? summary.held_still / context.input_rate_hz : 0.0));
   }
   causes.push_back(
       "dance: the input may not be any part of the library's dance (another dance, a walk, a "

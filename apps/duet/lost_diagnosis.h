@@ -25,11 +25,9 @@ struct LostSummary {
   int missing = 0;   // no usable pose, or the sensor repeated the last one (FollowResult::missing)
   int outliers = 0;  // evidence set aside (FollowResult::outlier)
   int held_still = 0;  // lost only for holding one place for seconds (FollowResult::held_still)
-  double held_still_s = 0.0;  // their input time
   double lost_fraction() const { return frames > 0 ? static_cast<double>(lost) / frames : 0.0; }
 };
-// results: one per input frame at frame_rate_hz.
-LostSummary summarise_lost(std::span<const FollowResult> results, double frame_rate_hz);
+LostSummary summarise_lost(std::span<const FollowResult> results);
 // " (frames without evidence: M missing or repeated, K outliers set aside)", or "" when none.
 std::string describe_set_aside(const LostSummary& summary);
 

@@ -98,10 +98,6 @@ Status FollowParams::validate(int num_states) const {
     return params_error("lost_distance_per_dim must be >= 0, got " +
                         std::to_string(lost_distance_per_dim));
   }
-  if (!(held_place_lost_s >= 0.0f && std::isfinite(held_place_lost_s))) {
-    return params_error("held_place_lost_s must be finite and >= 0, got " +
-                        std::to_string(held_place_lost_s));
-  }
   if (!(held_place_reach_s > 0.0f && std::isfinite(held_place_reach_s))) {
     return params_error("held_place_reach_s must be finite and > 0, got " +
                         std::to_string(held_place_reach_s));
@@ -113,15 +109,16 @@ Status FollowParams::validate(int num_states) const {
   const struct {
     const char* name;
     float value;
-  } noise_levels[] = {{"pause_noise_factor", pause_noise_factor},
+  } non_negative[] = {{"pause_noise_factor", pause_noise_factor},
                       {"pause_noise_allowance", pause_noise_allowance},
                       {"lost_noise_factor", lost_noise_factor},
                       {"lost_residual_factor", lost_residual_factor},
                       {"emission_noise_factor", emission_noise_factor},
                       {"emission_noise_allowance", emission_noise_allowance},
                       {"noise_filter_density", noise_filter_density},
-                      {"noise_filter_allowance", noise_filter_allowance}};
-  for (const auto& level : noise_levels) {
+                      {"noise_filter_allowance", noise_filter_allowance},
+                      {"held_place_lost_s", held_place_lost_s}};
+  for (const auto& level : non_negative) {
     if (!(level.value >= 0.0f && std::isfinite(level.value))) {
       return params_error(std::string(level.name) + " must be finite and >= 0, got " +
                           std::to_string(level.value));
