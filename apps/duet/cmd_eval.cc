@@ -411,8 +411,8 @@ int run_eval(EvalArgs& args) {
       "after {} s followed) jump_old_place_mass {} jump_alike_distance {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
       "lost_residual_factor {} lost_confirm {} s found_confirm {} x lost (at most {} s) "
-      "lost_velocity_cap {}/dim{} held_place_lost {} s (reach {} s) emission_noise_factor "
-      "{} "
+      "lost_velocity_cap {}/dim{} held_place_lost {} s (reach {} s) missing_lost {} s "
+      "emission_noise_factor {} "
       "emission_noise_allowance {} noise_filter_density {} noise_filter_allowance {}\n\n",
       library->takes().size(), library->model().num_states(), library->frame_rate(),
       args.library.role, takes, options.seed, hmm.self_prob, hmm.next_prob, hmm.skip_prob,
@@ -427,8 +427,8 @@ int run_eval(EvalArgs& args) {
       hmm.lost_noise_factor, hmm.lost_residual_factor, hmm.lost_confirm_s,
       hmm.found_confirm_per_lost_s, hmm.found_confirm_max_s, hmm.lost_velocity_cap_per_dim,
       hmm.pause_reported_lost ? " pause_reported_lost" : "", hmm.held_place_lost_s,
-      hmm.held_place_reach_s, hmm.emission_noise_factor, hmm.emission_noise_allowance,
-      hmm.noise_filter_density, hmm.noise_filter_allowance);
+      hmm.held_place_reach_s, hmm.missing_lost_s, hmm.emission_noise_factor,
+      hmm.emission_noise_allowance, hmm.noise_filter_density, hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
   if (!non_dance.value().empty()) {
     fmt::print("\nnon-dance input (motion no part of the library explains; hmm, {}): lost\n",
@@ -521,7 +521,8 @@ Command register_eval(CLI::App& app) {
                  "late-frames, body-size, room-place, partner-role, improv-30hz-noisy, harsh "
                  "(30 Hz, 4 deg per axis + 1 cm noise, 3% repeated frames, a 1.1x body), "
                  "120hz-noisy (a 120 Hz sensor with the noise), dropouts (the noise, and the "
-                 "sensor loses the dancer for 0.3-1 s every 8 s), suit-drift (an inertial "
+                 "sensor loses the dancer for 0.3-1 s every 8 s), stalls (the noise, and the "
+                 "sensor holds its last pose for 0.3-2 s every 8 s), suit-drift (an inertial "
                  "suit: the noise, and every joint off by a calibration error and a slow drift), "
                  "tilted (the noise in a tilted world, as a camera pitched down sees it), occluded "
                  "(the noise, and one arm held where last seen for 0.3-1.5 s every 6 s, as an "

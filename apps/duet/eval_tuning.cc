@@ -62,6 +62,10 @@ const std::vector<FloatRow>& float_rows() {
        "held_place_reach_s: how far (template seconds) the estimate must move to start a new "
        "hold",
        number_between(0.001, 10.0, "s")},
+      {"--missing-lost-s", &FollowParams::missing_lost_s,
+       "missing_lost_s: input without evidence (missing, or the sensor's last pose sent again) "
+       "for longer than this is reported lost (input seconds; 0 for never; all HMM variants)",
+       number_between(0.0, 600.0, "s")},
       {"--lost-velocity-cap-per-dim", &FollowParams::lost_velocity_cap_per_dim,
        "lost_velocity_cap_per_dim: most the velocity blocks add to the lost test's distance, per "
        "dimension of the model (and at most --velocity-cap; inf: the emission's); all HMM "

@@ -550,15 +550,16 @@ Result<Performance> with_head_hands(Performance performance, const PointNoiseOpt
 
 namespace {
 
-// Which frames fall into a tracking loss (FrameLossOptions::gap_every_s); empty when there are
-// none. Its own random stream, so performances without losses stay what they were.
-std::vector<bool> tracking_losses(const Performance& performance, const FrameLossOptions& options) {
-  Rng rng(derive_seed(options.seed, 5));
-  const std::vector<int> spans = random_spans(performance.times_s, options.gap_every_s,
-                                              options.gap_min_s, options.gap_max_s, rng);
-  std::vector<bool> lost(spans.size(), false);
-  for (std::size_t f = 0; f < spans.size(); ++f) lost[f] = spans[f] >= 0;
-  return lost;
+// Which frames fall into spans one every every_s on average, [min_s, max_s] long; empty when
+// there are none. Each kind of span has its own random stream (stream), so performances without
+// it stay what they were.
+std::vector<bool> in_spans(const Performance& performance, const FrameLossOptions& options,
+                           std::uint64_t stream, double every_s, double min_s, double max_s) {
+  Rng rng(derive_seed(options.seed, stream));
+  const std::vector<int> spans = random_spans(performance.times_s, every_s, min_s, max_s, rng);
+  std::vector<bool> in(spans.size(), false);
+  for (std::size_t f = 0; f < spans.size(); ++f) in[f] = spans[f] >= 0;
+  return in;
 }
 
 }  // namespace
@@ -567,7 +568,10 @@ Performance with_frame_loss(Performance performance, const FrameLossOptions& opt
   Rng rng(derive_seed(options.seed, 4));
   const int frames = performance.frame_count();
   const double period = 1.0 / performance.motion.frame_rate();
-  const std::vector<bool> lost = tracking_losses(performance, options);
+  const std::vector<bool> lost =
+      in_spans(performance, options, 5, options.gap_every_s, options.gap_min_s, options.gap_max_s);
+  const std::vector<bool> frozen = in_spans(performance, options, 6, options.freeze_every_s,
+                                            options.freeze_min_s, options.freeze_max_s);
   // Bursts of 1..3 frames (mean 2): a burst starts after a kept frame with probability p, so the
   // dropped fraction is 2p / (1 + 2p).
   const double f = std::clamp(options.drop_fraction, 0.0, 0.9);
@@ -611,7 +615,15 @@ Performance with_frame_loss(Performance performance, const FrameLossOptions& opt
     // Drawn only when asked for: performances without repeats stay what they were.
     const bool repeat =
         options.repeat_fraction > 0.0 && o > 0 && uniform(rng, 0.0, 1.0) < options.repeat_fraction;
-    if (repeat) {
+    if (o > 0 && !frozen.empty() && frozen[ks]) {
+      // A stall: the sensor holds its last pose while the dancer dances on.
+      std::ranges::copy(out.motion.translations_ls(o - 1), out.motion.translations_ls(o).begin());
+      std::ranges::copy(out.motion.rotations_ls(o - 1), out.motion.rotations_ls(o).begin());
+      TruthFrame truth = performance.truth[ks];
+      truth.jump = truth.jump || carry_jump;
+      carry_jump = false;
+      out.truth.push_back(truth);
+    } else if (repeat) {
       std::ranges::copy(out.motion.translations_ls(o - 1), out.motion.translations_ls(o).begin());
       std::ranges::copy(out.motion.rotations_ls(o - 1), out.motion.rotations_ls(o).begin());
       TruthFrame truth = out.truth.back();
@@ -666,6 +678,11 @@ Quat level_as_loaded(Performance& performance) {
   turn_world(performance.motion, level);
   for (std::array<Vec3, 2>& wrists : performance.true_wrists_ws) {
     for (Vec3& wrist : wrists) wrist = level * wrist;
+  }
+  for (Transform& heading : performance.true_headings_ws) {  // still a frame on the floor
+    const Vec3 moved = level * heading.translation;
+    heading = {yaw_rotation(heading_yaw(level * heading.rotation)),
+               Vec3(moved.x(), 0.0, moved.z())};
   }
   return level;
 }
@@ -776,6 +793,9 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
   if (recipe.world_tilt_deg != 0.0) {
     performance = with_world_tilt(std::move(performance), recipe.world_tilt_deg);
   }
+  // A sensor that stalls holds a pose the dancer has left: the partner is scored against the real
+  // body's place and hands (Performance::true_headings_ws, true_wrists_ws), not the held ones.
+  const bool holds_poses = recipe.loss.freeze_every_s > 0.0;
   if (recipe.noise.active()) {
     // The sensor's errors belong to the dancer's body, not to the skeleton the motion is delivered
     // on: they go in before retargeting, so every rig gets the same sensed performance. Put on
@@ -796,15 +816,15 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
       if (level.vec().squaredNorm() > 0.0) turn_world(truth.value().motion, level);
     }
     record_true_wrists(truth.value());
-    if (recipe.head_hands) record_true_headings(truth.value());
+    if (recipe.head_hands || holds_poses) record_true_headings(truth.value());
     performance.true_wrists_ws = std::move(truth.value().true_wrists_ws);
     performance.true_headings_ws = std::move(truth.value().true_headings_ws);
   } else {
     Result<Performance> moved = delivered(std::move(performance), recipe);
     if (!moved) return moved.error();
     performance = std::move(moved).value();
-    if (recipe.head_hands) {
-      level_head_path_as_loaded(performance);
+    if (recipe.head_hands) level_head_path_as_loaded(performance);
+    if (recipe.head_hands || holds_poses) {
       record_true_wrists(performance);
       record_true_headings(performance);
     }

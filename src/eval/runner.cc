@@ -111,6 +111,15 @@ std::vector<EvalCase> standard_cases(const CaseSettings& settings) {
     c.recipe.loss.gap_every_s = 8.0;
   }
   {
+    // A sensor that stalls now and then: a driver or a network stream that stops updating, a
+    // headset that lost tracking and reports its last pose. The dancer dances on.
+    EvalCase& c = add("stalls",
+                      "the take with the noise, the sensor holding its last pose for 0.3-2 s "
+                      "every 8 s (a stalled stream, a headset that lost tracking)");
+    c.recipe.noise = noise;
+    c.recipe.loss.freeze_every_s = 8.0;
+  }
+  {
     // An inertial suit's slow errors: every joint off by its calibration and drifting, as
     // SensorNoiseOptions describes; the white noise on top.
     EvalCase& c = add("suit-drift", fmt::format("an inertial suit: every joint off by {:g} deg of "
@@ -420,6 +429,7 @@ Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const Templ
       params.pause_reported_lost = options.hmm.pause_reported_lost;
       params.held_place_lost_s = options.hmm.held_place_lost_s;
       params.held_place_reach_s = options.hmm.held_place_reach_s;
+      params.missing_lost_s = options.hmm.missing_lost_s;
       params.confidence_window_frames = options.hmm.confidence_window_frames;
       params.max_steps_per_frame = options.hmm.max_steps_per_frame;
       return hmm_tracker(model, params, options, std::move(index));

@@ -44,6 +44,7 @@ FollowParams FollowParams::paper() {
   params.found_confirm_per_lost_s = 0.0f;
   params.pause_reported_lost = true;
   params.held_place_lost_s = 0.0f;
+  params.missing_lost_s = 0.0f;
   return params;
 }
 
@@ -117,7 +118,8 @@ Status FollowParams::validate(int num_states) const {
                       {"emission_noise_allowance", emission_noise_allowance},
                       {"noise_filter_density", noise_filter_density},
                       {"noise_filter_allowance", noise_filter_allowance},
-                      {"held_place_lost_s", held_place_lost_s}};
+                      {"held_place_lost_s", held_place_lost_s},
+                      {"missing_lost_s", missing_lost_s}};
   for (const auto& level : non_negative) {
     if (!(level.value >= 0.0f && std::isfinite(level.value))) {
       return params_error(std::string(level.name) + " must be finite and >= 0, got " +

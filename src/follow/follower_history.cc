@@ -31,6 +31,8 @@ void FollowerHistory::reset() noexcept {
   noise_filter.reset();
   explained_residual.reset();
   held_place.reset();
+  missing_s = 0.0;
+  evidence_confidence = -1.0f;
 }
 
 void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams& params,
@@ -41,7 +43,13 @@ void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams
   if (params.calibrate_confidence) {
     result.confidence =
         ConfidenceCalibration::apply(result.window_mass, result.sensor_noise_per_dim);
+    // Without evidence the band only spreads, and its mass within the window falls (to about 0.4
+    // in 2 s), but the tempo carries the estimate on: `stalls` was 99.7 % within 100 ms with a
+    // mean confidence of ~0.4 on its held frames (calibration error 9.7 %). The last evidence's
+    // confidence stands until missing_lost_s.
+    if (result.missing && evidence_confidence >= 0.0f) result.confidence = evidence_confidence;
   }
+  if (!result.missing) evidence_confidence = result.confidence;
   if (params.tempo_adaptive) {
     const bool band_move = !result.missing && !result.lost && !result.jumped;
     tempo.update(previous_state, result.state, result.steps, dt_s, band_move, limits);
@@ -74,6 +82,15 @@ void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams
       !result.lost) {
     result.lost = true;
     result.held_still = true;
+  }
+  if (!result.missing) {
+    missing_s = 0.0;
+  } else if (dt_s > 0.0 && std::isfinite(dt_s)) {
+    missing_s += dt_s;
+  }
+  if (params.missing_lost_s > 0.0f && missing_s > params.missing_lost_s) {
+    result.lost = true;
+    result.confidence = 0.0f;
   }
 }
 

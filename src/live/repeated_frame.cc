@@ -23,20 +23,14 @@ bool RepeatedFrameDetector::is_repeat(std::span<const Vec3> translations_ls,
                  [](const Vec3& a, const Vec3& b) { return a == b; }) &&
       std::equal(rotations_ls.begin(), rotations_ls.end(), rotations_.begin(),
                  [](const Quat& a, const Quat& b) { return a.coeffs() == b.coeffs(); });
-  if (same) {
-    ++copies_;
-  } else {
+  if (!same) {
     std::copy(translations_ls.begin(), translations_ls.end(), translations_.begin());
     std::copy(rotations_ls.begin(), rotations_ls.end(), rotations_.begin());
-    copies_ = 0;
   }
   has_previous_ = true;
-  return copies_ == 1;  // the first copy; the second on is a hold
+  return same;
 }
 
-void RepeatedFrameDetector::reset() noexcept {
-  has_previous_ = false;
-  copies_ = 0;
-}
+void RepeatedFrameDetector::reset() noexcept { has_previous_ = false; }
 
 }  // namespace duet

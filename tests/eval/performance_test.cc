@@ -514,6 +514,51 @@ TEST(Perturbations, RepeatedFramesShowThePreviousPoseAndPassTheJumpOn) {
   EXPECT_EQ(with_frame_loss(full, same).times_s, lossy.times_s);
 }
 
+// Whether frame a of one clip and frame b of another hold the same pose, bit for bit.
+bool same_pose(const Clip& one, int a, const Clip& other, int b) {
+  const auto t0 = one.translations_ls(a), t1 = other.translations_ls(b);
+  const auto r0 = one.rotations_ls(a), r1 = other.rotations_ls(b);
+  for (std::size_t j = 0; j < t0.size(); ++j) {
+    if (t0[j] != t1[j] || r0[j].coeffs() != r1[j].coeffs()) return false;
+  }
+  return true;
+}
+
+TEST(Perturbations, StallsHoldThePoseWhileTheTruthMovesOn) {
+  const Fixture f = make_fixture(1800);
+  const SourceTake source = f.source();
+  const Performance full = improvise(std::span(&source, 1), improv_options(0.0)).value();  // 40 s
+  FrameLossOptions options;
+  options.freeze_every_s = 4.0;
+  options.seed = 3;
+  ASSERT_TRUE(options.active());
+  const Performance stalled = with_frame_loss(full, options);
+  ASSERT_EQ(stalled.frame_count(), full.frame_count());  // every frame is sent
+  int held = 0, spans = 0;
+  for (int k = 0; k < full.frame_count(); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    EXPECT_DOUBLE_EQ(stalled.times_s[i], full.times_s[i]);
+    // The dancer dances on: the truth is the dancer's own frame, held or not.
+    EXPECT_EQ(stalled.truth[i].template_frame, full.truth[i].template_frame);
+    EXPECT_EQ(stalled.truth[i].jump, full.truth[i].jump);
+    if (same_pose(stalled.motion, k, full.motion, k)) continue;
+    ASSERT_GT(k, 0);
+    ++held;
+    // Bit for bit the pose before, which is the last one the sensor saw.
+    EXPECT_TRUE(same_pose(stalled.motion, k, stalled.motion, k - 1)) << k;
+    spans += same_pose(stalled.motion, k - 1, full.motion, k - 1) ? 1 : 0;  // a span's first
+  }
+  // 0.3-2 s (mean 1.15 s) every 4 s on average: about a fifth of the frames, in a few spans.
+  EXPECT_NEAR(static_cast<double>(held) / full.frame_count(), 1.15 / (4.0 + 1.15), 0.12);
+  EXPECT_GE(spans, 3);
+  EXPECT_LE(static_cast<double>(held) / spans, 2.0 * 60.0);
+  // Without stalls, the other perturbations draw the very same numbers as before.
+  FrameLossOptions same{0.10, 0.20, 1.5, 0.002, 3};
+  const Performance lossy = with_frame_loss(full, same);
+  same.freeze_every_s = 0.0;
+  EXPECT_EQ(with_frame_loss(full, same).times_s, lossy.times_s);
+}
+
 TEST(Perturbations, TrackingLossesDropWholeSpansAndPassTheJumpOn) {
   const Fixture f = make_fixture(1800);  // 30 s at 60 Hz
   const SourceTake source = f.source();

@@ -253,6 +253,47 @@ TEST_F(TrackingTest, APlaceHeldForSecondsIsLostUntilTheDanceMovesOn) {
   for (std::size_t t = 3; t < held.results.size(); ++t) EXPECT_FALSE(held.results[t].lost) << t;
 }
 
+TEST_F(TrackingTest, WithoutEvidenceTheTempoCarriesTheEstimateUntilItIsLost) {
+  // Two seconds of dance, then four seconds with no evidence (a stalled sensor: FollowSession
+  // gives the tracker missing frames) while the dancer dances on, then evidence again.
+  const FollowParams params;
+  ASSERT_FLOAT_EQ(params.missing_lost_s, 3.0f);
+  HmmFollower hmm = HmmFollower::create(model_, params).value();
+  const std::vector<float> none(kDims, std::numeric_limits<float>::quiet_NaN());
+  float evidence_confidence = 0.0f;
+  for (int t = 0; t < 500; ++t) {
+    const bool missing = t >= 120 && t < 360;
+    const FollowResult r = hmm.step(missing ? none : test::features_at(model_, t), 1.0 / 60);
+    ASSERT_EQ(r.missing, missing) << t;
+    const double missing_s = missing ? (t - 119) / 60.0 : 0.0;
+    if (t < 3) continue;
+    if (!missing) {
+      if (t < 360 || t >= 380) {  // a few frames to be followed again after the spell lost
+        EXPECT_FALSE(r.lost) << t;
+        EXPECT_LE(std::abs(r.state - t), 1) << t;
+      }
+      evidence_confidence = r.confidence;
+      continue;
+    }
+    EXPECT_LE(std::abs(r.state - t), 3) << t;  // the band moves on at the dancer's tempo
+    if (std::abs(missing_s - 3.0) < 0.02) continue;
+    EXPECT_EQ(r.lost, missing_s > 3.0) << t;
+    // The last evidence's confidence stands, although the band spreads; lost, none.
+    EXPECT_FLOAT_EQ(r.confidence, missing_s > 3.0 ? 0.0f : evidence_confidence) << t;
+  }
+
+  FollowParams never = params;
+  never.missing_lost_s = 0.0f;
+  HmmFollower patient = HmmFollower::create(model_, never).value();
+  for (int t = 0; t < 360; ++t) {
+    const bool missing = t >= 120;
+    const FollowResult r = patient.step(missing ? none : test::features_at(model_, t), 1.0 / 60);
+    if (t >= 3) {
+      EXPECT_FALSE(r.lost) << t;
+    }
+  }
+}
+
 class LibraryTest : public ::testing::Test {
  protected:
   TemplateModel model_ = test::make_model({400, 300, 500}, kDims, 4);

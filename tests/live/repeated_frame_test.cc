@@ -1,4 +1,4 @@
-// RepeatedFrameDetector: a pose sent again bit for bit is a repeat once; a hold is not.
+// RepeatedFrameDetector: a pose sent again bit for bit is a repeat, as often as it is sent.
 #include "duet/live/repeated_frame.h"
 
 #include <gtest/gtest.h>
@@ -20,13 +20,13 @@ Pose pose(double x) {
           {Quat(Eigen::AngleAxisd(x, Vec3::UnitY())), Quat::Identity()}};
 }
 
-TEST(RepeatedFrameDetector, ASingleRepeatIsSetAsideAHoldIsNot) {
+TEST(RepeatedFrameDetector, EveryCopyOfTheLastPoseIsARepeat) {
   RepeatedFrameDetector detector(2);
   const Pose a = pose(0.1), b = pose(0.2);
   EXPECT_FALSE(detector.is_repeat(a.t, a.r));  // nothing before it
   EXPECT_TRUE(detector.is_repeat(a.t, a.r));   // sent again
-  EXPECT_FALSE(detector.is_repeat(a.t, a.r));  // and again: a hold, evidence
-  EXPECT_FALSE(detector.is_repeat(a.t, a.r));
+  EXPECT_TRUE(detector.is_repeat(a.t, a.r));   // and again: a stalled sensor
+  EXPECT_TRUE(detector.is_repeat(a.t, a.r));
   EXPECT_FALSE(detector.is_repeat(b.t, b.r));
   EXPECT_TRUE(detector.is_repeat(b.t, b.r));
   EXPECT_FALSE(detector.is_repeat(a.t, a.r));

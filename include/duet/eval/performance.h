@@ -56,7 +56,9 @@ struct Performance {
   // the real ones).
   std::vector<std::array<Vec3, 2>> true_wrists_ws;
   // The real body's heading frame (body_heading_frame), one per frame, for a performance reduced
-  // to three points (with_head_hands), whose roles name no hips to take it from; else empty.
+  // to three points (with_head_hands), whose roles name no hips to take it from, or whose sensor
+  // stalls (FrameLossOptions::freeze_every_s: the held pose is not where the dancer is); else
+  // empty. Recorded before the sensor's noise, as true_wrists_ws.
   std::vector<Transform> true_headings_ws;
   // The head height standing the follower is told (SourceSkeleton::head_height_m), metres; 0:
   // none.
@@ -178,7 +180,11 @@ void record_true_headings(Performance& performance);
 // frame's pose, as a sensor that sends a stale sample again does; their truth is the repeated
 // pose's (a jump flag moves on to the next frame). Tracking losses (an occluded suit, a controller
 // out of the headset's view) drop every frame of spans of [gap_min_s, gap_max_s] seconds, one
-// every gap_every_s on average (exponential waits between them; never the first frame).
+// every gap_every_s on average (exponential waits between them; never the first frame). Stalls
+// (a driver or a stream that stops updating, a headset that lost tracking and holds its last
+// pose) deliver every frame of spans of [freeze_min_s, freeze_max_s] seconds, one every
+// freeze_every_s on average, as the pose of the frame before the span, bit for bit; the dancer
+// dances on, so their truth is the dancer's own frame.
 struct FrameLossOptions {
   double drop_fraction = 0.0;
   double late_fraction = 0.0;
@@ -189,10 +195,13 @@ struct FrameLossOptions {
   double gap_every_s = 0.0;  // 0: no tracking losses
   double gap_min_s = 0.3;
   double gap_max_s = 1.0;
+  double freeze_every_s = 0.0;  // 0: no stalls
+  double freeze_min_s = 0.3;
+  double freeze_max_s = 2.0;
 
   bool active() const {
     return drop_fraction > 0.0 || late_fraction > 0.0 || jitter_s > 0.0 || repeat_fraction > 0.0 ||
-           gap_every_s > 0.0;
+           gap_every_s > 0.0 || freeze_every_s > 0.0;
   }
 };
 Performance with_frame_loss(Performance performance, const FrameLossOptions& options);

@@ -177,6 +177,13 @@ struct FollowParams {
   // long"). 0: never.
   float held_place_lost_s = 3.0f;
   float held_place_reach_s = 0.2f;
+  // A frame without evidence (FollowResult::missing: no usable pose, or the sensor sent its last
+  // pose again) moves the band on at the dancer's tempo and keeps the last frame's lost flag and
+  // confidence: the tempo carries the estimate through a stall of seconds (`duet eval`'s `stalls`,
+  // docs/evaluation.md "A sensor that stalls"). Past missing_lost_s of input time in a row
+  // without evidence it is reported lost, with no confidence: nothing says where the dancer is
+  // (a headset taken off, a stream that stopped). 0: never.
+  float missing_lost_s = 3.0f;
   float emission_noise_factor = 4.0f;
   float emission_noise_allowance = 0.003f;
   // Smoothing of the input's posture features by the noise (noise_filter.h): the spectral

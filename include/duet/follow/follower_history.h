@@ -96,6 +96,8 @@ struct FollowerHistory {
   ExplainedResidual explained_residual;
   HeldPlace
       held_place;  // how long the estimate has held one place (FollowParams::held_place_lost_s)
+  double missing_s = 0.0;             // input time without evidence, consecutively (missing_lost_s)
+  float evidence_confidence = -1.0f;  // the last frame with evidence's confidence; < 0: none yet
 };
 
 }  // namespace duet
