@@ -171,7 +171,8 @@ Result<PartnerPerformanceResult> run_partner_performance(const DuetLibrary& libr
       r.step_us = elapsed_us(start, stop);
       const TruthFrame& truth = performance.truth[fs];
       CapturedDuetSampler& sampler = samplers.at(truth.take);
-      // The user's heading: the sensed body's, or for three points the real body's.
+      // The user's heading: the sensed body's, or the real body's for three points and for a
+      // sensor that stalls (Performance::true_headings_ws).
       const Transform user_heading =
           performance.true_headings_ws.empty()
               ? body_heading_frame(out.user_positions_ws, performance.roles)

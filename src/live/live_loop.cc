@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include "duet/motion/body_space.h"
 #include "duet/motion/forward_kinematics.h"
@@ -184,6 +185,7 @@ void LiveLoop::reset() noexcept {
   context_.reset();
   playhead_.reset();
   place_.reset();
+  unseen_user_.reset();
   has_previous_ = false;
 }
 
@@ -239,6 +241,14 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
     }
   } else if (!head_hands_bodies_.empty() && params_.contact) {
     user_pose_.wrist_body_difference_hs = head_hands_wrist_difference_hs(take, position);
+  }
+  // The user as last seen, carried on with the dance while the sensor says nothing new.
+  Transform template_heading = model.alignment().template_heading_at(position);
+  template_heading.translation *= model.spacing_scale(user_pose_.height_m);
+  if (!result.missing) {
+    unseen_user_.seen(user_pose_, template_heading, take);
+  } else if (params_.carry_unseen_user) {
+    unseen_user_.carry(user_pose_, template_heading, take);
   }
   job.frame = static_cast<int>(std::lround(position));
   job.frame_position = position;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <initializer_list>
 #include <map>
 
@@ -456,6 +457,45 @@ TEST(PartnerRun, ThreePointsAreScoredAgainstTheRealBody) {
   EXPECT_LT(m["all"].mean_joint_error_cm, 10.0);
   EXPECT_LT(m["align-only"].mean_joint_error_cm, 10.0);
   EXPECT_LT(m["all"].median_spacing_error_cm, 5.0);
+}
+
+// A sensor that stalls (0.3-2 s held every 8 s) while the dancer dances on: the partner is
+// scored against the real body (Performance::true_headings_ws), and the user carried on as the
+// template dancer moves (PartnerParams::carry_unseen_user) keeps the partner with them; left
+// standing where the sensor stopped, the partner danced on around a user who was not there.
+TEST(PartnerRun, AUserTheSensorStoppedReportingIsCarriedOnWithTheDance) {
+  Result<DuetLibrary> library = take_60_10(InputPoints::kFullBody);
+  ASSERT_TRUE(library) << library.error().message;
+  const DuetLibrary& lib = library.value();
+  const DuetTake& take = lib.takes()[0];
+  const SourceTake source{0, &take.template_motion.clip, take.template_motion.roles};
+  PerformanceRecipe recipe;
+  recipe.noise = {3.0, 0.005, 0};
+  recipe.loss.freeze_every_s = 8.0;
+  Result<Performance> made = make_performance({&source, 1}, recipe, 4);
+  ASSERT_TRUE(made) << made.error().message;
+  const Performance& performance = made.value();
+  ASSERT_EQ(performance.true_headings_ws.size(),
+            static_cast<std::size_t>(performance.frame_count()));
+
+  std::vector<PartnerConfig> configs(2);
+  configs[0].name = "carried";
+  configs[1].name = "held";
+  configs[1].params.carry_unseen_user = false;
+  Result<HmmFollower> hmm = HmmFollower::create(lib.model(), FollowParams{});
+  ASSERT_TRUE(hmm);
+  Result<PartnerPerformanceResult> run = run_partner_performance(
+      lib, performance, std::make_unique<HmmFollower>(std::move(hmm).value()), configs, {});
+  ASSERT_TRUE(run) << run.error().message;
+  const PartnerMetrics carried = run.value().configs[0].summary();
+  const PartnerMetrics held = run.value().configs[1].summary();
+  std::printf(
+      "stalls, take 60_10: joint %.1f / %.1f cm, hand mean %.2f / %.2f cm (carried / held)\n",
+      carried.mean_joint_error_cm, held.mean_joint_error_cm, carried.mean_hand_error_cm,
+      held.mean_hand_error_cm);
+  EXPECT_LT(carried.mean_joint_error_cm, 0.7 * held.mean_joint_error_cm);
+  EXPECT_LT(carried.mean_hand_error_cm, held.mean_hand_error_cm);
+  EXPECT_EQ(carried.crowded_frames, 0);
 }
 
 // Three points of a body other than the template dancer's: the contact IK takes the part of the

@@ -20,6 +20,7 @@
 #include "duet/live/follow_session.h"
 #include "duet/live/partner_place.h"
 #include "duet/live/source_frame.h"
+#include "duet/live/unseen_user.h"
 #include "duet/live/wrists_on_user_body.h"
 #include "duet/partner/head_hands_body.h"
 #include "duet/partner/partner_synthesis.h"
@@ -130,6 +131,7 @@ class LiveLoop {
   ResponsePlayhead playhead_;
   Pose shown_pose_;  // the response sampled at the playhead
   PartnerPlace place_;  // where in the library the partner dances
+  UnseenUser unseen_user_;  // the user carried on through frames without evidence
   double previous_time_s_ = 0.0;
   bool has_previous_ = false;
 };
