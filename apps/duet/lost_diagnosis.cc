@@ -12,6 +12,7 @@ LostSummary summarise_lost(std::span<const FollowResult> results) {
   LostSummary summary;
   for (const FollowResult& r : results) {
     summary.held_still += r.held_still ? 1 : 0;
+    summary.lost_unseen += r.lost && r.missing ? 1 : 0;
     ++summary.frames;
     summary.lost += r.lost ? 1 : 0;
     summary.jumps += r.jumped ? 1 : 0;
@@ -126,6 +127,14 @@ std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostCon
         "dancer standing still: lost, since a dance moves on); trim the waiting from the "
         "recording, or pass --allow-lost",
         context.input_rate_hz > 0.0 ? summary.held_still / context.input_rate_hz : 0.0));
+  }
+  // Stalled: no new pose for seconds (a sensor that stopped updating, poses without numbers).
+  if (summary.lost_unseen > 0 && 10 * summary.lost_unseen >= summary.lost) {
+    causes.push_back(fmt::format(
+        "stalled: {:.1f} s of the input brought no new pose for seconds at a time (the same pose "
+        "sent again, or none: a sensor or stream that stopped updating); cut those stretches, or "
+        "pass --allow-lost",
+        context.input_rate_hz > 0.0 ? summary.lost_unseen / context.input_rate_hz : 0.0));
   }
   causes.push_back(
       "dance: the input may not be any part of the library's dance (another dance, a walk, a "

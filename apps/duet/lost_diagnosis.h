@@ -25,6 +25,7 @@ struct LostSummary {
   int missing = 0;   // no usable pose, or the sensor repeated the last one (FollowResult::missing)
   int outliers = 0;  // evidence set aside (FollowResult::outlier)
   int held_still = 0;  // lost only for holding one place for seconds (FollowResult::held_still)
+  int lost_unseen = 0;  // lost while missing: seconds without a new pose (missing_lost_s)
   double lost_fraction() const { return frames > 0 ? static_cast<double>(lost) / frames : 0.0; }
 };
 LostSummary summarise_lost(std::span<const FollowResult> results);

@@ -1,5 +1,5 @@
 // `duet follow --trace`: a frame the sensor sent twice reaches the follower as missing, and the
-// summary and the trace say so (repeated_frame.h).
+// summary and the trace say so (repeated_frame.h); a sensor that stalls for good is lost, and said.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -31,6 +31,34 @@ std::string write_with_repeated_frame(const std::string& path) {
   std::ofstream out(path);
   for (const std::string& l : lines) out << l << '\n';
   return path;
+}
+
+// Take 60_05 whose sensor stalls at frame 200: every later frame is frame 200 again.
+std::string write_stalled(const std::string& path) {
+  std::ifstream in(data_path("cmu-salsa/bvh/60/60_05_scaled.bvh"));
+  std::vector<std::string> lines;
+  std::string line;
+  std::size_t first_frame = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("Frame Time", 0) == 0) first_frame = lines.size() + 1;
+    lines.push_back(line);
+  }
+  EXPECT_GT(lines.size(), first_frame + 1000);
+  for (std::size_t l = first_frame + 201; l < lines.size(); ++l)
+    lines[l] = lines[first_frame + 200];
+  std::ofstream out(path);
+  for (const std::string& l : lines) out << l << '\n';
+  return path;
+}
+
+TEST(CliFollowTrace, AStalledSensorIsCarriedOnThenLostAndSaid) {
+  // Over 3 s without a new pose is lost (FollowParams::missing_lost_s); most of this input is.
+  const std::string input = write_stalled(::testing::TempDir() + "cli_follow_stalled.bvh");
+  const auto r = run_duet("follow --library " + kSalsaLibrary + " --input " + input +
+                          " --input-fps 60 -o /dev/null");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("stalled: "), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("still: "), std::string::npos) << r.output;  // not standing still
 }
 
 TEST(CliFollowTrace, ARepeatedFrameIsMissingInTheTraceAndTheSummary) {
