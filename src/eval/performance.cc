@@ -523,6 +523,26 @@ Performance with_sensor_noise(Performance performance, const SensorNoiseOptions&
   return performance;
 }
 
+namespace {
+
+// PointNoiseOptions' stalls: each span holds one controller's last pose, left and right in turn.
+// Their own random stream, so performances without them stay what they were.
+void hold_stalled_controllers(Performance& performance, const PointNoiseOptions& options) {
+  Rng rng(derive_seed(options.seed, 9));
+  const std::vector<int> spans = random_spans(performance.times_s, options.stall_every_s,
+                                              options.stall_min_s, options.stall_max_s, rng);
+  Clip& motion = performance.motion;
+  for (int f = 1; f < motion.frame_count() && !spans.empty(); ++f) {
+    const int span = spans[static_cast<std::size_t>(f)];
+    if (span < 0) continue;
+    const auto hand = static_cast<std::size_t>(span % 2 == 0 ? kPointsLeftHand : kPointsRightHand);
+    motion.translations_ls(f)[hand] = motion.translations_ls(f - 1)[hand];
+    motion.rotations_ls(f)[hand] = motion.rotations_ls(f - 1)[hand];
+  }
+}
+
+}  // namespace
+
 Result<Performance> with_head_hands(Performance performance, const PointNoiseOptions& noise) {
   Result<Clip> points = head_hands_clip(performance.motion, performance.roles, noise.offsets);
   if (!points) return points.error();
@@ -544,6 +564,7 @@ Result<Performance> with_head_hands(Performance performance, const PointNoiseOpt
       }
     }
   }
+  hold_stalled_controllers(performance, noise);
   if (noise.taken_out.any()) device_points_to_joints(noise.taken_out, motion);
   return performance;
 }

@@ -115,9 +115,11 @@ std::vector<EvalCase> standard_cases(const CaseSettings& settings) {
     // headset that lost tracking and reports its last pose. The dancer dances on.
     EvalCase& c = add("stalls",
                       "the take with the noise, the sensor holding its last pose for 0.3-2 s "
-                      "every 8 s (a stalled stream, a headset that lost tracking)");
+                      "every 8 s (a stalled stream, a headset that lost tracking); three points: "
+                      "also one controller held 0.3-2 s every 6 s (out of the headset's view)");
     c.recipe.noise = noise;
     c.recipe.loss.freeze_every_s = 8.0;
+    c.recipe.point_noise.stall_every_s = 6.0;
   }
   {
     // An inertial suit's slow errors: every joint off by its calibration and drifting, as

@@ -6,9 +6,11 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <utility>
 
 #include "duet/live/lost_confidence.h"
 #include "duet/live/young_offset_confidence.h"
+#include "duet/motion/head_hands.h"
 
 namespace duet {
 
@@ -21,12 +23,19 @@ Result<FollowSession> FollowSession::create(const DuetLibrary& library,
   const int joints = user_skeleton ? user_skeleton->joint_count() : 0;
   Result<FeatureExtractor> extractor = library.make_extractor(std::move(user_skeleton), user_roles);
   if (!extractor) return Error{"the user's motion: " + extractor.error().message};
-  return FollowSession(library, std::move(extractor).value(), std::move(tracker), bias, joints);
+  // Three points are tracked each on its own: one may stall while the others move on.
+  std::vector<int> tracked_points;
+  if (is_head_hands_input(user_roles)) {
+    tracked_points = {user_roles[Role::kHead], user_roles[Role::kLeftWrist],
+                      user_roles[Role::kRightWrist]};
+  }
+  return FollowSession(library, std::move(extractor).value(), std::move(tracker), bias,
+                       RepeatedFrameDetector(joints, std::move(tracked_points)));
 }
 
 FollowSession::FollowSession(const DuetLibrary& library, FeatureExtractor extractor,
                              std::unique_ptr<Tracker> tracker, const PostureBiasParams& bias,
-                             int joints)
+                             RepeatedFrameDetector repeats)
     : library_(&library),
       extractor_(std::move(extractor)),
       context_(extractor_.make_context()),
@@ -37,7 +46,7 @@ FollowSession::FollowSession(const DuetLibrary& library, FeatureExtractor extrac
             posture_bias_params_for(extractor_.spec().input_points, bias)),
       search_(extractor_.spec().block_begin(FeatureBlock::kPosture),
               extractor_.spec().block_size(FeatureBlock::kPosture), extractor_.dimension()),
-      repeats_(joints) {}
+      repeats_(std::move(repeats)) {}
 
 FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
                                  std::span<const Quat> rotations_ls, double time_s) noexcept {

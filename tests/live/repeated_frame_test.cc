@@ -32,6 +32,27 @@ TEST(RepeatedFrameDetector, EveryCopyOfTheLastPoseIsARepeat) {
   EXPECT_FALSE(detector.is_repeat(a.t, a.r));
 }
 
+TEST(RepeatedFrameDetector, APointTrackedOnItsOwnStallsOnItsOwn) {
+  // Joint 1 is a controller: held where last seen while joint 0 moves on, the frame is a repeat.
+  RepeatedFrameDetector detector(2, {1, 7, -1});  // joints it does not have are left out
+  Pose a = pose(0.1);
+  EXPECT_FALSE(detector.is_repeat(a.t, a.r));
+  a.t[0].x() += 0.01;  // the head moves, the controller holds
+  EXPECT_TRUE(detector.is_repeat(a.t, a.r));
+  a.t[0].x() += 0.01;
+  EXPECT_TRUE(detector.is_repeat(a.t, a.r));
+  a.r[1] = Quat(Eigen::AngleAxisd(0.3, Vec3::UnitX()));  // seen again
+  a.t[0].x() += 0.01;
+  EXPECT_FALSE(detector.is_repeat(a.t, a.r));
+  // Without tracked points (a full body: joints no one moves are never sent otherwise), a joint
+  // held is no repeat.
+  RepeatedFrameDetector body(2);
+  Pose b = pose(0.2);
+  EXPECT_FALSE(body.is_repeat(b.t, b.r));
+  b.t[0].x() += 0.01;
+  EXPECT_FALSE(body.is_repeat(b.t, b.r));
+}
+
 TEST(RepeatedFrameDetector, AnyDifferenceIsANewFrame) {
   RepeatedFrameDetector detector(2);
   Pose a = pose(0.3);

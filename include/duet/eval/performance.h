@@ -247,6 +247,13 @@ struct PointNoiseOptions {
   // What the follower is told of them and takes out after the noise, as `duet follow
   // --device-offsets-cm` and `duet serve` do (device_points_to_joints); zero: nothing.
   DevicePointOffsets taken_out;
+  // A controller out of the headset's view, reported where it was last seen (its world pose,
+  // noise included, held bit for bit, as our viewer sends it) while the head and the other hand
+  // move on: spans of [stall_min_s, stall_max_s] seconds, one every stall_every_s on average,
+  // each holding one hand, left and right in turn. 0: none.
+  double stall_every_s = 0.0;
+  double stall_min_s = 0.3;
+  double stall_max_s = 2.0;
 };
 Result<Performance> with_head_hands(Performance performance, const PointNoiseOptions& noise);
 

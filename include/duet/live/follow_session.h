@@ -69,7 +69,8 @@ class FollowSession {
 
  private:
   FollowSession(const DuetLibrary& library, FeatureExtractor extractor,
-                std::unique_ptr<Tracker> tracker, const PostureBiasParams& bias, int joints);
+                std::unique_ptr<Tracker> tracker, const PostureBiasParams& bias,
+                RepeatedFrameDetector repeats);
   // A grown library: the estimate's take and frame as the captured take's.
   void report_captured_place(FollowResult& result) noexcept;
   // While lost: looks for a posture offset beyond bias_'s learning gate, and adopts it once the
