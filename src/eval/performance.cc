@@ -636,24 +636,19 @@ Performance with_frame_loss(Performance performance, const FrameLossOptions& opt
     // Drawn only when asked for: performances without repeats stay what they were.
     const bool repeat =
         options.repeat_fraction > 0.0 && o > 0 && uniform(rng, 0.0, 1.0) < options.repeat_fraction;
-    if (o > 0 && !frozen.empty() && frozen[ks]) {
-      // A stall: the sensor holds its last pose while the dancer dances on.
-      std::ranges::copy(out.motion.translations_ls(o - 1), out.motion.translations_ls(o).begin());
-      std::ranges::copy(out.motion.rotations_ls(o - 1), out.motion.rotations_ls(o).begin());
-      TruthFrame truth = performance.truth[ks];
-      truth.jump = truth.jump || carry_jump;
-      carry_jump = false;
-      out.truth.push_back(truth);
-    } else if (repeat) {
-      std::ranges::copy(out.motion.translations_ls(o - 1), out.motion.translations_ls(o).begin());
-      std::ranges::copy(out.motion.rotations_ls(o - 1), out.motion.rotations_ls(o).begin());
+    // A stall: the sensor holds its last pose while the dancer dances on (the truth moves on).
+    const bool stalled = o > 0 && !frozen.empty() && frozen[ks];
+    const bool held = stalled || repeat;
+    std::ranges::copy(held ? out.motion.translations_ls(o - 1) : motion.translations_ls(k),
+                      out.motion.translations_ls(o).begin());
+    std::ranges::copy(held ? out.motion.rotations_ls(o - 1) : motion.rotations_ls(k),
+                      out.motion.rotations_ls(o).begin());
+    if (repeat && !stalled) {
       TruthFrame truth = out.truth.back();
       carry_jump = carry_jump || performance.truth[ks].jump;
       truth.jump = false;
       out.truth.push_back(truth);
     } else {
-      std::ranges::copy(motion.translations_ls(k), out.motion.translations_ls(o).begin());
-      std::ranges::copy(motion.rotations_ls(k), out.motion.rotations_ls(o).begin());
       TruthFrame truth = performance.truth[ks];
       truth.jump = truth.jump || carry_jump;
       carry_jump = false;
