@@ -16,39 +16,40 @@ using testing::data_path;
 using testing::kSalsaLibrary;
 using testing::run_duet;
 
+// Take 60_05's BVH lines and the index of its first frame's line.
+struct BvhLines {
+  std::vector<std::string> lines;
+  std::size_t first_frame = 0;
+};
+BvhLines read_take_05() {
+  std::ifstream in(data_path("cmu-salsa/bvh/60/60_05_scaled.bvh"));
+  BvhLines bvh;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("Frame Time", 0) == 0) bvh.first_frame = bvh.lines.size() + 1;
+    bvh.lines.push_back(line);
+  }
+  EXPECT_GT(bvh.lines.size(), bvh.first_frame + 1000);
+  return bvh;
+}
+std::string write_lines(const BvhLines& bvh, const std::string& path) {
+  std::ofstream out(path);
+  for (const std::string& l : bvh.lines) out << l << '\n';
+  return path;
+}
+
 // Take 60_05 with its frame 300 replaced by frame 299: the sensor sent a sample again.
 std::string write_with_repeated_frame(const std::string& path) {
-  std::ifstream in(data_path("cmu-salsa/bvh/60/60_05_scaled.bvh"));
-  std::vector<std::string> lines;
-  std::string line;
-  std::size_t first_frame = 0;
-  while (std::getline(in, line)) {
-    if (line.rfind("Frame Time", 0) == 0) first_frame = lines.size() + 1;
-    lines.push_back(line);
-  }
-  EXPECT_GT(first_frame, 0u);
-  lines[first_frame + 300] = lines[first_frame + 299];
-  std::ofstream out(path);
-  for (const std::string& l : lines) out << l << '\n';
-  return path;
+  BvhLines bvh = read_take_05();
+  bvh.lines[bvh.first_frame + 300] = bvh.lines[bvh.first_frame + 299];
+  return write_lines(bvh, path);
 }
 
 // Take 60_05 whose sensor stalls at frame 200: every later frame is frame 200 again.
 std::string write_stalled(const std::string& path) {
-  std::ifstream in(data_path("cmu-salsa/bvh/60/60_05_scaled.bvh"));
-  std::vector<std::string> lines;
-  std::string line;
-  std::size_t first_frame = 0;
-  while (std::getline(in, line)) {
-    if (line.rfind("Frame Time", 0) == 0) first_frame = lines.size() + 1;
-    lines.push_back(line);
-  }
-  EXPECT_GT(lines.size(), first_frame + 1000);
-  for (std::size_t l = first_frame + 201; l < lines.size(); ++l)
-    lines[l] = lines[first_frame + 200];
-  std::ofstream out(path);
-  for (const std::string& l : lines) out << l << '\n';
-  return path;
+  BvhLines bvh = read_take_05();
+  for (std::size_t l = bvh.first_frame + 201; l < bvh.lines.size(); ++l)
+    bvh.lines[l] = bvh.lines[bvh.first_frame + 200];
+  return write_lines(bvh, path);
 }
 
 TEST(CliFollowTrace, AStalledSensorIsCarriedOnThenLostAndSaid) {
