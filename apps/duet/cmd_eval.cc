@@ -526,7 +526,9 @@ Command register_eval(CLI::App& app) {
                  "suit: the noise, and every joint off by a calibration error and a slow drift), "
                  "tilted (the noise in a tilted world, as a camera pitched down sees it), occluded "
                  "(the noise, and one arm held where last seen for 0.3-1.5 s every 6 s, as an "
-                 "optical system does when the partner hides its markers)")
+                 "optical system does when the partner hides its markers), glitches (the noise, "
+                 "and one joint turned 30-90 deg for 1-3 frames every 2 s, as a marker swap or a "
+                 "flipped limb; three points: also a controller reported 10-40 cm off)")
       ->delimiter(',');
   app.add_flag("--noise-sweep", args->noise_sweep,
                "Also run noise-sweep-0 ... noise-sweep-5: improv-pause with 0 to 5 degrees of "

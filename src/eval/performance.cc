@@ -445,6 +445,51 @@ void hold_occluded_arms(Performance& performance, const SensorNoiseOptions& opti
   }
 }
 
+// A random direction, uniform on the sphere.
+Vec3 random_direction(Rng& rng) {
+  std::normal_distribution<double> component(0.0, 1.0);
+  for (;;) {
+    const Vec3 v(component(rng), component(rng), component(rng));
+    if (v.norm() > 1e-9) return v.normalized();
+  }
+}
+
+// SensorNoiseOptions' glitches: in each span one joint of the trunk, arms or legs (drawn at
+// random among the roles the rig has) turned by one random rotation. Before the noise.
+void turn_glitched_joints(Performance& performance, const SensorNoiseOptions& options) {
+  Rng rng(derive_seed(options.seed, 15));
+  const std::vector<int> spans = random_spans(performance.times_s, options.glitch_every_s,
+                                              options.glitch_min_s, options.glitch_max_s, rng);
+  if (spans.empty()) return;
+  constexpr std::array kGlitchRoles = {
+      Role::kSpine,        Role::kChest,      Role::kNeck,      Role::kHead,
+      Role::kLeftShoulder, Role::kLeftElbow,  Role::kLeftWrist, Role::kRightShoulder,
+      Role::kRightElbow,   Role::kRightWrist, Role::kLeftHip,   Role::kLeftKnee,
+      Role::kLeftAnkle,    Role::kRightHip,   Role::kRightKnee, Role::kRightAnkle};
+  std::vector<int> joints;
+  for (const Role role : kGlitchRoles) {
+    if (performance.roles[role] >= 0) joints.push_back(performance.roles[role]);
+  }
+  if (joints.empty()) return;
+  std::uniform_int_distribution<std::size_t> pick(0, joints.size() - 1);
+  int span = -1;
+  std::size_t joint = 0;
+  Quat turn = Quat::Identity();
+  Clip& motion = performance.motion;
+  for (int f = 1; f < motion.frame_count(); ++f) {
+    const int s = spans[static_cast<std::size_t>(f)];
+    if (s < 0) continue;
+    if (s != span) {
+      span = s;
+      joint = static_cast<std::size_t>(joints[pick(rng)]);
+      const double angle = deg_to_rad(uniform(
+          rng, options.glitch_min_deg, std::max(options.glitch_min_deg, options.glitch_max_deg)));
+      turn = Quat(Eigen::AngleAxisd(angle, random_direction(rng)));
+    }
+    motion.rotations_ls(f)[joint] = (motion.rotations_ls(f)[joint] * turn).normalized();
+  }
+}
+
 // SensorNoiseOptions' slow errors: per joint a constant offset plus a drifting one, as rotation
 // vectors, advanced frame by frame with the performance's timestamps.
 class SlowRotationErrors {
@@ -497,6 +542,7 @@ Performance with_sensor_noise(Performance performance, const SensorNoiseOptions&
   const Skeleton& skeleton = motion.skeleton();
   SlowRotationErrors slow(options, skeleton.joint_count());
   hold_occluded_arms(performance, options);
+  turn_glitched_joints(performance, options);
   for (int f = 0; f < motion.frame_count(); ++f) {
     auto translations = motion.translations_ls(f);
     auto rotations = motion.rotations_ls(f);
@@ -541,6 +587,31 @@ void hold_stalled_controllers(Performance& performance, const PointNoiseOptions&
   }
 }
 
+// PointNoiseOptions' glitches: in each span one controller drawn at random reported a random
+// distance away in one random direction. Their own random stream.
+void displace_glitched_controllers(Performance& performance, const PointNoiseOptions& options) {
+  Rng rng(derive_seed(options.seed, 16));
+  const std::vector<int> spans = random_spans(performance.times_s, options.glitch_every_s,
+                                              options.glitch_min_s, options.glitch_max_s, rng);
+  std::bernoulli_distribution right(0.5);
+  int span = -1;
+  std::size_t hand = kPointsLeftHand;
+  Vec3 offset = Vec3::Zero();
+  Clip& motion = performance.motion;
+  for (int f = 1; f < motion.frame_count() && !spans.empty(); ++f) {
+    const int s = spans[static_cast<std::size_t>(f)];
+    if (s < 0) continue;
+    if (s != span) {
+      span = s;
+      hand = static_cast<std::size_t>(right(rng) ? kPointsRightHand : kPointsLeftHand);
+      offset =
+          uniform(rng, options.glitch_min_m, std::max(options.glitch_min_m, options.glitch_max_m)) *
+          random_direction(rng);
+    }
+    motion.translations_ls(f)[hand] += offset;
+  }
+}
+
 }  // namespace
 
 Result<Performance> with_head_hands(Performance performance, const PointNoiseOptions& noise) {
@@ -564,6 +635,7 @@ Result<Performance> with_head_hands(Performance performance, const PointNoiseOpt
       }
     }
   }
+  displace_glitched_controllers(performance, noise);
   hold_stalled_controllers(performance, noise);
   if (noise.taken_out.any()) device_points_to_joints(noise.taken_out, motion);
   return performance;
@@ -809,9 +881,10 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
   if (recipe.world_tilt_deg != 0.0) {
     performance = with_world_tilt(std::move(performance), recipe.world_tilt_deg);
   }
-  // A sensor that stalls holds a pose the dancer has left: the partner is scored against the real
-  // body's place and hands (Performance::true_headings_ws, true_wrists_ws), not the held ones.
-  const bool holds_poses = recipe.loss.freeze_every_s > 0.0;
+  // A sensor that stalls holds a pose the dancer has left, one that pops turns the trunk the
+  // heading is read from: the partner is scored against the real body's place and hands
+  // (Performance::true_headings_ws, true_wrists_ws), not the sensed ones.
+  const bool holds_poses = recipe.loss.freeze_every_s > 0.0 || recipe.noise.glitch_every_s > 0.0;
   if (recipe.noise.active()) {
     // The sensor's errors belong to the dancer's body, not to the skeleton the motion is delivered
     // on: they go in before retargeting, so every rig gets the same sensed performance. Put on

@@ -150,6 +150,17 @@ std::vector<EvalCase> standard_cases(const CaseSettings& settings) {
     c.recipe.noise = noise;
     c.recipe.noise.occlusion_every_s = 6.0;
   }
+  {
+    // Pops: a joint the tracker gets grossly wrong for a frame or a few (a marker swap, a flipped
+    // limb, a magnetic disturbance; three points: a controller reported elsewhere).
+    EvalCase& c = add("glitches",
+                      "the take with the noise, one joint turned 30-90 deg for 1-3 frames every "
+                      "2 s (a marker swap, a flipped limb); three points: also one controller "
+                      "reported 10-40 cm off for 1-3 frames every 2 s");
+    c.recipe.noise = noise;
+    c.recipe.noise.glitch_every_s = 2.0;
+    c.recipe.point_noise.glitch_every_s = 2.0;
+  }
   // Describe the magnitudes actually used.
   for (EvalCase& c : cases) {
     if (c.name == "harsh") continue;

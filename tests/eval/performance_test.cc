@@ -446,6 +446,84 @@ TEST(Perturbations, AnOccludedArmIsHeldWhereLastSeenWhileTheBodyMovesOn) {
   expect_white_noise_unchanged(clean, [](SensorNoiseOptions& o) { o.occlusion_every_s = 4.0; });
 }
 
+TEST(Perturbations, AGlitchTurnsOneJointGrosslyForAFewFrames) {
+  const Fixture f = make_fixture(1800);
+  const Performance clean = play(f.source(), {});
+  SensorNoiseOptions options;
+  options.glitch_every_s = 1.0;  // 30 s of take: about 30 pops of 0.01-0.05 s
+  options.seed = 5;
+  const Performance popped = with_sensor_noise(clean, options);
+  int popped_frames = 0, pops = 0, run = 0, longest_run = 0;
+  for (int k = 0; k < clean.frame_count(); ++k) {
+    int turned = 0;
+    double angle_deg = 0.0;
+    for (int j = 0; j < clean.motion.joint_count(); ++j) {
+      const auto i = static_cast<std::size_t>(j);
+      const double d =
+          popped.motion.rotations_ls(k)[i].angularDistance(clean.motion.rotations_ls(k)[i]);
+      if (d > 1e-12) {
+        ++turned;
+        angle_deg = rad_to_deg(d);
+        EXPECT_NE(j, 0) << "the root never pops";
+      }
+      EXPECT_EQ(popped.motion.translations_ls(k)[i], clean.motion.translations_ls(k)[i]);
+    }
+    // One joint at a time, turned by 30 to 90 degrees.
+    ASSERT_LE(turned, 1) << "frame " << k;
+    if (turned == 1) {
+      EXPECT_GE(angle_deg, 30.0 - 1e-6) << "frame " << k;
+      EXPECT_LE(angle_deg, 90.0 + 1e-6) << "frame " << k;
+      ++popped_frames;
+      pops += run == 0 ? 1 : 0;
+      longest_run = std::max(longest_run, ++run);
+    } else {
+      run = 0;
+    }
+  }
+  // Spans of at most 0.05 s: 3 frames at 60 Hz, or 4 where a span starts between two frames.
+  EXPECT_GE(pops, 15);
+  EXPECT_LE(longest_run, 4);
+  EXPECT_LT(popped_frames, clean.frame_count() / 10);
+  // The white noise is what it was without glitches: the glitches have their own stream.
+  expect_white_noise_unchanged(clean, [](SensorNoiseOptions& o) { o.glitch_every_s = 1.0; });
+}
+
+TEST(Perturbations, AControllersGlitchReportsOneHandElsewhereForAFewFrames) {
+  const Fixture f = make_fixture(1800);
+  Performance clean = play(f.source(), {});
+  clean.roles = f.roles;
+  PointNoiseOptions quiet;
+  quiet.position_m = 0.0;
+  quiet.rotation_deg = 0.0;
+  PointNoiseOptions glitching = quiet;
+  glitching.glitch_every_s = 1.0;
+  const Result<Performance> points_made = with_head_hands(clean, quiet);
+  const Result<Performance> popped_made = with_head_hands(clean, glitching);
+  ASSERT_TRUE(points_made && popped_made);
+  const Performance* points = &points_made.value();
+  const Performance* popped = &popped_made.value();
+  int popped_frames = 0;
+  for (int k = 0; k < points->frame_count(); ++k) {
+    const auto head = static_cast<std::size_t>(kPointsHead);
+    EXPECT_EQ(popped->motion.translations_ls(k)[head], points->motion.translations_ls(k)[head]);
+    int moved = 0;
+    for (const int hand : {kPointsLeftHand, kPointsRightHand}) {
+      const auto i = static_cast<std::size_t>(hand);
+      const double off =
+          (popped->motion.translations_ls(k)[i] - points->motion.translations_ls(k)[i]).norm();
+      if (off > 1e-12) {
+        ++moved;
+        EXPECT_GE(off, 0.1 - 1e-9) << "frame " << k;
+        EXPECT_LE(off, 0.4 + 1e-9) << "frame " << k;
+      }
+    }
+    ASSERT_LE(moved, 1) << "frame " << k;
+    popped_frames += moved;
+  }
+  EXPECT_GT(popped_frames, 15);
+  EXPECT_LT(popped_frames, points->frame_count() / 10);
+}
+
 // Frames flagged as the start of a jump in a performance's truth.
 int count_jumps(const Performance& performance) {
   return static_cast<int>(

@@ -57,8 +57,9 @@ struct Performance {
   std::vector<std::array<Vec3, 2>> true_wrists_ws;
   // The real body's heading frame (body_heading_frame), one per frame, for a performance reduced
   // to three points (with_head_hands), whose roles name no hips to take it from, or whose sensor
-  // stalls (FrameLossOptions::freeze_every_s: the held pose is not where the dancer is); else
-  // empty. Recorded before the sensor's noise, as true_wrists_ws.
+  // stalls or pops (FrameLossOptions::freeze_every_s, SensorNoiseOptions::glitch_every_s: the
+  // sensed pose is not where the dancer is); else empty. Recorded before the sensor's noise, as
+  // true_wrists_ws.
   std::vector<Transform> true_headings_ws;
   // The head height standing the follower is told (SourceSkeleton::head_height_m), metres; 0:
   // none.
@@ -148,6 +149,13 @@ Result<Performance> recorded_performance(Clip clip, const JointRoles& roles, int
 // waits, never the first frame), in which one arm drawn at random is held where it was last seen
 // (its shoulder's, elbow's and wrist's local rotations frozen while the body moves on, as a live
 // solver holds a segment it cannot see). The white noise goes on on top; its own random stream.
+//
+// Any tracker also pops now and then: a joint grossly wrong for a frame or a few (an optical
+// marker swapped with a neighbour, a depth camera's limb flipped, an inertial sensor's magnetic
+// disturbance): spans of [glitch_min_s, glitch_max_s] seconds, one every glitch_every_s on
+// average, in which one joint of the trunk, arms or legs drawn at random is turned by one random
+// rotation of glitch_min_deg to glitch_max_deg, about a random axis. Before the white noise; its
+// own random stream.
 struct SensorNoiseOptions {
   double rotation_deg = 0.0;
   double position_m = 0.0;
@@ -158,10 +166,15 @@ struct SensorNoiseOptions {
   double occlusion_every_s = 0.0;  // 0: no occlusions
   double occlusion_min_s = 0.3;
   double occlusion_max_s = 1.5;
+  double glitch_every_s = 0.0;  // 0: no glitches
+  double glitch_min_s = 0.01;   // a frame at 30-120 Hz
+  double glitch_max_s = 0.05;   // three frames at 60 Hz
+  double glitch_min_deg = 30.0;
+  double glitch_max_deg = 90.0;
 
   bool active() const {
     return rotation_deg > 0.0 || position_m > 0.0 || bias_deg > 0.0 || drift_deg > 0.0 ||
-           occlusion_every_s > 0.0;
+           occlusion_every_s > 0.0 || glitch_every_s > 0.0;
   }
 };
 Performance with_sensor_noise(Performance performance, const SensorNoiseOptions& options);
@@ -254,6 +267,15 @@ struct PointNoiseOptions {
   double stall_every_s = 0.0;
   double stall_min_s = 0.3;
   double stall_max_s = 2.0;
+  // A controller's tracking glitch (the headset's cameras take one controller for the other or
+  // lose its constellation for a frame): spans of [glitch_min_s, glitch_max_s] seconds, one
+  // every glitch_every_s on average, in which one controller drawn at random is reported
+  // glitch_min_m to glitch_max_m away from where it is, in one random direction. 0: none.
+  double glitch_every_s = 0.0;
+  double glitch_min_s = 0.01;
+  double glitch_max_s = 0.05;
+  double glitch_min_m = 0.1;
+  double glitch_max_m = 0.4;
 };
 Result<Performance> with_head_hands(Performance performance, const PointNoiseOptions& noise);
 
