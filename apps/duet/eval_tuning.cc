@@ -105,6 +105,10 @@ const std::vector<FloatRow>& float_rows() {
        "outlier_pause_fraction: the outlier gate sets a frame aside only when its best distance "
        "is beyond this share of the pause level",
        non_negative_check()},
+      {"--outlier-max-s", &FollowParams::outlier_max_s,
+       "outlier_max_s: how long the outlier gate sets a run of outlier frames aside (input "
+       "seconds; 0 for one frame only)",
+       number_between(0.0, 10.0, "s")},
       {"--jump-hold", &FollowParams::jump_hold_s,
        "jump_hold_s: how long a far place must hold the posterior's maximum before it is "
        "reported as a jump (template seconds; 0 for at once)",

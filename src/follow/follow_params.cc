@@ -139,6 +139,7 @@ Status FollowParams::validate(int num_states) const {
   } bounded[] = {{"lost_confirm_s", lost_confirm_s, 10, " s"},
                  {"found_confirm_per_lost_s", found_confirm_per_lost_s, 10, ""},
                  {"found_confirm_max_s", found_confirm_max_s, 10, " s"},
+                 {"outlier_max_s", outlier_max_s, 10, " s"},
                  {"jump_hold_s", jump_hold_s, 10, " s"},
                  {"noisy_jump_hold_s", noisy_jump_hold_s, 10, " s"},
                  {"unexplained_jump_hold_s", unexplained_jump_hold_s, 10, " s"},

@@ -21,6 +21,7 @@ void FollowerHistory::reset() noexcept {
   previous_state = -1;
   previous_lost = false;
   previous_outlier = false;
+  outlier_run_s = 0.0;
   lost_by_distance = false;
   ceiling_lost.reset();
   against_s = 0.0;
@@ -66,6 +67,7 @@ void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams
   previous_state = result.state;
   previous_lost = result.lost;
   previous_outlier = result.outlier;
+  outlier_run_s = result.outlier ? outlier_run_s + result.steps / model.frame_rate_hz() : 0.0;
   // A limb out of line at the estimate (a held arm, a wave) is not the rig's residual: taught, it
   // raised the lost level (the Bandai wave looped for 30 s, limb floor 0.05: 82 % lost against
   // 89 % untaught; FollowParams::limb_outlier_ratio).

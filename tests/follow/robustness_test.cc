@@ -163,7 +163,7 @@ TEST_F(RobustnessTest, FeaturesFarFromEveryTemplateFrame) {
   }
 }
 
-TEST_F(RobustnessTest, AnOutlierFrameIsSetAsideAndASecondInARowIsEvidence) {
+TEST_F(RobustnessTest, OutlierFramesAreSetAsideForOutlierMaxSThenAreEvidence) {
   std::vector<float> outlier(kDims, 30.0f);
   outlier[0] = -30.0f;
   {
@@ -187,14 +187,47 @@ TEST_F(RobustnessTest, AnOutlierFrameIsSetAsideAndASecondInARowIsEvidence) {
     track(hmm, 102, 10);
   }
   {
-    // Two in a row: the second is evidence, the pause state takes the mass.
+    // A tracker's pop of three frames: each is set aside, the estimate moves on along the band,
+    // and the dance is followed on after it with no jump.
     HmmFollower hmm = HmmFollower::create(model_, {}).value();
+    track(hmm, 0, 100);
+    for (int k = 0; k < 3; ++k) {
+      const FollowResult r = hmm.step(outlier, kDt);
+      EXPECT_TRUE(r.outlier) << k;
+      EXPECT_FALSE(r.in_pause) << k;
+      EXPECT_FALSE(r.jumped) << k;
+    }
+    FollowResult r;
+    for (int i = 104; i < 110; ++i) {
+      r = hmm.step(template_frame(i), kDt);
+      EXPECT_FALSE(r.jumped) << i;
+    }
+    EXPECT_EQ(r.state, 109);
+    EXPECT_FALSE(r.lost);
+  }
+  {
+    // A run is set aside for outlier_max_s (0.1 s: 6 frames at 60 Hz); the next frame is evidence:
+    // the dancer really left the library, and the pause state takes the mass.
+    const FollowParams params;
+    ASSERT_FLOAT_EQ(params.outlier_max_s, 0.1f);
+    HmmFollower hmm = HmmFollower::create(model_, params).value();
+    track(hmm, 0, 100);
+    for (int k = 0; k < 6; ++k) EXPECT_TRUE(hmm.step(outlier, kDt).outlier) << k;
+    const FollowResult seventh = hmm.step(outlier, kDt);
+    EXPECT_FALSE(seventh.outlier);
+    EXPECT_TRUE(seventh.in_pause);
+    EXPECT_TRUE(seventh.lost);
+  }
+  {
+    // outlier_max_s 0: one frame only, the second in a row is evidence.
+    FollowParams params;
+    params.outlier_max_s = 0.0f;
+    HmmFollower hmm = HmmFollower::create(model_, params).value();
     track(hmm, 0, 100);
     EXPECT_TRUE(hmm.step(outlier, kDt).outlier);
     const FollowResult second = hmm.step(outlier, kDt);
     EXPECT_FALSE(second.outlier);
     EXPECT_TRUE(second.in_pause);
-    EXPECT_TRUE(second.lost);
   }
   {
     // Without the gate the first one already hands the pause state the mass.

@@ -296,10 +296,10 @@ struct FollowParams {
   // seed 1). docs/evaluation.md, "A catch-up is no jump". 0: every far move can be a jump.
   float jump_catch_up_s = 0.5f;
   // Outlier gate: a frame whose evidence would hand the pause state the majority right after a
-  // frame that was followed (the first placement settled, that frame neither lost nor itself an
-  // outlier) is taken for an outlier of the sensor: its evidence is set aside (transitions only,
-  // as for a dropped frame). A second such frame in a row is evidence again: the dancer really
-  // jumped, paused or left the library, one frame later. Without it one outlier frame at 4
+  // frame that was followed (the first placement settled, that frame not lost) is taken for an
+  // outlier of the sensor: its evidence is set aside (transitions only, as for a dropped frame).
+  // Such frames in a row are set aside for outlier_max_s of input time; the next is evidence
+  // again: the dancer really jumped, paused or left the library. Without it one outlier frame at 4
   // degrees per axis moved the posterior to the pause state and from there to a look-alike place
   // and back (two false jumps); innovation gating, as in a Kalman filter's measurement gate.
   bool gate_outliers = true;
@@ -310,6 +310,12 @@ struct FollowParams {
   // the pause majority after a followed frame had a best distance of at most 0.4 of the pause
   // level at true jumps (434 of 437), at least 0.6 without one (73 of 74).
   float outlier_pause_fraction = 0.5f;
+  // How long a run of outlier frames is set aside (input seconds; 0: one frame only, as until
+  // session 52). A tracker's pop lasts a frame or a few (a marker swap, a flipped limb): with one
+  // frame set aside, the second put the pause state in the majority and the estimate on another
+  // take for a frame, where the partner went and came back (`glitches`: a planted foot sliding at
+  // 11.6 m/s). docs/evaluation.md, "A sensor that pops".
+  float outlier_max_s = 0.1f;
 
   // Input at another rate: each input frame applies n = clamp(round(dt_s * template_fps), 1,
   // max_steps_per_frame) template-rate transitions before its emission. The cap also bounds a

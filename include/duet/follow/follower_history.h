@@ -30,12 +30,14 @@ struct FollowerHistory {
   // Whether this frame is an outlier whose evidence is set aside (FollowParams::gate_outliers):
   // its evidence would hand the pause state the majority, its best squared distance is beyond
   // outlier_pause_fraction of the pause level's (pause_distance_sq), and the previous frame was
-  // followed: the first placement settled, the frame neither lost nor itself an outlier.
+  // followed (the first placement settled, the frame not lost) or an outlier of a run shorter
+  // than outlier_max_s (whose first frame followed one that was).
   bool is_outlier(const FollowParams& params, bool pause_majority, float best_distance_sq,
                   float pause_distance_sq) const noexcept {
     return params.gate_outliers && pause_majority &&
            best_distance_sq > params.outlier_pause_fraction * pause_distance_sq &&
-           previous_state >= 0 && !previous_lost && !previous_outlier &&
+           previous_state >= 0 &&
+           (previous_outlier ? outlier_run_s < params.outlier_max_s - 1e-6 : !previous_lost) &&
            jump_gate.held_a_place(params);
   }
 
@@ -85,6 +87,7 @@ struct FollowerHistory {
   int previous_state = -1;
   bool previous_lost = false;
   bool previous_outlier = false;   // the previous frame's evidence was set aside (outlier gate)
+  double outlier_run_s = 0.0;      // input time of the outlier frames up to it, in a row
   bool lost_by_distance = false;   // confirm_unexplained's decision
   CeilingLostReport ceiling_lost;  // report_lost's ceiling test
   double against_s = 0.0;          // input time the frames have disagreed with it, consecutively
