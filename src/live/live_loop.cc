@@ -242,10 +242,11 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   } else if (!head_hands_bodies_.empty() && params_.contact) {
     user_pose_.wrist_body_difference_hs = head_hands_wrist_difference_hs(take, position);
   }
-  // The user as last seen, carried on with the dance while the sensor says nothing new.
+  // The user as last seen, carried on with the dance while the sensor says nothing new, or
+  // nothing the follower believes (an outlier frame: a tracker's pop, set aside by the follower).
   Transform template_heading = model.alignment().template_heading_at(position);
   template_heading.translation *= model.spacing_scale(user_pose_.height_m);
-  if (!result.missing) {
+  if (!result.missing && !result.outlier) {
     unseen_user_.seen(user_pose_, template_heading, take);
   } else if (params_.carry_unseen_user) {
     unseen_user_.carry(user_pose_, template_heading, take);

@@ -498,6 +498,49 @@ TEST(PartnerRun, AUserTheSensorStoppedReportingIsCarriedOnWithTheDance) {
   EXPECT_EQ(carried.crowded_frames, 0);
 }
 
+// A tracker's pops (a joint turned 30-90 degrees for a frame or a few) are outliers to the
+// follower, which sets a run of them aside (FollowParams::outlier_max_s), and the partner carries
+// the user through them as through a stall (UnseenUser): a turned spine turned the body's heading
+// the partner is placed in, and the partner with it, its planted feet sliding.
+TEST(PartnerRun, ATrackersPopsDoNotMoveThePartner) {
+  Result<DuetLibrary> library = take_60_10(InputPoints::kFullBody);
+  ASSERT_TRUE(library) << library.error().message;
+  const DuetLibrary& lib = library.value();
+  const DuetTake& take = lib.takes()[0];
+  const SourceTake source{0, &take.template_motion.clip, take.template_motion.roles};
+  PerformanceRecipe recipe;
+  recipe.noise = {3.0, 0.005, 0};
+  recipe.noise.glitch_every_s = 1.0;
+  Result<Performance> made = make_performance({&source, 1}, recipe, 4);
+  ASSERT_TRUE(made) << made.error().message;
+
+  const auto run = [&](const FollowParams& follow, bool carry) {
+    std::vector<PartnerConfig> configs(1);
+    configs[0].params.carry_unseen_user = carry;
+    Result<HmmFollower> hmm = HmmFollower::create(lib.model(), follow);
+    EXPECT_TRUE(hmm);
+    Result<PartnerPerformanceResult> result = run_partner_performance(
+        lib, made.value(), std::make_unique<HmmFollower>(std::move(hmm).value()), configs, {});
+    EXPECT_TRUE(result) << result.error().message;
+    return result.value().configs[0].summary();
+  };
+  FollowParams one_frame;  // as until session 52: one outlier frame set aside, the pose as sensed
+  one_frame.outlier_max_s = 0.0f;
+  const PartnerMetrics before = run(one_frame, false);
+  const PartnerMetrics after = run(FollowParams{}, true);
+  std::printf(
+      "pops, take 60_10: largest planted slide %.2f / %.2f m/s, frames over %lld / %lld, "
+      "joint %.2f / %.2f cm, hand mean %.2f / %.2f cm (before / after)\n",
+      before.max_slide_mps, after.max_slide_mps, before.sliding_frames, after.sliding_frames,
+      before.mean_joint_error_cm, after.mean_joint_error_cm, before.mean_hand_error_cm,
+      after.mean_hand_error_cm);
+  EXPECT_LT(after.max_slide_mps, 0.5 * before.max_slide_mps);
+  EXPECT_LT(after.sliding_frames, before.sliding_frames);
+  // Scored against the real body: carried through a pop the user is no further from it.
+  EXPECT_LT(after.mean_joint_error_cm, before.mean_joint_error_cm + 0.1);
+  EXPECT_LT(after.mean_hand_error_cm, before.mean_hand_error_cm + 0.1);
+}
+
 // Three points of a body other than the template dancer's: the contact IK takes the part of the
 // hand's difference the body makes whole (LiveLoop: the template dancer scaled to the user's size,
 // each hand shifted by the offset the follower takes off the hands' places, told by the body

@@ -228,11 +228,11 @@ struct PartnerParams {
   // noise (every joint's above the hand) swung the offset by centimetres. false: by the sensed
   // turn. Measured in docs/evaluation.md ("What the hand's difference is trusted for").
   bool steady_hand_turn = true;
-  // align and contact: through frames without evidence (a stalled sensor, a pose missing) the
-  // user is carried on from where last seen as the template dancer moves, body and hands
-  // (UnseenUser, used by LiveLoop), instead of standing frozen where the sensor stopped while the
-  // partner dances on. false: the held pose as it is. Measured in docs/evaluation.md ("A sensor
-  // that stalls").
+  // align and contact: through frames without evidence (a stalled sensor, a pose missing, an
+  // outlier the follower set aside: a tracker's pop) the user is carried on from where last seen as
+  // the template dancer moves, body and hands (UnseenUser, used by LiveLoop), instead of standing
+  // frozen where the sensor stopped while the partner dances on. false: the held pose as it is.
+  // Measured in docs/evaluation.md ("A sensor that stalls").
   bool carry_unseen_user = true;
   // smooth: the response is shown at a real frame that advances at the dancer's tempo
   // (response_playhead.h; used by LiveLoop, which samples the pose there and passes it as
