@@ -230,6 +230,7 @@ FollowParams follow_params_for(InputPoints points, FollowParams params) {
   if (points == InputPoints::kHeadHands) {
     params.unexplained_jump_hold_s = kHeadHandsUnexplainedJumpHoldS;
     params.found_confirm_per_lost_s = 0.0f;
+    params.outlier_max_s = kHeadHandsOutlierMaxS;
   }
   return params;
 }

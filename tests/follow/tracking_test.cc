@@ -176,6 +176,8 @@ TEST(VelocityCap, LetsThePostureDecideWhileTheVelocitiesAreCorrupt) {
   const TemplateModel model = test::make_model({600}, kDims, 8, 60.0, 6);
   FollowParams capped;
   capped.velocity_distance_cap = 0.5f;
+  // The cap alone: the outlier gate sets such a run aside too (FollowParams::outlier_max_s).
+  capped.gate_outliers = false;
   FollowParams uncapped = capped;
   uncapped.velocity_distance_cap = std::numeric_limits<float>::infinity();
   HmmFollower with = HmmFollower::create(model, capped).value();

@@ -314,7 +314,7 @@ struct FollowParams {
   // session 52). A tracker's pop lasts a frame or a few (a marker swap, a flipped limb): with one
   // frame set aside, the second put the pause state in the majority and the estimate on another
   // take for a frame, where the partner went and came back (`glitches`: a planted foot sliding at
-  // 11.6 m/s). docs/evaluation.md, "A sensor that pops".
+  // 11.6 m/s). Three points keep 0 (follow_params_for). docs/evaluation.md, "A sensor that pops".
   float outlier_max_s = 0.1f;
 
   // Input at another rate: each input frame applies n = clamp(round(dt_s * template_fps), 1,

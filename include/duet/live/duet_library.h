@@ -78,8 +78,13 @@ struct DuetTake {
 // accuracy: the shorter decision delay is kept).
 // Nor do they take a longer wait to be found again after a spell lost
 // (FollowParams::found_confirm_per_lost_s: their improvised cases' frames lost although followed
-// doubled). `duet follow`, `duet serve` and `duet eval` make their trackers with it.
+// doubled). Nor do they set a run of outlier frames aside (FollowParams::outlier_max_s), one
+// frame only: the frames a true jump lands on fit the new place less closely than a body's, and
+// set aside for 0.05-0.1 s they cost the improvised cases up to 0.7 points within 100 ms on the
+// proportioned rig (docs/evaluation.md, "A sensor that pops").
+// `duet follow`, `duet serve` and `duet eval` make their trackers with it.
 inline constexpr float kHeadHandsUnexplainedJumpHoldS = 0.3f;
+inline constexpr float kHeadHandsOutlierMaxS = 0.0f;
 FollowParams follow_params_for(InputPoints points, FollowParams params);
 // The rig offset's parameters for these input points: three points average it over
 // PostureBiasParams::head_hands_time_constant_s (also while the sensor is noisy). FollowSession
