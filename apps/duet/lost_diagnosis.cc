@@ -120,21 +120,26 @@ std::vector<std::string> diagnose_lost(const LostSummary& summary, const LostCon
         "rate: the input runs at {:g} fps and the library at {:g} fps (fine if both are right)",
         context.input_rate_hz, context.library_rate_hz));
   }
+  // Stretches that account for a tenth of the lost frames or more are named, with their seconds.
+  const auto explains_lost = [&](int frames) { return frames > 0 && 10 * frames >= summary.lost; };
+  const auto seconds = [&](int frames) {
+    return context.input_rate_hz > 0.0 ? frames / context.input_rate_hz : 0.0;
+  };
   // Standing still: a dance moves on, so seconds held at one place are lost (HeldPlace).
-  if (summary.held_still > 0 && 10 * summary.held_still >= summary.lost) {
+  if (explains_lost(summary.held_still)) {
     causes.push_back(fmt::format(
         "still: {:.1f} s of the input held one place of the dance for seconds at a time (the "
         "dancer standing still: lost, since a dance moves on); trim the waiting from the "
         "recording, or pass --allow-lost",
-        context.input_rate_hz > 0.0 ? summary.held_still / context.input_rate_hz : 0.0));
+        seconds(summary.held_still)));
   }
   // Stalled: no new pose for seconds (a sensor that stopped updating, poses without numbers).
-  if (summary.lost_unseen > 0 && 10 * summary.lost_unseen >= summary.lost) {
+  if (explains_lost(summary.lost_unseen)) {
     causes.push_back(fmt::format(
         "stalled: {:.1f} s of the input brought no new pose for seconds at a time (the same pose "
         "sent again, or none: a sensor or stream that stopped updating); cut those stretches, or "
         "pass --allow-lost",
-        context.input_rate_hz > 0.0 ? summary.lost_unseen / context.input_rate_hz : 0.0));
+        seconds(summary.lost_unseen)));
   }
   causes.push_back(
       "dance: the input may not be any part of the library's dance (another dance, a walk, a "

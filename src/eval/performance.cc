@@ -407,42 +407,46 @@ std::vector<int> random_spans(const std::vector<double>& times_s, double every_s
   return span_of;
 }
 
-// SensorNoiseOptions' occlusions: per frame, the arm (Side) held still, -1 for none. Spans from
-// random_spans, each holding one arm drawn at random; their own random stream.
-std::vector<int> occluded_arms(const Performance& performance, const SensorNoiseOptions& options) {
-  Rng rng(derive_seed(options.seed, 8));
-  std::vector<int> arm_of = random_spans(performance.times_s, options.occlusion_every_s,
-                                         options.occlusion_min_s, options.occlusion_max_s, rng);
-  std::vector<int> arm_of_span;
-  std::bernoulli_distribution right(0.5);
-  for (int& arm : arm_of) {
-    if (arm < 0) continue;
-    while (static_cast<int>(arm_of_span.size()) <= arm) arm_of_span.push_back(right(rng) ? 1 : 0);
-    arm = arm_of_span[static_cast<std::size_t>(arm)];
+// Calls begin(span) as each span of random_spans' spans begins, then at(frame) on each of its
+// frames, in frame order (a span's random draws in begin keep their order in the stream).
+template <typename Begin, typename At>
+void for_each_span_frame(const std::vector<int>& spans, Begin&& begin, At&& at) {
+  int current = -1;
+  for (std::size_t f = 1; f < spans.size(); ++f) {
+    const int span = spans[f];
+    if (span < 0) continue;
+    if (span != current) {
+      current = span;
+      begin(span);
+    }
+    at(static_cast<int>(f));
   }
-  return arm_of;
 }
 
-// An occluded arm keeps its shoulder's, elbow's and wrist's local rotations of the frame before
-// the occlusion began, while the rest of the body moves on. Before the noise, which the sensor
-// goes on adding.
+// SensorNoiseOptions' occlusions: in each span one arm drawn at random keeps its shoulder's,
+// elbow's and wrist's local rotations of the frame before the occlusion began, while the rest of
+// the body moves on. Their own random stream; before the noise, which the sensor goes on adding.
 void hold_occluded_arms(Performance& performance, const SensorNoiseOptions& options) {
-  const std::vector<int> occluded = occluded_arms(performance, options);
+  Rng rng(derive_seed(options.seed, 8));
+  const std::vector<int> spans =
+      random_spans(performance.times_s, options.occlusion_every_s, options.occlusion_min_s,
+                   options.occlusion_max_s, rng);
   constexpr std::array<std::array<Role, 3>, 2> kArmJoints = {
       {{Role::kLeftShoulder, Role::kLeftElbow, Role::kLeftWrist},
        {Role::kRightShoulder, Role::kRightElbow, Role::kRightWrist}}};
+  std::bernoulli_distribution right(0.5);
+  std::size_t arm = 0;
   Clip& motion = performance.motion;
-  for (std::size_t f = 1; f < occluded.size(); ++f) {
-    const int arm = occluded[f];
-    if (arm < 0) continue;
-    const int frame = static_cast<int>(f);
-    for (const Role role : kArmJoints[static_cast<std::size_t>(arm)]) {
-      const int joint = performance.roles[role];
-      if (joint < 0) continue;
-      const auto i = static_cast<std::size_t>(joint);
-      motion.rotations_ls(frame)[i] = motion.rotations_ls(frame - 1)[i];
-    }
-  }
+  for_each_span_frame(
+      spans, [&](int) { arm = right(rng) ? 1 : 0; },
+      [&](int frame) {
+        for (const Role role : kArmJoints[arm]) {
+          const int joint = performance.roles[role];
+          if (joint < 0) continue;
+          const auto i = static_cast<std::size_t>(joint);
+          motion.rotations_ls(frame)[i] = motion.rotations_ls(frame - 1)[i];
+        }
+      });
 }
 
 // A random direction, uniform on the sphere.
@@ -472,22 +476,20 @@ void turn_glitched_joints(Performance& performance, const SensorNoiseOptions& op
   }
   if (joints.empty()) return;
   std::uniform_int_distribution<std::size_t> pick(0, joints.size() - 1);
-  int span = -1;
   std::size_t joint = 0;
   Quat turn = Quat::Identity();
   Clip& motion = performance.motion;
-  for (int f = 1; f < motion.frame_count(); ++f) {
-    const int s = spans[static_cast<std::size_t>(f)];
-    if (s < 0) continue;
-    if (s != span) {
-      span = s;
-      joint = static_cast<std::size_t>(joints[pick(rng)]);
-      const double angle = deg_to_rad(uniform(
-          rng, options.glitch_min_deg, std::max(options.glitch_min_deg, options.glitch_max_deg)));
-      turn = Quat(Eigen::AngleAxisd(angle, random_direction(rng)));
-    }
-    motion.rotations_ls(f)[joint] = (motion.rotations_ls(f)[joint] * turn).normalized();
-  }
+  for_each_span_frame(
+      spans,
+      [&](int) {
+        joint = static_cast<std::size_t>(joints[pick(rng)]);
+        const double angle = deg_to_rad(uniform(
+            rng, options.glitch_min_deg, std::max(options.glitch_min_deg, options.glitch_max_deg)));
+        turn = Quat(Eigen::AngleAxisd(angle, random_direction(rng)));
+      },
+      [&](int f) {
+        motion.rotations_ls(f)[joint] = (motion.rotations_ls(f)[joint] * turn).normalized();
+      });
 }
 
 // SensorNoiseOptions' slow errors: per joint a constant offset plus a drifting one, as rotation
@@ -577,14 +579,17 @@ void hold_stalled_controllers(Performance& performance, const PointNoiseOptions&
   Rng rng(derive_seed(options.seed, 9));
   const std::vector<int> spans = random_spans(performance.times_s, options.stall_every_s,
                                               options.stall_min_s, options.stall_max_s, rng);
+  std::size_t hand = kPointsLeftHand;
   Clip& motion = performance.motion;
-  for (int f = 1; f < motion.frame_count() && !spans.empty(); ++f) {
-    const int span = spans[static_cast<std::size_t>(f)];
-    if (span < 0) continue;
-    const auto hand = static_cast<std::size_t>(span % 2 == 0 ? kPointsLeftHand : kPointsRightHand);
-    motion.translations_ls(f)[hand] = motion.translations_ls(f - 1)[hand];
-    motion.rotations_ls(f)[hand] = motion.rotations_ls(f - 1)[hand];
-  }
+  for_each_span_frame(
+      spans,
+      [&](int span) {
+        hand = static_cast<std::size_t>(span % 2 == 0 ? kPointsLeftHand : kPointsRightHand);
+      },
+      [&](int f) {
+        motion.translations_ls(f)[hand] = motion.translations_ls(f - 1)[hand];
+        motion.rotations_ls(f)[hand] = motion.rotations_ls(f - 1)[hand];
+      });
 }
 
 // PointNoiseOptions' glitches: in each span one controller drawn at random reported a random
@@ -594,22 +599,18 @@ void displace_glitched_controllers(Performance& performance, const PointNoiseOpt
   const std::vector<int> spans = random_spans(performance.times_s, options.glitch_every_s,
                                               options.glitch_min_s, options.glitch_max_s, rng);
   std::bernoulli_distribution right(0.5);
-  int span = -1;
   std::size_t hand = kPointsLeftHand;
   Vec3 offset = Vec3::Zero();
   Clip& motion = performance.motion;
-  for (int f = 1; f < motion.frame_count() && !spans.empty(); ++f) {
-    const int s = spans[static_cast<std::size_t>(f)];
-    if (s < 0) continue;
-    if (s != span) {
-      span = s;
-      hand = static_cast<std::size_t>(right(rng) ? kPointsRightHand : kPointsLeftHand);
-      offset =
-          uniform(rng, options.glitch_min_m, std::max(options.glitch_min_m, options.glitch_max_m)) *
-          random_direction(rng);
-    }
-    motion.translations_ls(f)[hand] += offset;
-  }
+  for_each_span_frame(
+      spans,
+      [&](int) {
+        hand = static_cast<std::size_t>(right(rng) ? kPointsRightHand : kPointsLeftHand);
+        offset = uniform(rng, options.glitch_min_m,
+                         std::max(options.glitch_min_m, options.glitch_max_m)) *
+                 random_direction(rng);
+      },
+      [&](int f) { motion.translations_ls(f)[hand] += offset; });
 }
 
 }  // namespace
@@ -884,7 +885,8 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
   // A sensor that stalls holds a pose the dancer has left, one that pops turns the trunk the
   // heading is read from: the partner is scored against the real body's place and hands
   // (Performance::true_headings_ws, true_wrists_ws), not the sensed ones.
-  const bool holds_poses = recipe.loss.freeze_every_s > 0.0 || recipe.noise.glitch_every_s > 0.0;
+  const bool senses_a_false_body =
+      recipe.loss.freeze_every_s > 0.0 || recipe.noise.glitch_every_s > 0.0;
   if (recipe.noise.active()) {
     // The sensor's errors belong to the dancer's body, not to the skeleton the motion is delivered
     // on: they go in before retargeting, so every rig gets the same sensed performance. Put on
@@ -905,7 +907,7 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
       if (level.vec().squaredNorm() > 0.0) turn_world(truth.value().motion, level);
     }
     record_true_wrists(truth.value());
-    if (recipe.head_hands || holds_poses) record_true_headings(truth.value());
+    if (recipe.head_hands || senses_a_false_body) record_true_headings(truth.value());
     performance.true_wrists_ws = std::move(truth.value().true_wrists_ws);
     performance.true_headings_ws = std::move(truth.value().true_headings_ws);
   } else {
@@ -913,7 +915,7 @@ Result<Performance> make_performance(std::span<const SourceTake> sources,
     if (!moved) return moved.error();
     performance = std::move(moved).value();
     if (recipe.head_hands) level_head_path_as_loaded(performance);
-    if (recipe.head_hands || holds_poses) {
+    if (recipe.head_hands || senses_a_false_body) {
       record_true_wrists(performance);
       record_true_headings(performance);
     }

@@ -459,6 +459,35 @@ TEST(PartnerRun, ThreePointsAreScoredAgainstTheRealBody) {
   EXPECT_LT(m["all"].median_spacing_error_cm, 5.0);
 }
 
+// Take 60_10 (the library's only take) danced through a sensor with 3 degrees and 5 mm of noise
+// and the failures `recipe` adds (seed 4).
+Performance sensed_60_10(const DuetLibrary& library, PerformanceRecipe recipe) {
+  const DuetTake& take = library.takes()[0];
+  const SourceTake source{0, &take.template_motion.clip, take.template_motion.roles};
+  recipe.noise.rotation_deg = 3.0;
+  recipe.noise.position_m = 0.005;
+  recipe.noise.seed = 0;
+  Result<Performance> made = make_performance({&source, 1}, recipe, 4);
+  EXPECT_TRUE(made) << made.error().message;
+  EXPECT_EQ(made.value().true_headings_ws.size(),
+            static_cast<std::size_t>(made.value().frame_count()));
+  return std::move(made).value();
+}
+
+// The partner's metrics (every correction, `partner` for its parameters) of a live loop with the
+// hmm tracker following `performance` with `follow`.
+PartnerMetrics partner_metrics(const DuetLibrary& library, const Performance& performance,
+                               const FollowParams& follow, const PartnerParams& partner) {
+  std::vector<PartnerConfig> configs(1);
+  configs[0].params = partner;
+  Result<HmmFollower> hmm = HmmFollower::create(library.model(), follow);
+  EXPECT_TRUE(hmm);
+  Result<PartnerPerformanceResult> run = run_partner_performance(
+      library, performance, std::make_unique<HmmFollower>(std::move(hmm).value()), configs, {});
+  EXPECT_TRUE(run) << run.error().message;
+  return run.value().configs[0].summary();
+}
+
 // A sensor that stalls (0.3-2 s held every 8 s) while the dancer dances on: the partner is
 // scored against the real body (Performance::true_headings_ws), and the user carried on as the
 // template dancer moves (PartnerParams::carry_unseen_user) keeps the partner with them; left
@@ -466,29 +495,15 @@ TEST(PartnerRun, ThreePointsAreScoredAgainstTheRealBody) {
 TEST(PartnerRun, AUserTheSensorStoppedReportingIsCarriedOnWithTheDance) {
   Result<DuetLibrary> library = take_60_10(InputPoints::kFullBody);
   ASSERT_TRUE(library) << library.error().message;
-  const DuetLibrary& lib = library.value();
-  const DuetTake& take = lib.takes()[0];
-  const SourceTake source{0, &take.template_motion.clip, take.template_motion.roles};
-  PerformanceRecipe recipe;
-  recipe.noise = {3.0, 0.005, 0};
-  recipe.loss.freeze_every_s = 8.0;
-  Result<Performance> made = make_performance({&source, 1}, recipe, 4);
-  ASSERT_TRUE(made) << made.error().message;
-  const Performance& performance = made.value();
-  ASSERT_EQ(performance.true_headings_ws.size(),
-            static_cast<std::size_t>(performance.frame_count()));
-
-  std::vector<PartnerConfig> configs(2);
-  configs[0].name = "carried";
-  configs[1].name = "held";
-  configs[1].params.carry_unseen_user = false;
-  Result<HmmFollower> hmm = HmmFollower::create(lib.model(), FollowParams{});
-  ASSERT_TRUE(hmm);
-  Result<PartnerPerformanceResult> run = run_partner_performance(
-      lib, performance, std::make_unique<HmmFollower>(std::move(hmm).value()), configs, {});
-  ASSERT_TRUE(run) << run.error().message;
-  const PartnerMetrics carried = run.value().configs[0].summary();
-  const PartnerMetrics held = run.value().configs[1].summary();
+  PerformanceRecipe stalls;
+  stalls.loss.freeze_every_s = 8.0;
+  const Performance performance = sensed_60_10(library.value(), stalls);
+  PartnerParams held_params;
+  held_params.carry_unseen_user = false;
+  const PartnerMetrics carried =
+      partner_metrics(library.value(), performance, FollowParams{}, PartnerParams{});
+  const PartnerMetrics held =
+      partner_metrics(library.value(), performance, FollowParams{}, held_params);
   std::printf(
       "stalls, take 60_10: joint %.1f / %.1f cm, hand mean %.2f / %.2f cm (carried / held)\n",
       carried.mean_joint_error_cm, held.mean_joint_error_cm, carried.mean_hand_error_cm,
@@ -505,29 +520,16 @@ TEST(PartnerRun, AUserTheSensorStoppedReportingIsCarriedOnWithTheDance) {
 TEST(PartnerRun, ATrackersPopsDoNotMoveThePartner) {
   Result<DuetLibrary> library = take_60_10(InputPoints::kFullBody);
   ASSERT_TRUE(library) << library.error().message;
-  const DuetLibrary& lib = library.value();
-  const DuetTake& take = lib.takes()[0];
-  const SourceTake source{0, &take.template_motion.clip, take.template_motion.roles};
-  PerformanceRecipe recipe;
-  recipe.noise = {3.0, 0.005, 0};
-  recipe.noise.glitch_every_s = 1.0;
-  Result<Performance> made = make_performance({&source, 1}, recipe, 4);
-  ASSERT_TRUE(made) << made.error().message;
-
-  const auto run = [&](const FollowParams& follow, bool carry) {
-    std::vector<PartnerConfig> configs(1);
-    configs[0].params.carry_unseen_user = carry;
-    Result<HmmFollower> hmm = HmmFollower::create(lib.model(), follow);
-    EXPECT_TRUE(hmm);
-    Result<PartnerPerformanceResult> result = run_partner_performance(
-        lib, made.value(), std::make_unique<HmmFollower>(std::move(hmm).value()), configs, {});
-    EXPECT_TRUE(result) << result.error().message;
-    return result.value().configs[0].summary();
-  };
+  PerformanceRecipe pops;
+  pops.noise.glitch_every_s = 1.0;
+  const Performance performance = sensed_60_10(library.value(), pops);
   FollowParams one_frame;  // as until session 52: one outlier frame set aside, the pose as sensed
   one_frame.outlier_max_s = 0.0f;
-  const PartnerMetrics before = run(one_frame, false);
-  const PartnerMetrics after = run(FollowParams{}, true);
+  PartnerParams as_sensed;
+  as_sensed.carry_unseen_user = false;
+  const PartnerMetrics before = partner_metrics(library.value(), performance, one_frame, as_sensed);
+  const PartnerMetrics after =
+      partner_metrics(library.value(), performance, FollowParams{}, PartnerParams{});
   std::printf(
       "pops, take 60_10: largest planted slide %.2f / %.2f m/s, frames over %lld / %lld, "
       "joint %.2f / %.2f cm, hand mean %.2f / %.2f cm (before / after)\n",
@@ -560,13 +562,8 @@ TEST(PartnerRun, ThreePointsOfAnotherBodyHaveTheirHandsMet) {
   auto median_hand_error = [&](const PerformanceRecipe& recipe) {
     Result<Performance> performance = make_performance({&source, 1}, recipe, 7);
     EXPECT_TRUE(performance) << performance.error().message;
-    Result<HmmFollower> hmm = HmmFollower::create(lib.model(), FollowParams{});
-    EXPECT_TRUE(hmm);
-    const std::vector<PartnerConfig> all = {standard_partner_configs()[0]};
-    Result<PartnerPerformanceResult> run = run_partner_performance(
-        lib, performance.value(), std::make_unique<HmmFollower>(std::move(hmm).value()), all, {});
-    EXPECT_TRUE(run) << run.error().message;
-    const PartnerMetrics m = run.value().configs[0].summary();
+    const PartnerMetrics m = partner_metrics(lib, performance.value(), FollowParams{},
+                                             standard_partner_configs()[0].params);
     EXPECT_GT(m.hand_samples, 100);
     return m.median_hand_error_cm;
   };
