@@ -12,13 +12,14 @@ namespace duet {
 // ---------------------------------------------------------------------------------------------
 // ForwardContext
 
-void ForwardContext::resize(int num_states) {
+void ForwardContext::resize(int num_states, int num_dims) {
   assert(num_states > 0);
   num_states_ = num_states;
   const auto size = static_cast<std::size_t>(num_states);
   alpha_.assign(size + 1, 0.0f);
   scratch_.assign(size + 1, 0.0f);
   distance_sq_.assign(size, 0.0f);
+  carried_.assign(static_cast<std::size_t>(std::max(num_dims, 0)), 0.0f);
   reset();
 }
 
@@ -26,6 +27,8 @@ void ForwardContext::reset() noexcept {
   if (num_states_ == 0) return;
   std::fill(alpha_.begin(), alpha_.end() - 1, 1.0f / static_cast<float>(num_states_));
   alpha_.back() = 0.0f;
+  carry_from_ = -1;
+  carry_ahead_ = 0.0;
   history_.reset();
 }
 
@@ -198,9 +201,15 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   if (context.num_states_ != num_states) return result;
   assert(features.size() == static_cast<std::size_t>(model.num_dims()));
 
-  result.missing = features.size() != static_cast<std::size_t>(model.num_dims()) ||
-                   !follow_detail::all_finite(features);
   result.steps = steps_for(dt_s);
+  const bool sized = features.size() == static_cast<std::size_t>(model.num_dims());
+  const bool observed = sized && follow_detail::all_finite(features);
+  std::span<const float> evidence = features;
+  if (sized && !observed && carry_unobserved(features, result.steps, context)) {
+    evidence = context.carried_;
+    result.partly_observed = true;
+  }
+  result.missing = !observed && !result.partly_observed;
 
   // Input slower than the template (or late): the HMM runs at the template rate, so the band is
   // applied once per elapsed template frame before the emission.
@@ -210,13 +219,14 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
     context.alpha_.swap(context.scratch_);
   }
 
-  context.history_.sensor_noise.update(features, dt_s, !result.missing);
+  // The noise is read from observed frames only: carried values have none.
+  context.history_.sensor_noise.update(features, dt_s, observed);
   result.sensor_noise_per_dim = context.history_.sensor_noise.variance_per_dim();
   const float noise = result.sensor_noise_per_dim;
   const float* phi = nullptr;  // the filtered features, while the frame has them
   float best_plain = 0.0f;
   if (!result.missing) {
-    phi = context.history_.noise_filter.apply(features, dt_s, noise).data();
+    phi = context.history_.noise_filter.apply(evidence, dt_s, noise).data();
     best_plain = emit_all_states(phi, noise, context.history_, context.alpha_, context.scratch_,
                                  context.distance_sq_.data(), result)
                      .plain;
@@ -241,7 +251,60 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
   context.history_.jump_gate.apply(model, params_, alpha, 1.0f, context.history_.previous_state,
                                    context.history_.previous_lost, result, unexplained);
   context.history_.finish_step(model, params_, tempo_limits_, unexplained, dt_s, result);
+  note_carry_anchor(observed, result, context);
   return result;
+}
+
+namespace {
+// A stall longer than this carries nothing: a place moved on at the tempo for longer drifts from
+// the dance (the `stalls` case holds a controller for up to 2 s; FollowParams::missing_lost_s
+// calls a frame without evidence lost after 3 s).
+constexpr double kMaxCarryS = 3.0;
+}  // namespace
+
+bool HmmForward::carry_unobserved(std::span<const float> features, int steps,
+                                  ForwardContext& context) const noexcept {
+  const TemplateModel& model = *model_;
+  const int from = context.carry_from_;
+  const double ahead = context.carry_ahead_ + steps * static_cast<double>(context.tempo());
+  if (from < 0 || from >= model.num_states() || ahead > kMaxCarryS * model.frame_rate_hz() ||
+      context.carried_.size() != features.size()) {
+    return false;
+  }
+  const int take = model.take_of(from);
+  const int expected = std::clamp(from + static_cast<int>(std::lround(ahead)),
+                                  model.take_begin(take), model.take_end(take) - 1);
+  const auto row = model.features().row(expected);
+  // NaN is unobserved; an infinity is a broken frame, no evidence at all.
+  bool any_observed = false;
+  for (std::size_t d = 0; d < features.size(); ++d) {
+    if (std::isinf(features[d])) return false;
+    const bool seen = !std::isnan(features[d]);
+    any_observed = any_observed || seen;
+    context.carried_[d] = seen ? features[d] : row(static_cast<Eigen::Index>(d));
+  }
+  return any_observed;
+}
+
+void HmmForward::note_carry_anchor(bool observed, const FollowResult& result,
+                                   ForwardContext& context) const noexcept {
+  const bool followed = !result.missing && !result.lost && !result.in_pause && !result.outlier;
+  if (observed) {
+    context.carry_from_ = followed ? result.state : -1;
+    context.carry_ahead_ = 0.0;
+    return;
+  }
+  if (context.carry_from_ < 0) return;
+  context.carry_ahead_ += result.steps * static_cast<double>(context.tempo());
+  // A partly observed frame followed close to where the carry expected it moves the carry on
+  // with it (a dancer's tempo drifts while a controller is unseen); a far move does not.
+  constexpr double kNearFrames = 6.0;
+  const int from = context.carry_from_;
+  if (followed && model_->take_of(result.state) == model_->take_of(from) &&
+      std::abs(result.state - (from + context.carry_ahead_)) <= kNearFrames) {
+    context.carry_from_ = result.state;
+    context.carry_ahead_ = 0.0;
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -250,7 +313,7 @@ FollowResult HmmForward::step(std::span<const float> features, double dt_s,
 Result<HmmFollower> HmmFollower::create(const TemplateModel& model, const FollowParams& params) {
   Result<HmmForward> forward = HmmForward::create(model, params);
   if (!forward.ok()) return forward.error();
-  ForwardContext context(model.num_states());
+  ForwardContext context(model.num_states(), model.num_dims());
   context.history() = FollowerHistory(model, params);
   return HmmFollower(std::move(forward).value(), std::move(context));
 }

@@ -106,6 +106,40 @@ TEST_F(RobustnessTest, MissingFramesAreFlaggedAndDoNotPoisonTheState) {
   track(hmm, 151, 20);
 }
 
+// A frame with some dimensions NaN (a controller out of the headset's view, FollowSession) is
+// evidence on the others: the unobserved ones are carried along the dance from the last followed
+// estimate. A dancer speeding up to 1.5x while a third of the dimensions are unseen is followed by
+// the rest, not held to the carried tempo. Before any frame was followed nothing can be carried:
+// such a frame is missing; so is one with an infinity (a broken frame, not an unseen part).
+TEST_F(RobustnessTest, PartlyObservedFramesAreEvidenceOnTheRest) {
+  HmmFollower hmm = HmmFollower::create(model_, {}).value();
+  std::vector<float> first = template_frame(0);
+  first[0] = kNaN;
+  EXPECT_TRUE(hmm.step(first, kDt).missing);
+  hmm.reset();
+  track(hmm, 0, 100);
+  double position = 100.0;
+  for (int k = 0; k < 60; ++k, position += 1.5) {
+    std::vector<float> phi = test::features_at(model_, position);
+    for (int d = 0; d < kDims / 3; ++d) phi[static_cast<std::size_t>(d)] = kNaN;
+    const FollowResult r = hmm.step(phi, kDt);
+    EXPECT_TRUE(r.partly_observed);
+    EXPECT_FALSE(r.missing);
+    EXPECT_NE(r.log_likelihood, 0.0);
+    expect_valid_result(r, model_);
+    expect_valid_alpha(hmm);
+    if (k >= 10) {
+      EXPECT_LE(std::abs(r.state - position), 2.0) << "frame " << k;
+    }
+  }
+  std::vector<float> broken = test::features_at(model_, position);
+  broken[0] = kNaN;
+  broken[1] = kInf;
+  const FollowResult r = hmm.step(broken, kDt);
+  EXPECT_TRUE(r.missing);
+  EXPECT_FALSE(r.partly_observed);
+}
+
 TEST_F(RobustnessTest, FramesOfZeros) {
   HmmFollower hmm = HmmFollower::create(model_, {}).value();
   track(hmm, 200, 20);

@@ -29,6 +29,10 @@ struct FollowResult {
   bool held_still = false;
   bool in_pause = false;  // the pause state holds most of the posterior mass
   bool missing = false;   // the input held NaN/inf: transition only, no emission
+  // Some of the input's dimensions were NaN, the rest evidence (a controller out of the
+  // headset's view): the unobserved ones were carried along the dance (the hmm trackers; the
+  // others take such a frame as missing).
+  bool partly_observed = false;
   // An outlier frame (FollowParams::gate_outliers): its evidence would have handed the pause
   // state the majority right after a frame that was followed, so it was set aside like a dropped
   // frame's (the estimate moved on along the band).
