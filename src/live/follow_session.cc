@@ -50,7 +50,13 @@ FollowSession::FollowSession(const DuetLibrary& library, FeatureExtractor extrac
 
 FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
                                  std::span<const Quat> rotations_ls, double time_s) noexcept {
-  if (repeats_.is_repeat(translations_ls, rotations_ls)) {
+  const bool repeat = repeats_.is_repeat(translations_ls, rotations_ls);
+  // Three points: a controller out of the headset's view repeats its last pose while the head
+  // moves on. The head and the other hand are still evidence (mark_unseen_hands).
+  const bool only_hands_repeat = repeat &&
+                                 extractor_.spec().input_points == InputPoints::kHeadHands &&
+                                 !repeats_.whole_pose_repeated() && !repeats_.point_repeated(0);
+  if (repeat && !only_hands_repeat) {
     // No new evidence, and kept out of the velocities: the tracker moves its band on.
     std::ranges::fill(features_, std::numeric_limits<float>::quiet_NaN());
   } else {
@@ -63,6 +69,7 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
     has_previous_ = true;
   }
   bias_.correct(features_);
+  const bool partly_unseen = mark_unseen_hands(time_s);
   FollowResult result = tracker_->step(features_, dt_s);
   // Learn only from frames the library explains well: a motion that is no dance (a walk) must
   // stay lost, not teach the offset that would make it look like one. A step of the estimate
@@ -82,7 +89,8 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
       previous_state_ >= 0 && !result.jumped &&
       (!same_take || std::abs(result.state - previous_state_) > kFarFrames);
   previous_state_ = result.state;
-  if (!result.jumped && !stepped_back && !moved_unreported && !result.missing && !result.in_pause &&
+  if (!result.jumped && !stepped_back && !moved_unreported && !result.missing && !partly_unseen &&
+      !result.in_pause &&
       result.best_distance_per_dim <=
           bias_.params().learn_distance_limit(result.sensor_noise_per_dim) &&
       result.state >= 0 && result.state < library_->model().num_states()) {
@@ -92,7 +100,7 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
                                        static_cast<std::size_t>(rows.cols())),
                 dt_s, result.confidence, result.sensor_noise_per_dim);
   }
-  search_offset(result, dt_s);
+  if (!partly_unseen) search_offset(result, dt_s);
   // A frame without evidence neither breaks nor extends a lost run.
   if (!result.missing) bias_.note_lost(result.lost, dt_s);
   result.rig_offset = bias_.offset_rms();
@@ -108,6 +116,37 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
   }
   if (library_->grown()) report_captured_place(result);
   return result;
+}
+
+bool FollowSession::mark_unseen_hands(double time_s) noexcept {
+  if (extractor_.spec().input_points != InputPoints::kHeadHands || !std::isfinite(features_[0]) ||
+      !std::isfinite(time_s)) {
+    return false;
+  }
+  bool marked = false;
+  constexpr float kUnseen = std::numeric_limits<float>::quiet_NaN();
+  for (int side = 0; side < 2; ++side) {
+    const auto s = static_cast<std::size_t>(side);
+    const std::array<int, 4> dims = extractor_.spec().hand_point_dims(side);
+    if (repeats_.point_repeated(1 + s)) {
+      for (const int d : dims) features_[static_cast<std::size_t>(d)] = kUnseen;
+      hand_held_[s] = true;
+      marked = true;
+      continue;
+    }
+    if (hand_held_[s]) {
+      hand_held_[s] = false;
+      hand_seen_again_at_s_[s] = time_s;
+    }
+    // Seen again: until the first frame seen again is old enough to be the speed's reference
+    // sample (FeatureExtractor::velocity_reference), the speed is a difference from the place the
+    // hand was held at.
+    if (time_s - hand_seen_again_at_s_[s] < extractor_.spec().velocity_window_s) {
+      features_[static_cast<std::size_t>(dims[3])] = kUnseen;
+      marked = true;
+    }
+  }
+  return marked;
 }
 
 void FollowSession::search_offset(const FollowResult& result, double dt_s) noexcept {
@@ -217,6 +256,8 @@ void FollowSession::reset() noexcept {
   has_previous_ = false;
   previous_state_ = -1;
   previous_place_ = {};
+  hand_held_ = {false, false};
+  hand_seen_again_at_s_.fill(-std::numeric_limits<double>::infinity());
 }
 
 }  // namespace duet

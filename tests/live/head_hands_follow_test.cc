@@ -504,6 +504,42 @@ TEST(HeadHandsFollow, ANoisyHeadsetTakeIsFollowed) {
   EXPECT_GT(flickering.lost, 3 * followed.lost + 5) << flickering.lost << " of " << frames;
 }
 
+// A controller out of the headset's view is reported where it was last seen while the head and
+// the other hand move on: the frames are evidence on those (FollowResult::partly_observed, the
+// hand carried along the dance), not frames without evidence, and the dance is followed through.
+TEST(HeadHandsFollow, AControllerOutOfViewLeavesTheHeadAndTheOtherHandAsEvidence) {
+  const LoadedMotion take = load_take("60_07");
+  Performance performance = noisy_points(take);
+  constexpr int kHeldFrom = 600, kHeldTo = 720;  // 2 s
+  Clip& motion = performance.motion;
+  const auto hand = static_cast<std::size_t>(kPointsLeftHand);
+  for (int f = kHeldFrom; f < kHeldTo; ++f) {
+    motion.translations_ls(f)[hand] = motion.translations_ls(kHeldFrom - 1)[hand];
+    motion.rotations_ls(f)[hand] = motion.rotations_ls(kHeldFrom - 1)[hand];
+  }
+  FollowSession session =
+      hmm_session(head_hands_library(), motion.skeleton_ptr(), performance.roles, FollowParams{});
+  int partly = 0, within = 0, jumps = 0, lost = 0;
+  for (int f = 0; f < kHeldTo + 120; ++f) {
+    const FollowResult r =
+        session.step(motion.translations_ls(f), motion.rotations_ls(f), f / 60.0);
+    if (f < kHeldFrom) continue;
+    EXPECT_FALSE(r.missing) << "frame " << f;
+    partly += r.partly_observed ? 1 : 0;
+    within += (r.take == 6 && std::abs(r.frame_in_take - f) <= 6) ? 1 : 0;
+    jumps += r.jumped ? 1 : 0;
+    lost += r.lost ? 1 : 0;
+  }
+  // The held frames, and the hand's speed while it still spans a held place: until the first
+  // frame seen again is the velocity window (0.1 s) old.
+  int window = 0;
+  while ((kHeldTo + window) / 60.0 - kHeldTo / 60.0 < 0.1) ++window;
+  EXPECT_EQ(partly, kHeldTo - kHeldFrom + window);
+  EXPECT_GE(within, 0.95 * (kHeldTo - kHeldFrom + 120)) << within;
+  EXPECT_EQ(jumps, 0);
+  EXPECT_EQ(lost, 0);
+}
+
 TEST(HeadHandsFollow, ADanceFasterThanItsTakeIsNotLost) {
   // The evaluation's `tempo-fast` case on take 60_07 as three points with a headset's noise: the
   // take danced 1.4x faster than captured. Its velocities are 1.4x the take's; over three

@@ -39,11 +39,19 @@ TEST(RepeatedFrameDetector, APointTrackedOnItsOwnStallsOnItsOwn) {
   EXPECT_FALSE(detector.is_repeat(a.t, a.r));
   a.t[0].x() += 0.01;  // the head moves, the controller holds
   EXPECT_TRUE(detector.is_repeat(a.t, a.r));
+  EXPECT_FALSE(detector.whole_pose_repeated());
+  EXPECT_TRUE(detector.point_repeated(0));  // which one: its place in the list
+  EXPECT_FALSE(detector.point_repeated(1));
+  EXPECT_FALSE(detector.point_repeated(2));
   a.t[0].x() += 0.01;
   EXPECT_TRUE(detector.is_repeat(a.t, a.r));
+  EXPECT_TRUE(detector.is_repeat(a.t, a.r));  // the whole pose again
+  EXPECT_TRUE(detector.whole_pose_repeated());
   a.r[1] = Quat(Eigen::AngleAxisd(0.3, Vec3::UnitX()));  // seen again
   a.t[0].x() += 0.01;
   EXPECT_FALSE(detector.is_repeat(a.t, a.r));
+  EXPECT_FALSE(detector.whole_pose_repeated());
+  EXPECT_FALSE(detector.point_repeated(0));
   // Without tracked points (a full body: joints no one moves are never sent otherwise), a joint
   // held is no repeat.
   RepeatedFrameDetector body(2);

@@ -14,6 +14,7 @@
 // the skeleton's bones (duet::measure_body).
 #pragma once
 
+#include <array>
 #include <string_view>
 #include <vector>
 
@@ -151,6 +152,13 @@ struct FeatureSpec {
   // (FollowParams::limb_outlier_ratio): a live system holds an arm whose markers the partner
   // hides. Empty for three points, whose hands are the whole posture.
   std::vector<std::vector<int>> limb_dims() const;
+  // Three points: the dimensions one hand's point alone gives (side 0 the left hand, 1 the right):
+  // its place against the head (3) and its speed (1). A controller out of the headset's view
+  // leaves only these unobserved (FollowSession).
+  std::array<int, 4> hand_point_dims(int side) const {
+    const int place = 3 * side;
+    return {place, place + 1, place + 2, block_begin(FeatureBlock::kEffectorSpeed) + side};
+  }
   // First dimension and size of a block.
   int block_begin(FeatureBlock block) const;
   int block_size(FeatureBlock block) const;

@@ -2,6 +2,8 @@
 // the user's pose -> raw features -> standardised features -> tracker step.
 #pragma once
 
+#include <array>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -62,6 +64,11 @@ class FollowSession {
   // full-body user. Allocates nothing.
   std::array<Vec3, 2> hand_offsets() const noexcept;
 
+  // Three points: whether the last frame reported hand `side` (0 left, 1 right) where its
+  // controller last was, out of the headset's view (FollowResult::partly_observed).
+  bool hand_unseen(int side) const noexcept {
+    return side >= 0 && side < 2 && hand_held_[static_cast<std::size_t>(side)];
+  }
   // The standardised features of the last frame, after the rig's posture offset was removed.
   std::span<const float> last_features() const { return features_; }
   const PostureBias& posture_bias() const { return bias_; }
@@ -76,6 +83,10 @@ class FollowSession {
   // While lost: looks for a posture offset beyond bias_'s learning gate, and adopts it once the
   // input with it removed has been explained along the dance for a while (offset_search.h).
   void search_offset(const FollowResult& result, double dt_s) noexcept;
+  // Three points: marks the dimensions of a hand whose controller repeats its last pose (out of
+  // the headset's view) unobserved (NaN), and a hand's speed for the velocity window after it is
+  // seen again; the tracker carries them along the dance (HmmForward). Whether it marked any.
+  bool mark_unseen_hands(double time_s) noexcept;
 
   const DuetLibrary* library_;
   FeatureExtractor extractor_;
@@ -90,6 +101,11 @@ class FollowSession {
   double previous_time_s_ = 0.0;
   bool has_previous_ = false;
   int previous_state_ = -1;  // the estimate of the previous frame
+  // Three points: whether each hand's controller repeated its last pose on the previous frame,
+  // and when it was last seen again after doing so (mark_unseen_hands).
+  std::array<bool, 2> hand_held_{false, false};
+  std::array<double, 2> hand_seen_again_at_s_{-std::numeric_limits<double>::infinity(),
+                                              -std::numeric_limits<double>::infinity()};
   LibraryPlace previous_place_;  // its captured take and frame (a grown library)
 };
 

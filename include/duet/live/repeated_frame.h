@@ -31,13 +31,22 @@ class RepeatedFrameDetector {
   // Remembers the pose. Allocates nothing for poses of the sized joint count.
   bool is_repeat(std::span<const Vec3> translations_ls,
                  std::span<const Quat> rotations_ls) noexcept;
+  // Whether the last pose given to is_repeat was the previous one again as a whole.
+  bool whole_pose_repeated() const noexcept { return whole_; }
+  // Whether tracked point `index` (its place in the constructor's list) repeated in the last
+  // pose given to is_repeat, while the pose as a whole did not or did.
+  bool point_repeated(std::size_t index) const noexcept {
+    return index < point_repeated_.size() && point_repeated_[index];
+  }
   // Forget the previous pose.
   void reset() noexcept;
 
  private:
   std::vector<Vec3> translations_;
   std::vector<Quat> rotations_;
-  std::vector<int> tracked_points_;
+  std::vector<int> tracked_points_;  // -1: a point the skeleton does not have
+  std::vector<bool> point_repeated_;
+  bool whole_ = false;
   bool has_previous_ = false;
 };
 
