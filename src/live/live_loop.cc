@@ -243,10 +243,16 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
     user_pose_.wrist_body_difference_hs = head_hands_wrist_difference_hs(take, position);
   }
   // The user as last seen, carried on with the dance while the sensor says nothing new, or
-  // nothing the follower believes (an outlier frame: a tracker's pop, set aside by the follower).
+  // nothing the follower believes (an outlier frame: a tracker's pop, set aside by the follower);
+  // a hand unseen (a controller out of the headset's view reports where it was) is held against
+  // the body as seen.
   Transform template_heading = model.alignment().template_heading_at(position);
   template_heading.translation *= model.spacing_scale(user_pose_.height_m);
-  if (!result.missing && !result.outlier) {
+  const bool body_seen = !result.missing && !result.outlier;
+  if (body_seen && result.partly_observed && params_.carry_unseen_user) {
+    unseen_user_.hold_hands(user_pose_, {session_.hand_unseen(0), session_.hand_unseen(1)});
+  }
+  if (body_seen) {
     unseen_user_.seen(user_pose_, template_heading, take);
   } else if (params_.carry_unseen_user) {
     unseen_user_.carry(user_pose_, template_heading, take);

@@ -45,4 +45,16 @@ bool UnseenUser::carry(UserPose& user, const Transform& template_heading, int ta
   return true;
 }
 
+bool UnseenUser::hold_hands(UserPose& user, const std::array<bool, 2>& unseen) const noexcept {
+  if (take_ < 0) return false;
+  const Transform onto_seen = body_frame(user) * body_frame(last_).inverse();
+  if (!onto_seen.translation.allFinite() || !onto_seen.rotation.coeffs().allFinite()) return false;
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (!unseen[s]) continue;
+    user.wrist_positions_ws[s] = onto_seen.apply(last_.wrist_positions_ws[s]);
+    user.wrist_rotations_ws[s] = (onto_seen.rotation * last_.wrist_rotations_ws[s]).normalized();
+  }
+  return true;
+}
+
 }  // namespace duet

@@ -56,6 +56,27 @@ TEST(UnseenUser, TheUserMovesAsTheTemplateDancerMovedSinceLastSeen) {
   EXPECT_LT((still.root_position_ws - user_at(body_then).root_position_ws).norm(), 1e-9);
 }
 
+TEST(UnseenUser, AnUnseenHandIsHeldAgainstTheBodyAsSeen) {
+  // Three points with the left controller out of view: it reports where it was, in the world,
+  // while the body moves on (a step and a quarter turn); the hand stays where it was against the
+  // body, the seen one is the frame's own.
+  const Transform body_then = floor_frame(-120.0, -3.0, 4.0);
+  const Transform body_now = body_then * floor_frame(90.0, 0.0, 0.5);
+  UnseenUser unseen;
+  UserPose sensed = user_at(body_now);
+  EXPECT_FALSE(unseen.hold_hands(sensed, {true, false}));  // nothing seen yet
+  unseen.seen(user_at(body_then), floor_frame(0.0, 0.0, 0.0), 0);
+  sensed.wrist_positions_ws[0] = user_at(body_then).wrist_positions_ws[0];  // the held report
+  sensed.wrist_positions_ws[1] += Vec3(0.0, 0.1, 0.0);                      // the seen hand moved
+  const Vec3 seen_right = sensed.wrist_positions_ws[1];
+  ASSERT_TRUE(unseen.hold_hands(sensed, {true, false}));
+  const UserPose expected = user_at(body_now);
+  EXPECT_LT((sensed.wrist_positions_ws[0] - expected.wrist_positions_ws[0]).norm(), 1e-9);
+  EXPECT_LT(sensed.wrist_rotations_ws[0].angularDistance(expected.wrist_rotations_ws[0]), 1e-9);
+  EXPECT_EQ(sensed.wrist_positions_ws[1], seen_right);
+  EXPECT_LT((sensed.root_position_ws - expected.root_position_ws).norm(), 1e-9);
+}
+
 TEST(UnseenUser, NothingIsCarriedBeforeAUserIsSeenOrIntoAnotherTake) {
   UnseenUser unseen;
   UserPose user = user_at(floor_frame(10.0, 1.0, 1.0));

@@ -11,6 +11,8 @@
 // alike. Allocates nothing.
 #pragma once
 
+#include <array>
+
 #include "duet/math/types.h"
 #include "duet/partner/partner_synthesis.h"
 
@@ -26,6 +28,12 @@ class UnseenUser {
   // `user` unchanged) before any frame was seen, or in another take than the one last seen in
   // (a jump while unseen: nothing says how the user got there).
   bool carry(UserPose& user, const Transform& template_heading, int take) const noexcept;
+  // A frame with the body seen but some hands not (three points, a controller out of the
+  // headset's view, which reports where it was): each unseen hand held where it was last seen
+  // against the body's heading frame, on the body as seen now (what `carry` does to a hand, less
+  // the body's move, which is seen). False (and `user` unchanged) before any frame was seen.
+  // Then call `seen` with the result: a hand unseen for longer stays where it was.
+  bool hold_hands(UserPose& user, const std::array<bool, 2>& unseen) const noexcept;
   void reset() noexcept { take_ = -1; }
 
  private:
