@@ -18,14 +18,20 @@ LostSummary summarise_lost(std::span<const FollowResult> results) {
     summary.jumps += r.jumped ? 1 : 0;
     summary.missing += r.missing ? 1 : 0;
     summary.outliers += r.outlier ? 1 : 0;
+    summary.partly_observed += r.partly_observed ? 1 : 0;
   }
   return summary;
 }
 
 std::string describe_set_aside(const LostSummary& summary) {
-  if (summary.missing == 0 && summary.outliers == 0) return "";
-  return fmt::format(" (frames without evidence: {} missing or repeated, {} outliers set aside)",
-                     summary.missing, summary.outliers);
+  if (summary.missing == 0 && summary.outliers == 0 && summary.partly_observed == 0) return "";
+  const std::string unseen_hand =
+      summary.partly_observed > 0
+          ? fmt::format("; {} with a hand unseen, its controller repeating its last pose",
+                        summary.partly_observed)
+          : "";
+  return fmt::format(" (frames without evidence: {} missing or repeated, {} outliers set aside{})",
+                     summary.missing, summary.outliers, unseen_hand);
 }
 
 float median_followed_tempo(std::span<const FollowResult> results) {

@@ -24,12 +24,14 @@ struct LostSummary {
   int jumps = 0;
   int missing = 0;   // no usable pose, or the sensor repeated the last one (FollowResult::missing)
   int outliers = 0;  // evidence set aside (FollowResult::outlier)
+  int partly_observed = 0;  // a controller repeating its last pose (FollowResult::partly_observed)
   int held_still = 0;  // lost only for holding one place for seconds (FollowResult::held_still)
   int lost_unseen = 0;  // lost while missing: seconds without a new pose (missing_lost_s)
   double lost_fraction() const { return frames > 0 ? static_cast<double>(lost) / frames : 0.0; }
 };
 LostSummary summarise_lost(std::span<const FollowResult> results);
-// " (frames without evidence: M missing or repeated, K outliers set aside)", or "" when none.
+// " (frames without evidence: M missing or repeated, K outliers set aside; P with a hand unseen)",
+// or "" when none.
 std::string describe_set_aside(const LostSummary& summary);
 
 // What the input looked like, for the checks.

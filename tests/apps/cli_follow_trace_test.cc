@@ -75,13 +75,14 @@ TEST(CliFollowTrace, ARepeatedFrameIsMissingInTheTraceAndTheSummary) {
   std::ifstream in(trace);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line.substr(line.size() - 16), ",missing,outlier");
+  EXPECT_EQ(line.substr(line.size() - 32), ",missing,outlier,partly_observed");
   int row = 0, missing_rows = 0;
   while (std::getline(in, line)) {
     std::vector<std::string> cells;
     std::stringstream ss(line);
     for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
-    ASSERT_EQ(cells.size(), 12u) << line;
+    ASSERT_EQ(cells.size(), 13u) << line;
+    EXPECT_EQ(cells[12], "0");  // a full body is observed whole or not at all
     if (cells[10] == "1") {
       ++missing_rows;
       EXPECT_EQ(row, 300);

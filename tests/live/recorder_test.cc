@@ -182,14 +182,14 @@ TEST(Recorder, SessionRecorderWritesEveryPushedFrame) {
   int lines = 0;
   while (std::getline(csv, line)) {
     if (lines == 0) {
-      EXPECT_EQ(line.substr(line.size() - 16), ",missing,outlier");
+      EXPECT_EQ(line.substr(line.size() - 32), ",missing,outlier,partly_observed");
     }
     // Row f + 1 is frame f: missing on frame 100, outlier on frame 200, neither elsewhere.
     if (lines > 0) {
       const int f = lines - 1;
       const std::string end =
-          std::string(",") + (f == 100 ? "1" : "0") + "," + (f == 200 ? "1" : "0");
-      EXPECT_EQ(line.substr(line.size() - 4), end) << line;
+          std::string(",") + (f == 100 ? "1" : "0") + "," + (f == 200 ? "1" : "0") + ",0";
+      EXPECT_EQ(line.substr(line.size() - 6), end) << line;
     }
     ++lines;
   }
