@@ -29,7 +29,7 @@ namespace {
 
 using io_internal::ascii_lower;
 using io_internal::equals_ignore_case;
-using io_internal::quoted;
+using io_internal::quoted_token;
 
 // kPi / 180 as one factor: deg * kPi / 180 would overflow for |deg| > 5.7e307.
 constexpr double kDegToRad = kPi / 180.0;
@@ -130,8 +130,8 @@ NumberStatus parse_number(std::string_view token, double& value, bool allow_infi
 }
 
 std::string number_message(NumberStatus status, std::string_view token) {
-  if (status == NumberStatus::kNotFinite) return quoted(token) + " is not a finite number";
-  return "expected a number, found " + quoted(token);
+  if (status == NumberStatus::kNotFinite) return quoted_token(token) + " is not a finite number";
+  return "expected a number, found " + quoted_token(token);
 }
 
 // --------------------------------------------------------------------------------- the model
@@ -279,10 +279,10 @@ bool AsfParser::parse(AsfSkeleton& skeleton) {
     bool ok = true;
     switch (section_) {
       case Section::kNone:
-        ok = fail("expected a ':' keyword, found " + quoted(first));
+        ok = fail("expected a ':' keyword, found " + quoted_token(first));
         break;
       case Section::kIgnored:
-        ok = fail("unexpected " + quoted(first) + " after a one-line keyword");
+        ok = fail("unexpected " + quoted_token(first) + " after a one-line keyword");
         break;
       case Section::kDocumentation:
         break;  // free text
@@ -305,9 +305,9 @@ bool AsfParser::parse(AsfSkeleton& skeleton) {
 }
 
 bool AsfParser::keyword(std::string_view word) {
-  if (in_bone_) return fail("bone block has no 'end' before " + quoted(word));
+  if (in_bone_) return fail("bone block has no 'end' before " + quoted_token(word));
   if (section_ == Section::kHierarchy && hierarchy_state_ == 1) {
-    return fail(":hierarchy has no 'end' before " + quoted(word));
+    return fail(":hierarchy has no 'end' before " + quoted_token(word));
   }
   auto once = [&](bool& seen) {
     if (seen) return fail("second " + std::string(word) + " section");
@@ -333,17 +333,17 @@ bool AsfParser::keyword(std::string_view word) {
     if (!once(seen_hierarchy_)) return false;
     hierarchy_keyword_line_ = lines_.line();
   } else {
-    return fail("unknown keyword " + quoted(word));
+    return fail("unknown keyword " + quoted_token(word));
   }
   if (section_ != Section::kIgnored && tokens_.size() > 1) {
-    return fail("unexpected " + quoted(tokens_[1]) + " after " + std::string(word));
+    return fail("unexpected " + quoted_token(tokens_[1]) + " after " + std::string(word));
   }
   return true;
 }
 
 bool AsfParser::units_line() {
   const std::string_view field = tokens_[0];
-  if (tokens_.size() != 2) return fail("expected one value after " + quoted(field));
+  if (tokens_.size() != 2) return fail("expected one value after " + quoted_token(field));
   if (field == "mass") {
     double mass = 0.0;
     return number(tokens_[1], mass);
@@ -351,7 +351,8 @@ bool AsfParser::units_line() {
   if (field == "length") {
     double length = 0.0;
     if (!number(tokens_[1], length)) return false;
-    if (!(length > 0.0)) return fail("length unit must be positive, found " + quoted(tokens_[1]));
+    if (!(length > 0.0))
+      return fail("length unit must be positive, found " + quoted_token(tokens_[1]));
     skeleton_->length_unit = length;
     return true;
   }
@@ -361,11 +362,11 @@ bool AsfParser::units_line() {
     } else if (equals_ignore_case(tokens_[1], "rad")) {
       skeleton_->degrees = false;
     } else {
-      return fail("angle unit must be 'deg' or 'rad', found " + quoted(tokens_[1]));
+      return fail("angle unit must be 'deg' or 'rad', found " + quoted_token(tokens_[1]));
     }
     return true;
   }
-  return fail("unknown :units field " + quoted(field));
+  return fail("unknown :units field " + quoted_token(field));
 }
 
 bool AsfParser::root_line() {
@@ -376,10 +377,11 @@ bool AsfParser::root_line() {
     for (std::size_t k = 1; k < tokens_.size(); ++k) {
       const std::optional<Dof> dof = parse_dof(tokens_[k]);
       if (!dof || *dof == Dof::kL) {
-        return fail("root order: expected TX, TY, TZ, RX, RY or RZ, found " + quoted(tokens_[k]));
+        return fail("root order: expected TX, TY, TZ, RX, RY or RZ, found " +
+                    quoted_token(tokens_[k]));
       }
       if (std::find(root.dofs.begin(), root.dofs.end(), *dof) != root.dofs.end()) {
-        return fail("root order lists " + quoted(tokens_[k]) + " twice");
+        return fail("root order lists " + quoted_token(tokens_[k]) + " twice");
       }
       root.dofs.push_back(*dof);
     }
@@ -393,14 +395,14 @@ bool AsfParser::root_line() {
   }
   if (field == "position") return vec3(field, 1, skeleton_->root_position);
   if (field == "orientation") return vec3(field, 1, root.axis_angles);
-  return fail("unknown :root field " + quoted(field));
+  return fail("unknown :root field " + quoted_token(field));
 }
 
 bool AsfParser::bonedata_line() {
   const std::string_view first = tokens_[0];
   if (!in_bone_) {
     if (first != "begin" || tokens_.size() != 1) {
-      return fail("expected 'begin' in :bonedata, found " + quoted(first));
+      return fail("expected 'begin' in :bonedata, found " + quoted_token(first));
     }
     in_bone_ = true;
     bone_ = AsfBone{};
@@ -409,7 +411,7 @@ bool AsfParser::bonedata_line() {
     return true;
   }
   if (first == "end") {
-    if (tokens_.size() != 1) return fail("unexpected " + quoted(tokens_[1]) + " after 'end'");
+    if (tokens_.size() != 1) return fail("unexpected " + quoted_token(tokens_[1]) + " after 'end'");
     return close_bone();
   }
   return bone_field();
@@ -447,7 +449,7 @@ bool AsfParser::bone_field() {
     // `axis 0 0 20 XYZ`: the x, y and z angles, then the order they are applied in.
     if (tokens_.size() == 5) {
       if (!parse_euler_order(tokens_[4], bone_.axis_order)) {
-        return fail("axis: expected an order such as XYZ, found " + quoted(tokens_[4]));
+        return fail("axis: expected an order such as XYZ, found " + quoted_token(tokens_[4]));
       }
       tokens_.pop_back();
     }
@@ -458,9 +460,9 @@ bool AsfParser::bone_field() {
     for (std::size_t k = 1; k < tokens_.size(); ++k) {
       const std::optional<Dof> dof = parse_dof(tokens_[k]);
       if (!dof)
-        return fail("dof: expected rx, ry, rz, tx, ty, tz or l, found " + quoted(tokens_[k]));
+        return fail("dof: expected rx, ry, rz, tx, ty, tz or l, found " + quoted_token(tokens_[k]));
       if (std::find(bone_.dofs.begin(), bone_.dofs.end(), *dof) != bone_.dofs.end()) {
-        return fail("dof lists " + quoted(tokens_[k]) + " twice");
+        return fail("dof lists " + quoted_token(tokens_[k]) + " twice");
       }
       bone_.dofs.push_back(*dof);
     }
@@ -474,7 +476,7 @@ bool AsfParser::bone_field() {
     double value = 0.0;
     return numbers(field, 1, 1, &value);
   }
-  return fail("unknown bone field " + quoted(field));
+  return fail("unknown bone field " + quoted_token(field));
 }
 
 // `limits (-160.0 20.0)`, one pair per DOF, possibly one pair per line. We check and drop them:
@@ -488,7 +490,7 @@ bool AsfParser::limits(std::size_t first) {
       if (!value.empty()) {
         double limit = 0.0;
         if (parse_number(value, limit, /*allow_infinity=*/true) != NumberStatus::kOk) {
-          return fail("limits: expected a number, found " + quoted(value));
+          return fail("limits: expected a number, found " + quoted_token(value));
         }
         if (bone_.limit_values == INT_MAX) return fail("too many limits");
         ++bone_.limit_values;
@@ -525,12 +527,13 @@ bool AsfParser::hierarchy_line() {
   const std::string_view first = tokens_[0];
   if (hierarchy_state_ == 0) {
     if (first != "begin" || tokens_.size() != 1) {
-      return fail("expected 'begin' in :hierarchy, found " + quoted(first));
+      return fail("expected 'begin' in :hierarchy, found " + quoted_token(first));
     }
     hierarchy_state_ = 1;
     return true;
   }
-  if (hierarchy_state_ == 2) return fail("unexpected " + quoted(first) + " after :hierarchy 'end'");
+  if (hierarchy_state_ == 2)
+    return fail("unexpected " + quoted_token(first) + " after :hierarchy 'end'");
   if (first == "end" && tokens_.size() == 1) {
     hierarchy_state_ = 2;
     return true;
@@ -555,14 +558,14 @@ bool AsfParser::finish() {
   for (const HierarchyLine& line : hierarchy_) {
     const auto parent_it = bone_index_.find(line.names[0]);
     if (parent_it == bone_index_.end()) {
-      return fail(line.line, "hierarchy names bone " + quoted(line.names[0]) +
+      return fail(line.line, "hierarchy names bone " + quoted_token(line.names[0]) +
                                  ", which :bonedata does not define");
     }
     const int parent = parent_it->second;
     for (std::size_t k = 1; k < line.names.size(); ++k) {
       const auto child_it = bone_index_.find(line.names[k]);
       if (child_it == bone_index_.end()) {
-        return fail(line.line, "hierarchy names bone " + quoted(line.names[k]) +
+        return fail(line.line, "hierarchy names bone " + quoted_token(line.names[k]) +
                                    ", which :bonedata does not define");
       }
       const int child = child_it->second;
@@ -708,16 +711,17 @@ bool AmcParser::parse(AmcMotion& motion, bool& degrees) {
     const std::string_view first = tokens_[0];
     if (first.front() == '#') continue;
     if (first.front() == ':') {
-      if (frame_number_ >= 0) return fail("keyword " + quoted(first) + " after the first frame");
+      if (frame_number_ >= 0)
+        return fail("keyword " + quoted_token(first) + " after the first frame");
       if (tokens_.size() != 1)
-        return fail("unexpected " + quoted(tokens_[1]) + " after " + quoted(first));
+        return fail("unexpected " + quoted_token(tokens_[1]) + " after " + quoted_token(first));
       if (equals_ignore_case(first, ":FULLY-SPECIFIED")) continue;
       if (equals_ignore_case(first, ":DEGREES")) {
         degrees = true;
       } else if (equals_ignore_case(first, ":RADIANS")) {
         degrees = false;
       } else {
-        return fail("unknown keyword " + quoted(first));
+        return fail("unknown keyword " + quoted_token(first));
       }
       continue;
     }
@@ -738,19 +742,19 @@ bool AmcParser::start_frame(std::string_view token) {
   const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), number);
   if (ptr != token.data() + token.size() ||
       (ec != std::errc() && ec != std::errc::result_out_of_range)) {
-    return fail("expected a frame number, found " + quoted(token));
+    return fail("expected a frame number, found " + quoted_token(token));
   }
   if (ec == std::errc::result_out_of_range)
-    return fail("frame number " + quoted(token) + " is out of range");
+    return fail("frame number " + quoted_token(token) + " is out of range");
   // A frame number is plain digits: "-0" is 0 to from_chars, but no AMC writer emits a sign.
   if (number < 0 || token.front() == '-') {
-    return fail("frame number " + quoted(token) + " is negative");
+    return fail("frame number " + quoted_token(token) + " is negative");
   }
   if (frame_number_ >= 0) {
     if (!end_frame()) return false;
     if (number != frame_number_ + 1) {
       return fail("expected frame " + std::to_string(frame_number_ + 1) + " after frame " +
-                  std::to_string(frame_number_) + ", found " + quoted(token) +
+                  std::to_string(frame_number_) + ", found " + quoted_token(token) +
                   (number <= frame_number_ ? " (out of order)" : " (a gap)"));
     }
   }
@@ -800,10 +804,11 @@ int AmcParser::find_bone(std::string_view name) {
 bool AmcParser::bone_line() {
   const std::string_view name = tokens_[0];
   const int b = find_bone(name);
-  if (b < 0) return fail("bone " + quoted(name) + " is not in the ASF");
+  if (b < 0) return fail("bone " + quoted_token(name) + " is not in the ASF");
   const auto bone = static_cast<std::size_t>(b);
   if (seen_in_frame_[bone] == motion_->frame_count) {
-    return fail("bone " + quoted(name) + " given twice in frame " + std::to_string(frame_number_));
+    return fail("bone " + quoted_token(name) + " given twice in frame " +
+                std::to_string(frame_number_));
   }
   seen_in_frame_[bone] = motion_->frame_count;
   dof_lines_in_frame_ += skeleton_.bones[bone].dofs.empty() ? 0 : 1;
@@ -811,7 +816,7 @@ bool AmcParser::bone_line() {
   ++line_in_frame_;
   const std::size_t count = skeleton_.bones[bone].dofs.size();
   if (tokens_.size() - 1 != count) {
-    return fail("bone " + quoted(name) + " has " + std::to_string(count) +
+    return fail("bone " + quoted_token(name) + " has " + std::to_string(count) +
                 " DOF but the line has " + std::to_string(tokens_.size() - 1) + " value" +
                 (tokens_.size() == 2 ? "" : "s"));
   }

@@ -24,7 +24,7 @@ namespace {
 
 using io_internal::ascii_lower;
 using io_internal::equals_ignore_case;
-using io_internal::quoted;
+using io_internal::quoted_token;
 
 // kPi / 180 as one factor: deg * kPi / 180 would overflow for |deg| > 5.7e307.
 constexpr double kDegToRad = kPi / 180.0;
@@ -46,7 +46,7 @@ bool starts_with_ignore_case(std::string_view text, std::string_view prefix) {
 
 // A token for an error message; the empty token is the end of the file.
 std::string quoted_or_end(std::string_view token) {
-  return token.empty() ? "end of file" : quoted(token);
+  return token.empty() ? "end of file" : quoted_token(token);
 }
 
 enum class NumberStatus { kOk, kNotANumber, kNotFinite };

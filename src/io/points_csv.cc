@@ -72,7 +72,7 @@ Result<Sample> parse_line(std::string_view line, const std::string& name, int li
       return make_error(name, line_number,
                         fmt::format("column {} ({}): {} is not a finite number", column + 1,
                                     column_names()[static_cast<std::size_t>(column)],
-                                    io_internal::quoted(trim(token))));
+                                    io_internal::quoted_token(trim(token))));
     }
     ++column;
     if (comma == std::string_view::npos) break;

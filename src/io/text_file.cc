@@ -51,7 +51,7 @@ bool equals_ignore_case(std::string_view a, std::string_view b) {
   return true;
 }
 
-std::string quoted(std::string_view token) {
+std::string quoted_token(std::string_view token) {
   std::string out = "'";
   const std::size_t n = std::min<std::size_t>(token.size(), 40);
   for (std::size_t i = 0; i < n; ++i) {

@@ -14,7 +14,7 @@ inline char ascii_lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<ch
 bool equals_ignore_case(std::string_view a, std::string_view b);
 
 // A token quoted for an error message: at most 40 bytes, non-printable bytes as \xNN.
-std::string quoted(std::string_view token);
+std::string quoted_token(std::string_view token);
 
 // Reads the whole file into memory in one call (no per-line or per-number stream I/O).
 // Errors name the path: "walk.bvh: cannot open: No such file or directory".

@@ -1,5 +1,7 @@
 #include "duet/motion/rig_variants.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -101,23 +103,23 @@ bool parse_rig_proportions(std::string_view text, RigProportions& proportions, s
     text = comma == std::string_view::npos ? std::string_view{} : text.substr(comma + 1);
     const std::size_t eq = item.find('=');
     if (eq == std::string_view::npos) {
-      error = "'" + std::string(item) + "': expected key=value";
+      error = fmt::format("'{}': expected key=value", item);
       return false;
     }
     const std::string_view key = item.substr(0, eq), value_text = item.substr(eq + 1);
     const std::optional<double> number = parse_number<double>(value_text);
     if (!number) {
-      error = "'" + std::string(item) + "': the value is not a number";
+      error = fmt::format("'{}': the value is not a number", item);
       return false;
     }
     const double value = *number;
     const bool factor = key == "arms" || key == "legs" || key == "trunk";
     if (factor && !(value > 0.0 && value <= 10.0)) {
-      error = "'" + std::string(item) + "': a length factor must be in (0, 10]";
+      error = fmt::format("'{}': a length factor must be in (0, 10]", item);
       return false;
     }
     if (!factor && !(std::abs(value) <= 90.0)) {
-      error = "'" + std::string(item) + "': an angle must be within [-90, 90] degrees";
+      error = fmt::format("'{}': an angle must be within [-90, 90] degrees", item);
       return false;
     }
     if (key == "arms")
@@ -135,8 +137,8 @@ bool parse_rig_proportions(std::string_view text, RigProportions& proportions, s
     else if (key == "toes_out")
       parsed.toes_out_deg = value;
     else {
-      error = "'" + std::string(key) +
-              "': unknown key (arms, legs, trunk, arms_down, legs_apart, lean, toes_out)";
+      error = fmt::format(
+          "'{}': unknown key (arms, legs, trunk, arms_down, legs_apart, lean, toes_out)", key);
       return false;
     }
   }

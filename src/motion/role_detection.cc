@@ -207,7 +207,7 @@ int name_priority(const NameInfo& info, Part part) {
 
 const char* side_word(int side) { return side == kLeft ? "left" : "right"; }
 
-std::string quoted(const Tree& tree, int j) { return "'" + tree.name(j) + "'"; }
+std::string quoted_joint(const Tree& tree, int j) { return "'" + tree.name(j) + "'"; }
 
 // ---- Shared structure rules ------------------------------------------------------------------
 
@@ -249,8 +249,8 @@ struct Detector {
     if (hips >= 0) {  // the spine lies between the two; without legs only the top is found
       if (chest != hips && !tree.is_ancestor(hips, chest)) {
         out.notes[at(static_cast<int>(Role::kChest))] =
-            "the arms meet at " + quoted(tree, chest) + ", which is not above the legs' " +
-            quoted(tree, hips);
+            "the arms meet at " + quoted_joint(tree, chest) + ", which is not above the legs' " +
+            quoted_joint(tree, hips);
         out.roles.joints[at(static_cast<int>(Role::kChest))] = kNone;
         return;
       }
@@ -275,7 +275,7 @@ struct Detector {
         best = priority;
       }
     }
-    std::string head_note = "named " + (head >= 0 ? quoted(tree, head) : std::string());
+    std::string head_note = "named " + (head >= 0 ? quoted_joint(tree, head) : std::string());
     if (head < 0) {
       if (head_branch < 0) {
         for (int c : tree.children[at(chest)]) {
@@ -288,7 +288,7 @@ struct Detector {
       }
       if (head_branch < 0) {
         out.notes[at(static_cast<int>(Role::kHead))] =
-            "no joint named head and no branch above the chest " + quoted(tree, chest) +
+            "no joint named head and no branch above the chest " + quoted_joint(tree, chest) +
             " besides the arms";
         return;
       }
@@ -307,7 +307,7 @@ struct Detector {
       if (name_priority(names[at(j)], Part::kNeck) >= 0) neck = j;
     }
     if (neck >= 0) {
-      set(Role::kNeck, neck, "named " + quoted(tree, neck));
+      set(Role::kNeck, neck, "named " + quoted_joint(tree, neck));
     } else if (first_below_chest >= 0) {
       set(Role::kNeck, first_below_chest, "the joint above the chest on the way to the head");
     } else {
@@ -381,11 +381,11 @@ RoleDetection detect_roles_by_name(const Skeleton& skeleton) {
     if (wrist < 0) {
       d.set(wrist_role, kNone, "no joint named like a hand or wrist" + where);
     } else {
-      d.set(wrist_role, wrist, "named " + quoted(tree, wrist));
+      d.set(wrist_role, wrist, "named " + quoted_joint(tree, wrist));
       int elbow = best_named(tree, names, Part::kElbow, side,
                              [&](int j) { return tree.is_ancestor(j, wrist); });
       if (elbow >= 0) {
-        d.set(elbow_role, elbow, "named " + quoted(tree, elbow));
+        d.set(elbow_role, elbow, "named " + quoted_joint(tree, elbow));
       } else {
         elbow = joint_above(tree, wrist, names);
         d.set(elbow_role, elbow, "the joint above the wrist");
@@ -394,7 +394,7 @@ RoleDetection detect_roles_by_name(const Skeleton& skeleton) {
         const int shoulder = joint_above(tree, elbow, names);
         d.set(shoulder_role, shoulder,
               shoulder >= 0 ? "the joint above the elbow (the upper arm), named " +
-                                  quoted(tree, shoulder)
+                                  quoted_joint(tree, shoulder)
                             : "nothing above the elbow");
       }
     }
@@ -408,11 +408,11 @@ RoleDetection detect_roles_by_name(const Skeleton& skeleton) {
       d.set(ankle_role, kNone, "no joint named like a foot or ankle" + where);
       continue;
     }
-    d.set(ankle_role, ankle, "named " + quoted(tree, ankle));
+    d.set(ankle_role, ankle, "named " + quoted_joint(tree, ankle));
     int knee = best_named(tree, names, Part::kKnee, side,
                           [&](int j) { return tree.is_ancestor(j, ankle); });
     if (knee >= 0) {
-      d.set(knee_role, knee, "named " + quoted(tree, knee));
+      d.set(knee_role, knee, "named " + quoted_joint(tree, knee));
     } else {
       knee = joint_above(tree, ankle, names);
       d.set(knee_role, knee, "the joint above the ankle");
@@ -420,7 +420,7 @@ RoleDetection detect_roles_by_name(const Skeleton& skeleton) {
     if (knee >= 0) {
       const int hip = joint_above(tree, knee, names);
       d.set(hip_role, hip,
-            hip >= 0 ? "the joint above the knee (the thigh), named " + quoted(tree, hip)
+            hip >= 0 ? "the joint above the knee (the thigh), named " + quoted_joint(tree, hip)
                      : "nothing above the knee");
     }
     auto below_ankle = [&](int j) { return tree.is_ancestor(ankle, j); };
@@ -439,7 +439,7 @@ RoleDetection detect_roles_by_name(const Skeleton& skeleton) {
       }
       toe_note = "the joint past the ankle, ";
     }
-    d.set(toe_role, toe, toe >= 0 ? toe_note + quoted(tree, toe) : "nothing below the ankle");
+    d.set(toe_role, toe, toe >= 0 ? toe_note + quoted_joint(tree, toe) : "nothing below the ankle");
   }
   d.find_trunk(kNone);
   d.finish("names");
