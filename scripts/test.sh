@@ -12,6 +12,9 @@ stage() { echo "== [$((SECONDS / 60)) min $((SECONDS % 60)) s] $*" >&2; }
 # ccache (installed by install-deps.sh) makes a second run on the same machine rebuild only what
 # changed, also from a fresh clone elsewhere (paths relative to the clone, no directory in the hash).
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
+# ccache caches compiles that use a precompiled header (cmake/DuetPrecompiledHeaders.cmake) only
+# with this sloppiness (its manual, "Precompiled headers").
+export CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
 launcher=()
 if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
 
