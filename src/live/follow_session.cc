@@ -14,6 +14,15 @@
 
 namespace duet {
 
+namespace {
+
+// The three points' places in the repeat detector's list of points tracked on their own: the
+// head, then the left and right wrists (side 0 and 1, as FeatureSpec::hand_point_dims).
+constexpr std::size_t kHeadPoint = 0;
+constexpr std::size_t hand_point(std::size_t side) { return 1 + side; }
+
+}  // namespace
+
 Result<FollowSession> FollowSession::create(const DuetLibrary& library,
                                             std::shared_ptr<const Skeleton> user_skeleton,
                                             const JointRoles& user_roles,
@@ -27,7 +36,7 @@ Result<FollowSession> FollowSession::create(const DuetLibrary& library,
   std::vector<int> tracked_points;
   if (is_head_hands_input(user_roles)) {
     tracked_points = {user_roles[Role::kHead], user_roles[Role::kLeftWrist],
-                      user_roles[Role::kRightWrist]};
+                      user_roles[Role::kRightWrist]};  // kHeadPoint, hand_point(0), hand_point(1)
   }
   return FollowSession(library, std::move(extractor).value(), std::move(tracker), bias,
                        RepeatedFrameDetector(joints, std::move(tracked_points)));
@@ -53,9 +62,9 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
   const bool repeat = repeats_.is_repeat(translations_ls, rotations_ls);
   // Three points: a controller out of the headset's view repeats its last pose while the head
   // moves on. The head and the other hand are still evidence (mark_unseen_hands).
-  const bool only_hands_repeat = repeat &&
-                                 extractor_.spec().input_points == InputPoints::kHeadHands &&
-                                 !repeats_.whole_pose_repeated() && !repeats_.point_repeated(0);
+  const bool only_hands_repeat =
+      repeat && extractor_.spec().input_points == InputPoints::kHeadHands &&
+      !repeats_.whole_pose_repeated() && !repeats_.point_repeated(kHeadPoint);
   if (repeat && !only_hands_repeat) {
     // No new evidence, and kept out of the velocities: the tracker moves its band on.
     std::ranges::fill(features_, std::numeric_limits<float>::quiet_NaN());
@@ -128,7 +137,7 @@ bool FollowSession::mark_unseen_hands(double time_s) noexcept {
   for (int side = 0; side < 2; ++side) {
     const auto s = static_cast<std::size_t>(side);
     const std::array<int, 4> dims = extractor_.spec().hand_point_dims(side);
-    if (repeats_.point_repeated(1 + s)) {
+    if (repeats_.point_repeated(hand_point(s))) {
       for (const int d : dims) features_[static_cast<std::size_t>(d)] = kUnseen;
       hand_held_[s] = true;
       marked = true;
