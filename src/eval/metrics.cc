@@ -50,6 +50,7 @@ FrameEstimate frame_estimate(const FollowResult& r, double step_us) {
   FrameEstimate e;
   e.take = r.take;
   e.frame_in_take = r.frame_in_take;
+  e.frame_offset = r.frame_offset;
   e.lost = r.lost;
   e.jumped = r.jumped;
   e.confidence = r.confidence;

@@ -410,18 +410,19 @@ std::string format_frames_csv(const EvalReport& report) {
   std::string out =
       "case,tracker,take,error_ms,confidence,window_mass,best_distance_per_dim,"
       "sensor_noise_per_dim,lost,in_pause,jumped,true_take,true_frame,estimated_take,"
-      "estimated_frame,true_jump,outlier,tracker_confidence,rig_offset,rig_offset_learnt_s\n";
+      "estimated_frame,true_jump,outlier,tracker_confidence,rig_offset,rig_offset_learnt_s,"
+      "frame_offset\n";
   for (const EvalRow& row : report.rows) {
     for (const ScoredFrame& f : row.frames) {
       const FrameEstimate& e = f.estimate;
       fmt::format_to(std::back_inserter(out),
                      "{},{},{},{:.1f},{:.5f},{:.5f},{:.6f},{:.7f},{},{},{},{},{:.1f},{},{},{},{},"
-                     "{:.5f},{:.5f},{:.3f}\n",
+                     "{:.5f},{:.5f},{:.3f},{:.3f}\n",
                      row.case_name, row.tracker, f.take, f.error_ms, e.confidence, e.window_mass,
                      e.best_distance_per_dim, e.sensor_noise_per_dim, e.lost ? 1 : 0,
                      e.in_pause ? 1 : 0, e.jumped ? 1 : 0, f.truth.take, f.truth.template_frame,
                      e.take, e.frame_in_take, f.truth.jump ? 1 : 0, e.outlier ? 1 : 0,
-                     e.tracker_confidence, e.rig_offset, e.rig_offset_learnt_s);
+                     e.tracker_confidence, e.rig_offset, e.rig_offset_learnt_s, e.frame_offset);
     }
   }
   return out;

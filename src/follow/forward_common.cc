@@ -227,19 +227,26 @@ void describe_state(const TemplateModel& model, const float* posterior, float to
                     int window, FollowResult& result, std::span<const int> support) noexcept {
   const int take = model.take_of(state);
   float mass = 0.0f;
+  float offset = 0.0f;  // the window's mean frame - state
   if (const CopyPlaces* places = model.copy_places(); places != nullptr) {
     mass = support.empty() ? places->window_mass(posterior, state, window)
                            : places->window_mass(posterior, state, window, support);
   } else {
     const int begin = std::max(model.take_begin(take), state - window);
     const int end = std::min(model.take_end(take), state + window + 1);
-    for (int i = begin; i < end; ++i) mass += posterior[i];
+    float moment = 0.0f;
+    for (int i = begin; i < end; ++i) {
+      mass += posterior[i];
+      moment += static_cast<float>(i - state) * posterior[i];
+    }
+    offset = mass > 0.0f ? moment / mass : 0.0f;
   }
   result.state = state;
   result.take = take;
   result.frame_in_take = state - model.take_begin(take);
   result.confidence = total > 0.0f ? std::clamp(mass / total, 0.0f, 1.0f) : 0.0f;
   result.window_mass = result.confidence;
+  result.frame_offset = std::isfinite(offset) ? offset : 0.0f;
 }
 
 void decide(const TemplateModel& model, const float* posterior, float total, float pause_mass,

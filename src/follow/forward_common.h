@@ -119,11 +119,11 @@ double weigh_and_normalise(const float* predicted, const float* distance_sq, flo
 // uniform over the first uniform_count entries.
 void normalise(float* mass, int count, int uniform_count) noexcept;
 
-// Fills state (= `state`), take, frame_in_take and confidence (mass within +/- window frames in
-// the same take, divided by total).
+// Fills state (= `state`), take, frame_in_take, confidence (mass within +/- window frames in
+// the same take, divided by total) and frame_offset (that mass's mean frame - state).
 // In a library grown with copies (TemplateModel::copy_places) the window is taken in the captured
-// takes, over every copy; `support`, when not empty, lists the only states that can hold mass
-// (a beam), which is then all that is read.
+// takes, over every copy (frame_offset 0 there); `support`, when not empty, lists the only states
+// that can hold mass (a beam), which is then all that is read.
 void describe_state(const TemplateModel& model, const float* posterior, float total, int state,
                     int window, FollowResult& result, std::span<const int> support = {}) noexcept;
 

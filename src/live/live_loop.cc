@@ -224,8 +224,8 @@ const LiveOutput& LiveLoop::step(const SourceFrame& frame) noexcept {
   // The response at the playhead (smooth) or at the estimate itself.
   double position = frame_in_take;
   if (params_.smooth) {
-    position = playhead_.advance(frame_in_take, job.jumped, result.tempo, job.dt_s,
-                                 response.frame_rate(), params_.playhead);
+    position = playhead_.advance(frame_in_take + place.frame_offset, job.jumped, result.tempo,
+                                 job.dt_s, response.frame_rate(), params_.playhead);
     position = std::clamp(position, 0.0, static_cast<double>(model.frame_count() - 1));
   } else {
     playhead_.reset();

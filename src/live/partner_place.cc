@@ -9,13 +9,16 @@ namespace duet {
 PartnerPlaceStep PartnerPlace::next(const FollowResult& result, double dt_s,
                                     std::span<const PartnerModel> models,
                                     const PlayheadParams& params) noexcept {
-  PartnerPlaceStep step{result.take, result.frame_in_take, false, false};
+  PartnerPlaceStep step{result.take, result.frame_in_take,
+                        std::isfinite(result.frame_offset) ? result.frame_offset : 0.0f, false,
+                        false};
   // No estimate (or one outside the library): where the partner was.
   const int takes = static_cast<int>(models.size());
   if (step.take < 0 || step.take >= takes || step.frame < 0 ||
       step.frame >= models[static_cast<std::size_t>(step.take)].frame_count()) {
     step.take = std::max(take_, 0);
     step.frame = frame_;
+    step.frame_offset = 0.0;
   }
   const bool timed = std::isfinite(dt_s) && dt_s > 0.0;
   const double tempo = std::isfinite(result.tempo) && result.tempo > 0.0f ? result.tempo : 1.0;
@@ -33,6 +36,7 @@ PartnerPlaceStep PartnerPlace::next(const FollowResult& result, double dt_s,
     if (timed) coast_frame_ += tempo * dt_s * model.frame_rate();
     coast_frame_ = std::clamp(coast_frame_, 0.0, static_cast<double>(model.frame_count() - 1));
     step.frame = static_cast<int>(std::lround(coast_frame_));
+    step.frame_offset = 0.0;
   }
   coasting_ = step.coasting;
   // A jump for the partner: one the follower reports, another take, or a move further than

@@ -26,7 +26,7 @@ const char* PlayheadParams::validate() const noexcept {
   return "";
 }
 
-double ResponsePlayhead::advance(int estimate, bool restart, double tempo, double dt_s,
+double ResponsePlayhead::advance(double estimate, bool restart, double tempo, double dt_s,
                                  double frame_rate, const PlayheadParams& params) noexcept {
   const double target = estimate;
   const bool timed =

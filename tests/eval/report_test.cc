@@ -184,6 +184,7 @@ TEST(EvalReportCsv, HasTheCalibrationErrorAndTheFramesCsvItsRows) {
   e.tracker_confidence = 0.625f;
   e.rig_offset = 0.04f;
   e.rig_offset_learnt_s = 1.25f;
+  e.frame_offset = -0.25f;
   TruthFrame truth;
   truth.take = 0;
   truth.template_frame = 7.0;
@@ -200,9 +201,10 @@ TEST(EvalReportCsv, HasTheCalibrationErrorAndTheFramesCsvItsRows) {
   EXPECT_EQ(format_frames_csv(report),
             "case,tracker,take,error_ms,confidence,window_mass,best_distance_per_dim,"
             "sensor_noise_per_dim,lost,in_pause,jumped,true_take,true_frame,estimated_take,"
-            "estimated_frame,true_jump,outlier,tracker_confidence,rig_offset,rig_offset_learnt_s\n"
+            "estimated_frame,true_jump,outlier,tracker_confidence,rig_offset,rig_offset_learnt_s,"
+            "frame_offset\n"
             "clean,hmm,0,33.3,0.50000,0.75000,0.000000,0.0020000,1,0,1,0,7.0,0,5,1,0,0.62500,"
-            "0.04000,1.250\n");
+            "0.04000,1.250,-0.250\n");
 }
 
 }  // namespace

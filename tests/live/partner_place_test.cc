@@ -65,6 +65,7 @@ TEST(PartnerPlace, FollowsTheEstimateAndCoastsThroughALossAfterItsDelay) {
     }
   }
   // Found again next to where the partner danced on to: no jump; elsewhere: a jump.
+  // (While it coasts, the follower's place between frames is not the partner's.)
   PartnerPlace same = place;
   const int take = place.next(estimate(0, 0, true), kDt, models, params).take;
   PartnerPlaceStep found = same.next(estimate(take, coasted + 2), kDt, models, params);
@@ -72,6 +73,25 @@ TEST(PartnerPlace, FollowsTheEstimateAndCoastsThroughALossAfterItsDelay) {
   EXPECT_FALSE(found.jumped);
   found = place.next(estimate(1 - take, coasted), kDt, models, params);
   EXPECT_TRUE(found.jumped);
+}
+
+TEST(PartnerPlace, TheEstimatesPlaceBetweenFramesIsPassedOnUnlessThePartnerCoasts) {
+  const std::vector<PartnerModel> models = two_takes();
+  PlayheadParams params;
+  PartnerPlace place;
+  FollowResult r = estimate(0, 100);
+  r.frame_offset = 0.4f;
+  EXPECT_NEAR(place.next(r, kDt, models, params).frame_offset, 0.4, 1e-6);
+  r.frame_in_take = 101;
+  r.frame_offset = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(place.next(r, kDt, models, params).frame_offset, 0.0);
+  // Lost long enough to coast: the partner dances on by itself, at whole frames of its own.
+  r.lost = true;
+  r.frame_offset = -0.3f;
+  PartnerPlaceStep step;
+  for (int k = 0; k < 12; ++k) step = place.next(r, kDt, models, params);
+  ASSERT_TRUE(step.coasting);
+  EXPECT_EQ(step.frame_offset, 0.0);
 }
 
 TEST(PartnerPlace, ADancerLostForStandingStillIsWaitedWith) {

@@ -35,6 +35,7 @@ struct FrameEstimate {
   float tracker_confidence = 0.0f;
   bool in_pause = false;
   bool outlier = false;  // FollowResult::outlier: the frame's evidence was set aside
+  float frame_offset = 0.0f;  // FollowResult::frame_offset: where between frames
 };
 
 // A follower's result as scored; step_us its measured wall-clock time.

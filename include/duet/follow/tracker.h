@@ -17,6 +17,10 @@ struct FollowResult {
   // fitted on `duet eval` performances (confidence_calibration.h; raw where a tracker has none).
   float confidence = 0.0f;
   float window_mass = 0.0f;  // that posterior mass before calibration
+  // The posterior's mean frame within that window, minus state: where between frames the dancer
+  // is (the partner's playhead aims there). 0 for trackers without a posterior, and in a library
+  // of grown copies.
+  float frame_offset = 0.0f;
   // The estimate moved by something other than 0..2n frames forward within its take (n = steps),
   // or changed take: the dancer left their figure for another part of the dance. False on the
   // first frame after reset(); for the HMM followers also for the moves JumpGate does not call a

@@ -17,6 +17,9 @@ namespace duet {
 struct PartnerPlaceStep {
   int take = 0;
   int frame = 0;        // a frame of that take's response
+  // Where between frames the dancer is, from `frame` (FollowResult::frame_offset; 0 while the
+  // partner coasts or holds its place).
+  double frame_offset = 0.0;
   bool jumped = false;  // the partner restarts there (a blend)
   bool coasting = false;
 };

@@ -3,8 +3,9 @@
 // 2 frames per input frame, so for a dancer at 0.7x the template's tempo the raw estimate holds
 // and steps (0, 1, 1, 2, 3, 3, ...): the partner moves in a staircase, which shows as jerk
 // (docs/evaluation.md, partner metrics). The playhead instead advances at the tempo the follower
-// measured (FollowResult::tempo) and is pulled towards the estimate with a half-life, never
-// further than max_offset_frames from it; at a jump, a change of take or the first frame it
+// measured (FollowResult::tempo) and is pulled towards the estimate (with its place between
+// frames, FollowResult::frame_offset: a real frame) with a half-life, never further than
+// max_offset_frames from it; at a jump, a change of take or the first frame it
 // starts on the estimate. The pose is then sampled at that real frame (Clip::sample).
 #pragma once
 
@@ -55,12 +56,12 @@ class ResponsePlayhead {
     primed_ = false;
     jitter_.reset();
   }
-  // estimate: the follower's frame; restart: a jump or another take (start on the estimate);
-  // tempo: template frames per template frame of input time (non-finite or <= 0: 1); dt_s: time
-  // since the previous call (<= 0 or non-finite: restart); frame_rate: the template's. Returns
-  // the real frame to show, within max_offset_frames of the estimate (the caller clamps it to
-  // the clip).
-  double advance(int estimate, bool restart, double tempo, double dt_s, double frame_rate,
+  // estimate: the follower's frame (plus its place between frames); restart: a jump or another take
+  // (start on the estimate); tempo: template frames per template frame of input time (non-finite or
+  // <= 0: 1); dt_s: time since the previous call (<= 0 or non-finite: restart); frame_rate: the
+  // template's. Returns the real frame to show, within max_offset_frames of the estimate (the
+  // caller clamps it to the clip).
+  double advance(double estimate, bool restart, double tempo, double dt_s, double frame_rate,
                  const PlayheadParams& params) noexcept;
   double position() const noexcept { return position_; }
   // The estimate's jitter RMS (frames) the band is widened by.
