@@ -201,6 +201,8 @@ void FollowSession::report_captured_place(FollowResult& result) noexcept {
       std::abs(place.frame - previous_place_.frame) <= kSamePlaceFrames) {
     result.jumped = false;
   }
+  // A copy's frames are not the captured take's: its place between frames is not known there.
+  if (place.take != result.take) result.frame_offset = 0.0f;
   result.take = place.take;
   result.frame_in_take = place.frame;
   previous_place_ = place;
