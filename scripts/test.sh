@@ -9,9 +9,9 @@ data_dir=$(scripts/get-data.sh "${1:-}")
 jobs=$(nproc)
 # Each stage says how long the run has taken so far (the CI budget is 40 minutes on 2 cores).
 stage() { echo "== [$((SECONDS / 60)) min $((SECONDS % 60)) s] $*" >&2; }
-# ccache (installed by install-deps.sh) makes a second run in the same clone rebuild only what
-# changed. A fresh clone compiles everything again: each clone compiles its own precompiled header,
-# and a compile that uses one is cached under that header's hash.
+# ccache (installed by install-deps.sh) makes a second run on the same machine rebuild only what
+# changed, also from a fresh clone elsewhere (paths relative to the clone, no directory in the hash;
+# the precompiled headers come out the same and hit too).
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
 # ccache caches compiles that use a precompiled header (cmake/DuetPrecompiledHeaders.cmake) only
 # with this sloppiness (its manual, "Precompiled headers").
