@@ -230,7 +230,7 @@ int run_follow(const FollowArgs& args) {
   Clip partner(loop.value().partner_skeleton(), user.frame_rate(), user.frame_count());
   std::string trace =
       "frame,time_s,take,template_frame,confidence,jumped,lost,in_pause,best_distance_per_dim,"
-      "sensor_noise_per_dim,missing,outlier,partly_observed\n";
+      "sensor_noise_per_dim,missing,outlier,partly_observed,frame_offset\n";
   std::vector<FollowResult> results;
   results.reserve(static_cast<std::size_t>(user.frame_count()));
   SourceFrame frame;
@@ -245,10 +245,11 @@ int run_follow(const FollowArgs& args) {
     const FollowResult& r = out.follow;
     results.push_back(r);
     fmt::format_to(std::back_inserter(trace),
-                   "{},{:.6f},{},{},{:.4f},{},{},{},{:.6f},{:.7f},{},{},{}\n", f, frame.time_s,
-                   r.take, r.frame_in_take, r.confidence, r.jumped ? 1 : 0, r.lost ? 1 : 0,
-                   r.in_pause ? 1 : 0, r.best_distance_per_dim, r.sensor_noise_per_dim,
-                   r.missing ? 1 : 0, r.outlier ? 1 : 0, r.partly_observed ? 1 : 0);
+                   "{},{:.6f},{},{},{:.4f},{},{},{},{:.6f},{:.7f},{},{},{},{:.3f}\n", f,
+                   frame.time_s, r.take, r.frame_in_take, r.confidence, r.jumped ? 1 : 0,
+                   r.lost ? 1 : 0, r.in_pause ? 1 : 0, r.best_distance_per_dim,
+                   r.sensor_noise_per_dim, r.missing ? 1 : 0, r.outlier ? 1 : 0,
+                   r.partly_observed ? 1 : 0, r.frame_offset);
     std::ranges::copy(out.partner_translations_ls, partner.translations_ls(f).begin());
     std::ranges::copy(out.partner_rotations_ls, partner.rotations_ls(f).begin());
     if (f % 64 == 0) bar.update(f, user.frame_count());
@@ -341,10 +342,13 @@ Command register_follow(CLI::App& app) {
   app.add_option("--trace", args->trace_path,
                  "Write one CSV row per input frame: "
                  "frame,time_s,take,template_frame,confidence,jumped,lost,in_pause,"
-                 "best_distance_per_dim,sensor_noise_per_dim,missing,outlier,partly_observed "
+                 "best_distance_per_dim,sensor_noise_per_dim,missing,outlier,partly_observed,"
+                 "frame_offset "
                  "(missing: no usable pose, or the sensor repeated the last one; outlier: a frame "
                  "nothing explained, its evidence set aside; partly_observed: three points with "
-                 "a controller repeating its last pose, the head and the other hand evidence)");
+                 "a controller repeating its last pose, the head and the other hand evidence; "
+                 "frame_offset: where between template frames the dancer is, from "
+                 "template_frame)");
   app.add_option("-o,--output", args->output_path,
                  "Write the partner's motion: BVH in the response takes' units, in the user's "
                  "world frame, at the input's rate and frame count");

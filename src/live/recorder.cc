@@ -202,7 +202,7 @@ Result<std::unique_ptr<SessionRecorder>> SessionRecorder::start(
   }
   recorder->follow_pending_ =
       "seq,time_s,take,template_frame,confidence,jumped,lost,in_pause,contact_left,"
-      "contact_right,missing,outlier,partly_observed\n";
+      "contact_right,missing,outlier,partly_observed,frame_offset\n";
   recorder->follow_pending_.reserve(1 << 16);
 
   recorder->ring_.resize(static_cast<std::size_t>(recorder->options_.ring_frames));
@@ -255,10 +255,11 @@ void SessionRecorder::drain() {
       partner_.append(slot.partner_translations, slot.partner_rotations);
       const FollowResult& r = slot.follow;
       fmt::format_to(std::back_inserter(follow_pending_),
-                     "{},{:.6f},{},{},{:.4f},{},{},{},{},{},{},{},{}\n", slot.seq, slot.time_s,
-                     r.take, r.frame_in_take, r.confidence, r.jumped ? 1 : 0, r.lost ? 1 : 0,
-                     r.in_pause ? 1 : 0, slot.contact_left ? 1 : 0, slot.contact_right ? 1 : 0,
-                     r.missing ? 1 : 0, r.outlier ? 1 : 0, r.partly_observed ? 1 : 0);
+                     "{},{:.6f},{},{},{:.4f},{},{},{},{},{},{},{},{},{:.3f}\n", slot.seq,
+                     slot.time_s, r.take, r.frame_in_take, r.confidence, r.jumped ? 1 : 0,
+                     r.lost ? 1 : 0, r.in_pause ? 1 : 0, slot.contact_left ? 1 : 0,
+                     slot.contact_right ? 1 : 0, r.missing ? 1 : 0, r.outlier ? 1 : 0,
+                     r.partly_observed ? 1 : 0, r.frame_offset);
       recorded_.fetch_add(1, std::memory_order_relaxed);
     } else {
       lost_.fetch_add(1, std::memory_order_relaxed);

@@ -2,6 +2,7 @@
 // summary and the trace say so (repeated_frame.h); a sensor that stalls for good is lost, and said.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -75,14 +76,18 @@ TEST(CliFollowTrace, ARepeatedFrameIsMissingInTheTraceAndTheSummary) {
   std::ifstream in(trace);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line.substr(line.size() - 32), ",missing,outlier,partly_observed");
-  int row = 0, missing_rows = 0;
+  EXPECT_EQ(line.substr(line.size() - 45), ",missing,outlier,partly_observed,frame_offset");
+  int row = 0, missing_rows = 0, between_rows = 0;
   while (std::getline(in, line)) {
     std::vector<std::string> cells;
     std::stringstream ss(line);
     for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
-    ASSERT_EQ(cells.size(), 13u) << line;
+    ASSERT_EQ(cells.size(), 14u) << line;
     EXPECT_EQ(cells[12], "0");  // a full body is observed whole or not at all
+    // Where between frames the dancer is: within the confidence window around template_frame.
+    const double between = std::stod(cells[13]);
+    EXPECT_LE(std::abs(between), 6.0) << line;
+    if (between != 0.0) ++between_rows;
     if (cells[10] == "1") {
       ++missing_rows;
       EXPECT_EQ(row, 300);
@@ -91,6 +96,7 @@ TEST(CliFollowTrace, ARepeatedFrameIsMissingInTheTraceAndTheSummary) {
     ++row;
   }
   EXPECT_EQ(missing_rows, 1);
+  EXPECT_GT(between_rows, row / 2);  // the posterior is rarely all on one frame
 }
 
 }  // namespace

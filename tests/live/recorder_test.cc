@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -182,14 +183,18 @@ TEST(Recorder, SessionRecorderWritesEveryPushedFrame) {
   int lines = 0;
   while (std::getline(csv, line)) {
     if (lines == 0) {
-      EXPECT_EQ(line.substr(line.size() - 32), ",missing,outlier,partly_observed");
+      EXPECT_EQ(line.substr(line.size() - 45), ",missing,outlier,partly_observed,frame_offset");
     }
     // Row f + 1 is frame f: missing on frame 100, outlier on frame 200, neither elsewhere.
     if (lines > 0) {
       const int f = lines - 1;
       const std::string end =
           std::string(",") + (f == 100 ? "1" : "0") + "," + (f == 200 ? "1" : "0") + ",0";
-      EXPECT_EQ(line.substr(line.size() - 6), end) << line;
+      // The last column is the place between frames (a number), the three before it the flags.
+      const std::size_t last = line.rfind(',');
+      ASSERT_NE(last, std::string::npos) << line;
+      EXPECT_TRUE(std::isfinite(std::stod(line.substr(last + 1)))) << line;
+      EXPECT_EQ(line.substr(last - 6, 6), end) << line;
     }
     ++lines;
   }
