@@ -108,7 +108,7 @@ TEST(CliHeadHands, AControllerOutOfViewIsFollowedOnTheOtherPoints) {
   int frame = 0, right = 0, partly = 0;
   while (std::getline(rows, row)) {
     const std::vector<std::string> cells = cells_of(row);
-    ASSERT_EQ(cells.size(), 13u) << row;
+    ASSERT_EQ(cells.size(), 14u) << row;
     right += (cells[2] == "6" && std::abs(std::stoi(cells[3]) - frame) <= 6) ? 1 : 0;
     // Frames 600-719 held (the first and last perhaps not bit for bit: the reader puts the
     // rows' 9-decimal times on an even grid), then the hand's speed for the velocity window.
