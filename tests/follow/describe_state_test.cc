@@ -1,20 +1,14 @@
 // describe_state: what the follower reports of the state it chose, from the posterior around it.
 #include <gtest/gtest.h>
 
-#include <utility>
+#include <algorithm>
 #include <vector>
 
 #include "follow/forward_common.h"
+#include "follow/synthetic.h"
 
 namespace duet {
 namespace {
-
-// Two takes of 100 frames at 60 Hz.
-TemplateModel two_takes() {
-  FeatureMatrix f = FeatureMatrix::Zero(200, 2);
-  for (int i = 0; i < 200; ++i) f(i, 0) = static_cast<float>(i);
-  return std::move(TemplateModel::build(std::move(f), {0, 100}, 60.0, 0)).value();
-}
 
 FollowResult described(const TemplateModel& model, const std::vector<float>& posterior,
                        int state) {
@@ -24,7 +18,7 @@ FollowResult described(const TemplateModel& model, const std::vector<float>& pos
 }
 
 TEST(DescribeState, TheFrameOffsetIsThePosteriorsMeanAroundTheState) {
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   std::vector<float> p(201, 0.0f);
   // Half the mass on 50, half on 51: the dancer is half-way between them.
   p[50] = 0.5f;
@@ -51,7 +45,7 @@ TEST(DescribeState, TheFrameOffsetIsThePosteriorsMeanAroundTheState) {
 }
 
 TEST(DescribeState, TheOffsetStaysInTheStatesTake) {
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   std::vector<float> p(201, 0.0f);
   p[99] = 0.5f;  // the last frame of take 0
   p[100] = 0.3f;

@@ -8,16 +8,10 @@
 #include <utility>
 #include <vector>
 
+#include "follow/synthetic.h"
+
 namespace duet {
 namespace {
-
-// Two takes of 100 frames at 60 Hz, every frame unlike every other (the gate looks at the
-// features only to tell look-alike places).
-TemplateModel two_takes() {
-  FeatureMatrix f = FeatureMatrix::Zero(200, 2);
-  for (int i = 0; i < 200; ++i) f(i, 0) = static_cast<float>(i);
-  return std::move(TemplateModel::build(std::move(f), {0, 100}, 60.0, 0)).value();
-}
 
 // A follower whose first placement has settled from the first frame (JumpGate::settled): no
 // settling time, no forward move asked for.
@@ -74,7 +68,7 @@ FollowResult step_to(JumpGate& gate, const TemplateModel& model, const FollowPar
 }
 
 TEST(JumpGate, SmallStepsBackAreJitterLargerOnesAndOtherTakesAreJumps) {
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   FollowParams params;
   params.jump_hold_s = 0.0f;
   params.jump_tolerance_frames = 6;
@@ -98,7 +92,7 @@ TEST(JumpGate, SmallStepsBackAreJitterLargerOnesAndOtherTakesAreJumps) {
 }
 
 TEST(JumpGate, AFarPlaceIsReportedOnlyOnceItHolds) {
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   FollowParams params;
   params.jump_hold_s = 0.05f;  // 3 template frames
   settle_at_once(params);
@@ -133,7 +127,7 @@ TEST(JumpGate, AFarPlaceIsReportedOnlyOnceItHolds) {
 }
 
 TEST(JumpGate, AfterALostFrameEveryMovePastTheBandIsAJump) {
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   FollowParams params;
   params.jump_tolerance_frames = 6;
   settle_at_once(params);
@@ -148,7 +142,7 @@ TEST(JumpGate, AfterALostFrameEveryMovePastTheBandIsAJump) {
 }
 
 TEST(JumpGate, AfterALostFrameTheNewPlaceIsTakenAtOnce) {
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   FollowParams params;
   params.jump_hold_s = 0.5f;
   settle_at_once(params);
@@ -161,7 +155,7 @@ TEST(JumpGate, AfterALostFrameTheNewPlaceIsTakenAtOnce) {
 }
 
 TEST(JumpGate, WhileLostTheWanderingMaximumIsNoJumpAndBeingFoundAgainElsewhereIsOne) {
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   FollowParams params;
   settle_at_once(params);
   params.jump_hold_s = 0.0f;
@@ -212,7 +206,7 @@ TEST(JumpGate, AdriftFromTheFirstFrameIsASpellWithNoPlaceToJumpFrom) {
   // A performance that begins unexplained (three points' `improv-library`: 17 false jumps in its
   // first 2.6 s): the maximum hops between takes before any frame was steady. None of it is a
   // jump, nor is the first place found; from there on, jumps count as usual.
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   FollowParams params;
   settle_at_once(params);  // settled at once, as after a performance's first 0.3 s
   params.jump_hold_s = 0.0f;
@@ -268,7 +262,7 @@ TEST(JumpGate, AMoveBetweenPlacesThatLookAlikeIsNoJump) {
 }
 
 TEST(JumpGate, TheFirstPlacementIsRefinedWithoutJumpsUntilItHasSettled) {
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   FollowParams params;
   params.jump_settle_s = 0.1f;  // 6 template frames
   params.jump_settle_advance_s = 0.1f;  // the same 6 frames move forward
@@ -319,7 +313,7 @@ TEST(JumpGate, TheFirstPlacementIsRefinedWithoutJumpsUntilItHasSettled) {
 }
 
 TEST(JumpGate, TheFirstPlacementSettlesOnlyOnceTheEstimateMovesForward) {
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   const FollowParams params = settling_over_six_frames();
   JumpGate gate;
   // Half a second sure of one standing frame (as a standing start is): time alone does not
@@ -340,7 +334,7 @@ TEST(JumpGate, TheFirstPlacementSettlesOnlyOnceTheEstimateMovesForward) {
 }
 
 TEST(JumpGate, JitterBackAndForthIsNoMoveForward) {
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   const FollowParams params = settling_over_six_frames();
   JumpGate gate;
   // A standing start read through a noisy suit: the maximum jitters 3 frames forward and back
@@ -375,7 +369,7 @@ TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
   params.jump_hold_s = 0.0f;
   settle_at_once(params);
 
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   const auto noisy = [&](int state) { return noisy_maximum_at(model, params, state); };
   // One frame at take 1 and back: the old place goes on, no jump either way.
   JumpGate gate;
@@ -418,7 +412,7 @@ TEST(JumpGate, UnderANoisySensorAOneFrameExcursionIsNoJump) {
 TEST(JumpGate, UnderANoisySensorAFarPlaceWaitsUntilTheOldPlaceHasLostItsMass) {
   FollowParams params;
   settle_at_once(params);
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   const auto noisy = [&](int state) { return noisy_maximum_at(model, params, state); };
   // The maximum sits at take 1 for six frames while the old place (the band's reach of the
   // reported state) keeps 10 % of the mass: no jump, the old place goes on.
@@ -472,7 +466,7 @@ TEST(JumpGate, AFarPlaceTheInputFitsPoorlyWaitsTheLongerHold) {
 
   // An arm held where it was last seen fits take 1 better for a moment, and poorly: the old
   // place goes on until the far place has held for 0.4 s (24 frames at 60 Hz).
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   const auto far = [&](int state, float distance) {
     FollowResult r = maximum_at(model, {}, state);
     r.sensor_noise_per_dim = noise;
@@ -511,7 +505,7 @@ TEST(JumpGate, APlaceJustLandedOnIsLeftAtOnceOneFollowedForAWhileWaits) {
   EXPECT_EQ(JumpGate::hold_s(params, 0.0f, poorly, 0.5), 0.3f);
   EXPECT_EQ(JumpGate::hold_s(params, 0.0f, poorly), 0.3f);  // followed time not given
 
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   const auto poorly_fitted_step = [&](JumpGate& gate, int& previous, int state) {
     const std::vector<float> p = posterior(state);
     FollowResult r = maximum_at(model, p, state);
@@ -542,7 +536,7 @@ TEST(JumpGate, APlaceJustLandedOnIsLeftAtOnceOneFollowedForAWhileWaits) {
 }
 
 TEST(JumpGate, ABurstOfJumpsIsAPlaceLostFoundAgainWithoutJumps) {
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   FollowParams params;
   params.jump_hold_s = 0.0f;
   params.noisy_jump_hold_s = 0.0f;
@@ -586,7 +580,7 @@ TEST(JumpGate, ABurstOfJumpsIsAPlaceLostFoundAgainWithoutJumps) {
 }
 
 TEST(JumpGate, ACatchUpWithinTheTakeIsNoJump) {
-  const TemplateModel model = two_takes();
+  const TemplateModel model = test::two_ramp_takes();
   FollowParams params;
   params.jump_hold_s = 0.0f;
   params.noisy_jump_hold_s = 0.0f;

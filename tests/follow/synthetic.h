@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "duet/follow/template_model.h"
@@ -57,6 +58,14 @@ inline TemplateModel make_model(const std::vector<int>& take_lengths, int dims, 
   std::normal_distribution<float> noise(0.0f, 0.03f);
   for (Eigen::Index i = 0; i < f.size(); ++i) f.data()[i] += noise(rng);
   return std::move(TemplateModel::build(std::move(f), starts, fps, velocity_dims)).value();
+}
+
+// Two takes of 100 frames at 60 Hz, every frame unlike every other (frame i's one feature is i):
+// for tests of what is decided from a posterior, where the features only tell places apart.
+inline TemplateModel two_ramp_takes() {
+  FeatureMatrix f = FeatureMatrix::Zero(200, 2);
+  for (int i = 0; i < 200; ++i) f(i, 0) = static_cast<float>(i);
+  return std::move(TemplateModel::build(std::move(f), {0, 100}, 60.0, 0)).value();
 }
 
 // Features at fractional template position `position` (global state index), linearly

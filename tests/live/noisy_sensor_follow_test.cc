@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "duet/eval/metrics.h"
@@ -23,26 +24,45 @@ struct NoisyRun {
   double mean_noise = 0.0;
 };
 
-// Take 01 played whole at rate_hz with rotation noise (RMS per joint) and 1 cm root noise.
-NoisyRun follow_noisy(double rotation_deg, double rate_hz) {
+// Take 01 performed by `recipe` (seed `seed`) and followed by the HMM through the salsa library.
+struct FollowedTake {
+  Performance performance;
+  std::vector<FrameEstimate> estimates;  // empty when either step failed (a test failure)
+};
+
+FollowedTake follow_take_01(const PerformanceRecipe& recipe, std::uint64_t seed) {
   const DuetLibrary& library = test::salsa_library();
   const DuetTake& take = library.takes()[0];
   const SourceTake source{0, &take.template_motion.clip, take.template_motion.roles};
-  PerformanceRecipe recipe;
-  recipe.play.rate_hz = rate_hz;
-  recipe.noise = {rotation_deg, 0.01, 0};
-  Result<Performance> performance = make_performance({&source, 1}, recipe, 11);
-  EXPECT_TRUE(performance) << performance.error().message;
+  FollowedTake followed;
+  Result<Performance> performance = make_performance({&source, 1}, recipe, seed);
+  if (!performance) {
+    ADD_FAILURE() << performance.error().message;
+    return followed;
+  }
+  followed.performance = std::move(performance).value();
   Result<std::unique_ptr<Tracker>> tracker =
       make_eval_tracker(TrackerKind::kHmm, library.model(), EvalOptions{});
   EXPECT_TRUE(tracker);
+  if (!tracker) return followed;
   Result<std::vector<FrameEstimate>> estimates =
-      follow_performance(library, performance.value(), std::move(tracker).value());
+      follow_performance(library, followed.performance, std::move(tracker).value());
   EXPECT_TRUE(estimates) << estimates.error().message;
+  if (estimates) followed.estimates = std::move(estimates).value();
+  return followed;
+}
+
+// Take 01 played whole at rate_hz with rotation noise (RMS per joint) and 1 cm root noise.
+NoisyRun follow_noisy(double rotation_deg, double rate_hz) {
+  PerformanceRecipe recipe;
+  recipe.play.rate_hz = rate_hz;
+  recipe.noise = {rotation_deg, 0.01, 0};
+  const FollowedTake followed = follow_take_01(recipe, 11);
   NoisyRun run;
-  run.metrics = compute_metrics(performance.value(), estimates.value());
-  for (const FrameEstimate& e : estimates.value()) run.mean_noise += e.sensor_noise_per_dim;
-  run.mean_noise /= static_cast<double>(estimates.value().size());
+  if (followed.estimates.empty()) return run;
+  run.metrics = compute_metrics(followed.performance, followed.estimates);
+  for (const FrameEstimate& e : followed.estimates) run.mean_noise += e.sensor_noise_per_dim;
+  run.mean_noise /= static_cast<double>(followed.estimates.size());
   return run;
 }
 
@@ -75,25 +95,16 @@ TEST(NoisySensorFollow, FourDegreesPerAxisAtThirtyHertzIsFollowedNotLost) {
 // playhead aims there) is nearer the truth than the whole frame chosen: on take 01 at 0.85 of its
 // tempo with 2 degrees per axis, mean error 9.8 -> 8.5 ms (session 55).
 TEST(NoisySensorFollow, ThePlaceBetweenFramesIsNearerTheTruthThanTheFrame) {
-  const DuetLibrary& library = test::salsa_library();
-  const DuetTake& take = library.takes()[0];
-  const SourceTake source{0, &take.template_motion.clip, take.template_motion.roles};
   PerformanceRecipe recipe;
   recipe.play.tempo.factor = 0.85;
   recipe.noise = {3.46, 0.01, 0};  // 2 degrees per axis
-  Result<Performance> performance = make_performance({&source, 1}, recipe, 5);
-  ASSERT_TRUE(performance) << performance.error().message;
-  Result<std::unique_ptr<Tracker>> tracker =
-      make_eval_tracker(TrackerKind::kHmm, library.model(), EvalOptions{});
-  ASSERT_TRUE(tracker);
-  Result<std::vector<FrameEstimate>> estimates =
-      follow_performance(library, performance.value(), std::move(tracker).value());
-  ASSERT_TRUE(estimates) << estimates.error().message;
+  const FollowedTake followed = follow_take_01(recipe, 5);
+  ASSERT_FALSE(followed.estimates.empty());
   double whole = 0.0, between = 0.0;
   int counted = 0, offsets = 0;
-  for (std::size_t i = 0; i < estimates.value().size(); ++i) {
-    const FrameEstimate& e = estimates.value()[i];
-    const TruthFrame& truth = performance.value().truth[i];
+  for (std::size_t i = 0; i < followed.estimates.size(); ++i) {
+    const FrameEstimate& e = followed.estimates[i];
+    const TruthFrame& truth = followed.performance.truth[i];
     const double error = e.frame_in_take - truth.template_frame;
     if (e.take != truth.take || e.lost || std::abs(error) > 6.0) continue;
     ASSERT_TRUE(std::isfinite(e.frame_offset));
@@ -105,7 +116,7 @@ TEST(NoisySensorFollow, ThePlaceBetweenFramesIsNearerTheTruthThanTheFrame) {
   }
   std::printf("mean error %.2f ms at the frame, %.2f ms between frames (%d frames)\n",
               1000.0 * whole / counted / 60.0, 1000.0 * between / counted / 60.0, counted);
-  ASSERT_GT(counted, static_cast<int>(0.9 * static_cast<double>(estimates.value().size())));
+  ASSERT_GT(counted, static_cast<int>(0.9 * static_cast<double>(followed.estimates.size())));
   EXPECT_GT(offsets, counted / 2);
   EXPECT_LT(between, 0.95 * whole);
 }
