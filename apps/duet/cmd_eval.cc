@@ -411,7 +411,9 @@ int run_eval(EvalArgs& args) {
       "after {} s followed) jump_old_place_mass {} jump_alike_distance {}\n"
       "noise-scaled: pause_noise_factor {} lost_residual {} lost_noise_factor {} "
       "lost_residual_factor {} lost_confirm {} s found_confirm {} x lost (at most {} s) "
-      "lost_velocity_cap {}/dim{} held_place_lost {} s (reach {} s) missing_lost {} s "
+      "lost_velocity_cap {}/dim{} held_place_lost {} s (reach {} s) found_still_spell {} s (reach "
+      "{} s) "
+      "missing_lost {} s "
       "emission_noise_factor {} "
       "emission_noise_allowance {} noise_filter_density {} noise_filter_allowance {}\n\n",
       library->takes().size(), library->model().num_states(), library->frame_rate(),
@@ -427,8 +429,9 @@ int run_eval(EvalArgs& args) {
       hmm.lost_noise_factor, hmm.lost_residual_factor, hmm.lost_confirm_s,
       hmm.found_confirm_per_lost_s, hmm.found_confirm_max_s, hmm.lost_velocity_cap_per_dim,
       hmm.pause_reported_lost ? " pause_reported_lost" : "", hmm.held_place_lost_s,
-      hmm.held_place_reach_s, hmm.missing_lost_s, hmm.emission_noise_factor,
-      hmm.emission_noise_allowance, hmm.noise_filter_density, hmm.noise_filter_allowance);
+      hmm.held_place_reach_s, hmm.found_still_spell_s, hmm.found_still_reach_s, hmm.missing_lost_s,
+      hmm.emission_noise_factor, hmm.emission_noise_allowance, hmm.noise_filter_density,
+      hmm.noise_filter_allowance);
   fmt::print("{}", format_eval_table(report.value()));
   if (!non_dance.value().empty()) {
     fmt::print("\nnon-dance input (motion no part of the library explains; hmm, {}): lost\n",

@@ -62,6 +62,15 @@ const std::vector<FloatRow>& float_rows() {
        "held_place_reach_s: how far (template seconds) the estimate must move to start a new "
        "hold",
        number_between(0.001, 10.0, "s")},
+      {"--found-still-spell-s", &FollowParams::found_still_spell_s,
+       "found_still_spell_s: after a spell lost by distance this long or longer, the place found "
+       "again is reported lost until the estimate moves on by --found-still-reach-s (input "
+       "seconds; 0 for never; all HMM variants)",
+       number_between(0.0, 600.0, "s")},
+      {"--found-still-reach-s", &FollowParams::found_still_reach_s,
+       "found_still_reach_s: how far (template seconds) the estimate must move from where it was "
+       "found again",
+       number_between(0.001, 10.0, "s")},
       {"--missing-lost-s", &FollowParams::missing_lost_s,
        "missing_lost_s: input without evidence (missing, or the sensor's last pose sent again) "
        "for longer than this is reported lost (input seconds; 0 for never; all HMM variants)",

@@ -442,6 +442,8 @@ Result<std::unique_ptr<Tracker>> make_eval_tracker(TrackerKind kind, const Templ
       params.pause_reported_lost = options.hmm.pause_reported_lost;
       params.held_place_lost_s = options.hmm.held_place_lost_s;
       params.held_place_reach_s = options.hmm.held_place_reach_s;
+      params.found_still_spell_s = options.hmm.found_still_spell_s;
+      params.found_still_reach_s = options.hmm.found_still_reach_s;
       params.missing_lost_s = options.hmm.missing_lost_s;
       params.confidence_window_frames = options.hmm.confidence_window_frames;
       params.max_steps_per_frame = options.hmm.max_steps_per_frame;

@@ -44,6 +44,7 @@ FollowParams FollowParams::paper() {
   params.found_confirm_per_lost_s = 0.0f;
   params.pause_reported_lost = true;
   params.held_place_lost_s = 0.0f;
+  params.found_still_spell_s = 0.0f;
   params.missing_lost_s = 0.0f;
   return params;
 }
@@ -103,6 +104,10 @@ Status FollowParams::validate(int num_states) const {
     return params_error("held_place_reach_s must be finite and > 0, got " +
                         std::to_string(held_place_reach_s));
   }
+  if (!(found_still_reach_s > 0.0f && std::isfinite(found_still_reach_s))) {
+    return params_error("found_still_reach_s must be finite and > 0, got " +
+                        std::to_string(found_still_reach_s));
+  }
   if (!(sensor_noise_time_constant_s > 0.0 && std::isfinite(sensor_noise_time_constant_s))) {
     return params_error("sensor_noise_time_constant_s must be finite and > 0, got " +
                         std::to_string(sensor_noise_time_constant_s));
@@ -119,6 +124,7 @@ Status FollowParams::validate(int num_states) const {
                       {"noise_filter_density", noise_filter_density},
                       {"noise_filter_allowance", noise_filter_allowance},
                       {"held_place_lost_s", held_place_lost_s},
+                      {"found_still_spell_s", found_still_spell_s},
                       {"missing_lost_s", missing_lost_s}};
   for (const auto& level : non_negative) {
     if (!(level.value >= 0.0f && std::isfinite(level.value))) {

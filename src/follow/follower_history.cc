@@ -32,6 +32,9 @@ void FollowerHistory::reset() noexcept {
   noise_filter.reset();
   explained_residual.reset();
   held_place.reset();
+  distance_spell_s = 0.0;
+  found_from_state = -1;
+  still_since_found.reset();
   missing_s = 0.0;
   evidence_confidence = -1.0f;
 }
@@ -75,11 +78,34 @@ void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams
                             !result.missing && !result.outlier && !result.in_pause &&
                                 !result.jumped && !result.limb_out_of_line,
                             moved_far ? 0 : advanced, dt_s, model.frame_rate_hz());
+  const bool lost_by_distance_before = lost_by_distance;
   result.lost = report_lost(params, result.lost, past_ceiling, unexplained, result.missing,
                             result.steps / model.frame_rate_hz());
-  held_place.update(result.state, result.jumped, dt_s,
-                    std::max(1, static_cast<int>(std::lround(params.held_place_reach_s *
-                                                             model.frame_rate_hz()))));
+  if (!result.missing) {  // where the input came back within reach while lost (a frame's wait)
+    const bool waiting = lost_by_distance_before && !unexplained;
+    if (!waiting) {
+      found_from_state = -1;
+    } else if (found_from_state < 0) {
+      found_from_state = result.state;
+    }
+  }
+  if (lost_by_distance && dt_s > 0.0 && std::isfinite(dt_s)) distance_spell_s += dt_s;
+  const bool found_after_spell = params.found_still_spell_s > 0.0f && lost_by_distance_before &&
+                                 !lost_by_distance &&
+                                 distance_spell_s >= params.found_still_spell_s - 1e-6;
+  if (!lost_by_distance) distance_spell_s = 0.0;
+  const auto reach_states = [&](float reach_s) {
+    return std::max(1, static_cast<int>(std::lround(reach_s * model.frame_rate_hz())));
+  };
+  held_place.update(result.state, result.jumped, dt_s, reach_states(params.held_place_reach_s));
+  still_since_found.update(result.state, result.jumped, found_after_spell ? found_from_state : -1,
+                           reach_states(params.found_still_reach_s));
+  if (!lost_by_distance) found_from_state = -1;
+  if (still_since_found.still() && !result.lost) {
+    result.lost = true;
+    result.held_still = true;
+    result.still_since_lost = true;
+  }
   if (params.held_place_lost_s > 0.0f && held_place.held_s() > params.held_place_lost_s &&
       !result.lost) {
     result.lost = true;

@@ -111,7 +111,7 @@ FollowResult FollowSession::step(std::span<const Vec3> translations_ls,
   }
   if (!partly_unseen) search_offset(result, dt_s);
   // A frame without evidence neither breaks nor extends a lost run.
-  if (!result.missing) bias_.note_lost(result.lost, dt_s);
+  if (!result.missing) bias_.note_lost(result.lost && !result.still_since_lost, dt_s);
   result.rig_offset = bias_.offset_rms();
   result.rig_offset_learnt_s = static_cast<float>(bias_.learnt_s());
   result.tracker_confidence = result.confidence;
@@ -163,8 +163,9 @@ void FollowSession::search_offset(const FollowResult& result, double dt_s) noexc
   const TemplateModel& model = library_->model();
   // Only while the input is unexplained (the pause state holds it, or it is lost) and no offset of
   // size is held (a held one is let go after release_after_lost_s lost; the search starts then).
-  if (!params.enabled || !params.search.enabled || !(result.in_pause || result.lost) ||
-      result.missing || result.state < 0 || result.state >= model.num_states() ||
+  if (!params.enabled || !params.search.enabled ||
+      !(result.in_pause || (result.lost && !result.still_since_lost)) || result.missing ||
+      result.state < 0 || result.state >= model.num_states() ||
       bias_.offset_rms() > params.release_offset_rms) {
     if (!result.missing) {
       search_.reset();

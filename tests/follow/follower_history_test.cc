@@ -169,13 +169,56 @@ TEST(FollowerHistory, TheHeldPlaceLimitsAreChecked) {
     params = FollowParams{};
     params.held_place_reach_s = bad;
     EXPECT_FALSE(params.validate(10)) << bad;
+    params = FollowParams{};
+    params.found_still_spell_s = bad;
+    EXPECT_FALSE(params.validate(10)) << bad;
+    params = FollowParams{};
+    params.found_still_reach_s = bad;
+    EXPECT_FALSE(params.validate(10)) << bad;
   }
   FollowParams zero_reach;
   zero_reach.held_place_reach_s = 0.0f;
   EXPECT_FALSE(zero_reach.validate(10));
+  zero_reach = FollowParams{};
+  zero_reach.found_still_reach_s = 0.0f;
+  EXPECT_FALSE(zero_reach.validate(10));
   FollowParams never;
   never.held_place_lost_s = 0.0f;
+  never.found_still_spell_s = 0.0f;
   EXPECT_TRUE(never.validate(10));
+}
+
+TEST(StillSinceFound, HoldsFromWhereThePlaceWasFoundAgainUntilTheEstimateMovesOn) {
+  StillSinceFound still;
+  constexpr int kReach = 6;
+  constexpr int kNone = -1;
+  still.update(300, false, kNone, kReach);  // nothing found again yet
+  EXPECT_FALSE(still.still());
+  still.update(294, true, 294, kReach);  // found again at 294, by a jump there
+  EXPECT_TRUE(still.still());
+  for (int f = 0; f < 60; ++f) {  // jitter within reach either way
+    still.update(294 + f % 11 - 5, false, kNone, kReach);
+    EXPECT_TRUE(still.still()) << f;
+  }
+  still.update(300, false, kNone, kReach);  // moved on by the reach
+  EXPECT_FALSE(still.still());
+  still.update(294, false, kNone, kReach);  // back near the place: moved on is moved on
+  EXPECT_FALSE(still.still());
+  still.update(294, false, 294, kReach);
+  still.update(288, false, kNone, kReach);  // the reach back counts too
+  EXPECT_FALSE(still.still());
+  still.update(340, false, 294, kReach);  // moved on while the follower waited to find it
+  EXPECT_FALSE(still.still());
+  still.update(297, false, 294, kReach);  // within reach of where the wait began
+  EXPECT_TRUE(still.still());
+  still.update(295, true, kNone, kReach);  // a jump, even nearby
+  EXPECT_FALSE(still.still());
+  still.update(294, false, 294, kReach);
+  still.update(-1, false, kNone, kReach);  // no estimate
+  EXPECT_FALSE(still.still());
+  still.update(294, false, 294, kReach);
+  still.reset();
+  EXPECT_FALSE(still.still());
 }
 
 }  // namespace

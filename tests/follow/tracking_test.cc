@@ -255,6 +255,44 @@ TEST_F(TrackingTest, APlaceHeldForSecondsIsLostUntilTheDanceMovesOn) {
   for (std::size_t t = 3; t < held.results.size(); ++t) EXPECT_FALSE(held.results[t].lost) << t;
 }
 
+TEST_F(TrackingTest, APlaceFoundAgainAfterASpellLostIsLostUntilTheDanceMovesOn) {
+  // Two seconds of dance, one second no frame explains (a wave), the pose of frame 120 held for
+  // 1.5 s (the arm down: a person standing as a take's frame stands), then the dance from there.
+  const FollowParams params;
+  ASSERT_FLOAT_EQ(params.found_still_spell_s, 0.5f);
+  const auto follow = [&](const FollowParams& p) {
+    HmmFollower hmm = HmmFollower::create(model_, p).value();
+    std::vector<FollowResult> results;
+    for (int t = 0; t < 390; ++t) {
+      const double position = t < 120 ? t : t < 270 ? 120.0 : 120.0 + (t - 270);
+      std::vector<float> phi = test::features_at(model_, position);
+      if (t >= 120 && t < 180) {
+        for (float& v : phi) v += 3.0f;  // far from every frame
+      }
+      results.push_back(hmm.step(phi, 1.0 / 60));
+    }
+    return results;
+  };
+  const std::vector<FollowResult> r = follow(params);
+  for (int t = 130; t < 180; ++t) EXPECT_TRUE(r[t].lost && !r[t].still_since_lost) << t;
+  for (int t = 180; t < 270; ++t) {
+    EXPECT_TRUE(r[t].lost) << t;  // the found again wait first (found_confirm_per_lost_s), then
+    if (t >= 200) {               // the place found again that does not move on
+      EXPECT_TRUE(r[t].still_since_lost && r[t].held_still) << t;
+      EXPECT_LE(std::abs(r[t].state - 120), 3) << t;  // the estimate itself holds the place
+    }
+  }
+  for (int t = 290; t < 390; ++t) {  // the dance moves on: followed
+    EXPECT_FALSE(r[t].lost) << t;
+    EXPECT_LE(std::abs(r[t].state - (120 + t - 270)), 1) << t;
+  }
+
+  FollowParams never = params;
+  never.found_still_spell_s = 0.0f;
+  const std::vector<FollowResult> found = follow(never);
+  for (int t = 200; t < 390; ++t) EXPECT_FALSE(found[t].lost) << t;
+}
+
 TEST_F(TrackingTest, WithoutEvidenceTheTempoCarriesTheEstimateUntilItIsLost) {
   // Two seconds of dance, then four seconds with no evidence (a stalled sensor: FollowSession
   // gives the tracker missing frames) while the dancer dances on, then evidence again.

@@ -177,6 +177,19 @@ struct FollowParams {
   // long"). 0: never.
   float held_place_lost_s = 3.0f;
   float held_place_reach_s = 0.2f;
+  // After a spell lost by distance of found_still_spell_s of input time or longer, the place the
+  // follower finds again is reported lost (FollowResult::still_since_lost) until the estimate
+  // moves found_still_reach_s of template time from where the found-again wait began
+  // (StillSinceFound): a wave's arm coming down
+  // leaves a person standing as a take's standing start does, and a dancer found again moves on
+  // with the dance. The Bandai wave as three points was 75.2 % lost (issue 11: >= 95), its second
+  // between two waves followed on one standing frame; 96.7 % with 0.3 or 0.5 s and a reach of
+  // 0.05, 0.1 or 0.2 s. Three points' dance frames lost on tracked rose 0.93 -> 0.99 % at 0.5 /
+  // 0.1 against 1.03 at 0.3 / 0.1 and 1.10 at 0.3 / 0.2; the full body's were the same (its found
+  // again waits, found_confirm_per_lost_s). 0: never (docs/evaluation.md, "Still where found
+  // again").
+  float found_still_spell_s = 0.5f;
+  float found_still_reach_s = 0.1f;
   // A frame without evidence (FollowResult::missing: no usable pose, or the sensor sent its last
   // pose again) moves the band on at the dancer's tempo and keeps the last frame's lost flag and
   // confidence: the tempo carries the estimate through a stall of seconds (`duet eval`'s `stalls`,

@@ -99,6 +99,9 @@ struct FollowerHistory {
   ExplainedResidual explained_residual;
   HeldPlace
       held_place;  // how long the estimate has held one place (FollowParams::held_place_lost_s)
+  double distance_spell_s = 0.0;      // input time lost by distance, consecutively
+  int found_from_state = -1;          // the estimate where a found-again wait began; negative: none
+  StillSinceFound still_since_found;  // FollowParams::found_still_spell_s
   double missing_s = 0.0;             // input time without evidence, consecutively (missing_lost_s)
   float evidence_confidence = -1.0f;  // the last frame with evidence's confidence; < 0: none yet
 };

@@ -27,4 +27,27 @@ class HeldPlace {
   double held_s_ = 0.0;
 };
 
+// Whether the estimate still stands where the follower found a place again after a spell lost.
+//
+// Motion no take holds passes through poses a dance holds: the Bandai wave's arm coming down
+// leaves a person standing, hands hanging, which three points cannot tell from a salsa take's
+// standing start. Found again there, the estimate stays put; a dancer found again moves on with
+// the dance at once (FollowParams::found_still_spell_s).
+class StillSinceFound {
+ public:
+  // The frame's estimate (a template state; negative: none), whether the follower called a jump,
+  // and, on the frame the follower found a place again after a long enough spell lost, the
+  // estimate where the input first came back within reach of the library (the found-again wait
+  // began; negative on every other frame). A move of `reach_states` or more from there (either
+  // way), or a jump after that frame, ends the stillness: a dancer moved on during the wait is
+  // no person standing.
+  void update(int state, bool jumped, int found_again_from, int reach_states) noexcept;
+  // Whether the estimate has not moved on since it was found again.
+  bool still() const noexcept { return found_at_ >= 0; }
+  void reset() noexcept { found_at_ = -1; }
+
+ private:
+  int found_at_ = -1;  // the state the place was found again at; negative: moved on, or none
+};
+
 }  // namespace duet

@@ -31,6 +31,11 @@ struct FollowResult {
   // (FollowParams::held_place_lost_s): a dancer standing still, whom the partner waits with
   // instead of dancing on as through a spell the library does not explain.
   bool held_still = false;
+  // Lost (and held_still) because the estimate has not moved on since the follower found a place
+  // again after a spell lost by distance (FollowParams::found_still_spell_s): a person who stopped
+  // moving after motion no take explains, whom a stance matches. The input's evidence did not
+  // call it lost, so the rig's offset is not searched or let go for it (FollowSession).
+  bool still_since_lost = false;
   bool in_pause = false;  // the pause state holds most of the posterior mass
   bool missing = false;   // the input held NaN/inf: transition only, no emission
   // Some of the input's dimensions were NaN, the rest evidence (a controller out of the
