@@ -231,6 +231,9 @@ FollowParams follow_params_for(InputPoints points, FollowParams params) {
     params.unexplained_jump_hold_s = kHeadHandsUnexplainedJumpHoldS;
     params.found_confirm_per_lost_s = 0.0f;
     params.outlier_max_s = kHeadHandsOutlierMaxS;
+    if (params.held_place_lost_s > kHeadHandsHeldPlaceLostS) {
+      params.held_place_lost_s = kHeadHandsHeldPlaceLostS;
+    }
   }
   return params;
 }

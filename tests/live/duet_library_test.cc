@@ -57,6 +57,20 @@ TEST(DuetLibrary, ThreePointLibrariesHoldOnlyFromAPlaceFollowedAWhile) {
   EXPECT_TRUE(points.validate(100));
 }
 
+TEST(DuetLibrary, ThreePointLibrariesCallAPlaceHeldForTwoSecondsLost) {
+  const FollowParams defaults;
+  ASSERT_GT(defaults.held_place_lost_s, kHeadHandsHeldPlaceLostS);
+  EXPECT_EQ(follow_params_for(InputPoints::kFullBody, defaults).held_place_lost_s,
+            defaults.held_place_lost_s);
+  EXPECT_EQ(follow_params_for(InputPoints::kHeadHands, defaults).held_place_lost_s,
+            kHeadHandsHeldPlaceLostS);
+  FollowParams given = defaults;
+  given.held_place_lost_s = 0.0f;  // never (the paper preset) stays never
+  EXPECT_EQ(follow_params_for(InputPoints::kHeadHands, given).held_place_lost_s, 0.0f);
+  given.held_place_lost_s = 1.0f;  // a shorter one stays
+  EXPECT_EQ(follow_params_for(InputPoints::kHeadHands, given).held_place_lost_s, 1.0f);
+}
+
 TEST(DuetLibrary, ThreePointLibrariesAverageTheRigOffsetOverTheirOwnTime) {
   PostureBiasParams defaults;
   defaults.head_hands_time_constant_s = 2.5;

@@ -82,9 +82,15 @@ struct DuetTake {
 // frame only: the frames a true jump lands on fit the new place less closely than a body's, and
 // set aside for 0.05-0.1 s they cost the improvised cases up to 0.7 points within 100 ms on the
 // proportioned rig (docs/evaluation.md, "A sensor that pops").
+// And they call a place held still for kHeadHandsHeldPlaceLostS lost, not the body's 3 s
+// (FollowParams::held_place_lost_s; a shorter one, or 0 for never, stays): a person standing
+// with the hands hanging is a take's standing start to three points only. The Bandai dance as
+// three points (8.5 s standing first) 95.3 -> 96.9 % lost, the library's, Bandai and
+// proportioned rigs' dance cases the same (docs/evaluation.md, "Still where found again").
 // `duet follow`, `duet serve` and `duet eval` make their trackers with it.
 inline constexpr float kHeadHandsUnexplainedJumpHoldS = 0.3f;
 inline constexpr float kHeadHandsOutlierMaxS = 0.0f;
+inline constexpr float kHeadHandsHeldPlaceLostS = 2.0f;
 FollowParams follow_params_for(InputPoints points, FollowParams params);
 // The rig offset's parameters for these input points: three points average it over
 // PostureBiasParams::head_hands_time_constant_s (also while the sensor is noisy). FollowSession
