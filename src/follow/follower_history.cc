@@ -81,7 +81,9 @@ void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams
   const bool lost_by_distance_before = lost_by_distance;
   result.lost = report_lost(params, result.lost, past_ceiling, unexplained, result.missing,
                             result.steps / model.frame_rate_hz());
-  if (!result.missing) {  // where the input came back within reach while lost (a frame's wait)
+  // The estimate at the first frame back within the lost distance while lost (the found-again
+  // wait's first frame): StillSinceFound measures the dancer's move on from there.
+  if (!result.missing) {
     const bool waiting = lost_by_distance_before && !unexplained;
     if (!waiting) {
       found_from_state = -1;
