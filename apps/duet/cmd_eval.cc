@@ -421,7 +421,12 @@ int run_eval(EvalArgs& args) {
       hmm.leave_prob, hmm.pause_stay_prob, hmm.emission_sigma, hmm.pause_distance_per_dim,
       hmm.lost_distance_per_dim, hmm.velocity_distance_cap, hmm.limb_outlier_ratio,
       hmm.limb_outlier_floor,
-      hmm.tempo_adaptive ? fmt::format("adaptive ({:g} s)", hmm.tempo_time_constant_s) : "fixed",
+      hmm.tempo_adaptive
+          ? fmt::format("adaptive ({:g} s; windows of {:g} s under {:g} x the template's "
+                        "tempo a hold, untaught for up to {:g} s)",
+                        hmm.tempo_time_constant_s, hmm.tempo_hold_window_s, hmm.tempo_hold_advance,
+                        hmm.tempo_hold_max_s)
+          : "fixed",
       hmm.jump_hold_s, hmm.jump_tolerance_frames, hmm.jump_settle_s, hmm.jump_settle_mass,
       hmm.jump_settle_advance_s, hmm.noisy_jump_hold_s, hmm.unexplained_jump_hold_s,
       hmm.unexplained_jump_ratio, hmm.unexplained_jump_hold_after_s, hmm.jump_old_place_mass,

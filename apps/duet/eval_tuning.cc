@@ -62,6 +62,20 @@ const std::vector<FloatRow>& float_rows() {
        "held_place_reach_s: how far (template seconds) the estimate must move to start a new "
        "hold",
        number_between(0.001, 10.0, "s")},
+      {"--tempo-hold-window-s", &FollowParams::tempo_hold_window_s,
+       "tempo_hold_window_s: a window of input this long whose estimate advances less than "
+       "--tempo-hold-advance frames per frame of time is a hold, and teaches the tempo nothing (0 "
+       "for every "
+       "band move; all HMM variants but the paper preset)",
+       number_between(0.0, 2.0, "s")},
+      {"--tempo-hold-advance", &FollowParams::tempo_hold_advance,
+       "tempo_hold_advance: template frames per template frame of input time under which a "
+       "window is a hold",
+       number_between(0.0, 1.99)},
+      {"--tempo-hold-max-s", &FollowParams::tempo_hold_max_s,
+       "tempo_hold_max_s: a hold longer than this is someone standing, and its moves teach the "
+       "tempo again",
+       number_between(0.0, 600.0, "s")},
       {"--found-still-spell-s", &FollowParams::found_still_spell_s,
        "found_still_spell_s: after a spell lost by distance this long or longer, the place found "
        "again is reported lost until the estimate moves on by --found-still-reach-s (input "

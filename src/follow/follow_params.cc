@@ -13,6 +13,18 @@ bool is_probability(float p) { return std::isfinite(p) && p >= 0.0f && p <= 1.0f
 
 }  // namespace
 
+TempoLimits FollowParams::tempo_limits(double template_fps) const {
+  TempoLimits limits;
+  limits.time_constant_s = tempo_time_constant_s;
+  limits.min_tempo = min_tempo;
+  limits.max_tempo = max_tempo;
+  limits.hold_window_s = tempo_hold_window_s;
+  limits.hold_advance = tempo_hold_advance;
+  limits.template_fps = template_fps;
+  limits.hold_max_s = tempo_hold_max_s;
+  return limits;
+}
+
 FollowParams FollowParams::paper() {
   FollowParams params;
   params.self_prob = 0.33f;
@@ -208,6 +220,18 @@ Status FollowParams::validate(int num_states) const {
     if (!(min_tempo > 0.0f && max_tempo >= min_tempo && max_tempo < 2.0f)) {
       return params_error("the tempo range needs 0 < min_tempo <= max_tempo < 2, got [" +
                           std::to_string(min_tempo) + ", " + std::to_string(max_tempo) + "]");
+    }
+    if (!(tempo_hold_window_s >= 0.0f && tempo_hold_window_s <= 2.0f)) {
+      return params_error("tempo_hold_window_s must be in [0, 2] s, got " +
+                          std::to_string(tempo_hold_window_s));
+    }
+    if (!(tempo_hold_max_s >= 0.0f && std::isfinite(tempo_hold_max_s))) {
+      return params_error("tempo_hold_max_s must be finite and >= 0, got " +
+                          std::to_string(tempo_hold_max_s));
+    }
+    if (!(tempo_hold_advance >= 0.0f && tempo_hold_advance < 2.0f)) {
+      return params_error("tempo_hold_advance must be in [0, 2) frames a step, got " +
+                          std::to_string(tempo_hold_advance));
     }
     if (!(self_prob > 0.0f && skip_prob > 0.0f)) {
       return params_error(

@@ -59,6 +59,7 @@ void FollowerHistory::finish_step(const TemplateModel& model, const FollowParams
     tempo.update(previous_state, result.state, result.steps, dt_s, band_move, limits);
   }
   tempo.observe_rate(result.steps, dt_s, model.frame_rate_hz(), limits);
+  if (params.tempo_adaptive) tempo.start_at_template_tempo(limits);
   result.tempo = tempo.dancer_tempo();
   total_log_likelihood += result.log_likelihood;
   ++frames;

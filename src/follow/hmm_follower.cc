@@ -47,7 +47,7 @@ Result<HmmForward> HmmForward::create(const TemplateModel& model, const FollowPa
   const float total =
       params.self_prob + params.next_prob + params.skip_prob + (jump ? params.leave_prob : 0.0f);
   forward.band_ = {params.self_prob / total, params.next_prob / total, params.skip_prob / total};
-  forward.tempo_limits_ = {params.tempo_time_constant_s, params.min_tempo, params.max_tempo};
+  forward.tempo_limits_ = params.tempo_limits(model.frame_rate_hz());
   forward.leave_ = jump ? params.leave_prob / total : 0.0f;
   forward.pause_stay_ = jump ? params.pause_stay_prob : 1.0f;
   if (jump && !params.resume_weights.empty()) {

@@ -31,7 +31,7 @@ Result<NaiveHmmFollower> NaiveHmmFollower::create(const TemplateModel& model,
       params.self_prob + params.next_prob + params.skip_prob + (jump ? params.leave_prob : 0.0f);
   follower.band_ = {params.self_prob / total, params.next_prob / total, params.skip_prob / total};
   follower.leave_ = jump ? params.leave_prob / total : 0.0f;
-  follower.tempo_limits_ = {params.tempo_time_constant_s, params.min_tempo, params.max_tempo};
+  follower.tempo_limits_ = params.tempo_limits(model.frame_rate_hz());
   double resume_sum = 0.0;
   for (const float w : params.resume_weights) resume_sum += w;
 
@@ -149,6 +149,7 @@ FollowResult NaiveHmmFollower::step(std::span<const float> features, double dt_s
     tempo_.update(previous_state_, result.state, result.steps, dt_s, band_move, tempo_limits_);
   }
   tempo_.observe_rate(result.steps, dt_s, model.frame_rate_hz(), tempo_limits_);
+  if (params_.tempo_adaptive) tempo_.start_at_template_tempo(tempo_limits_);
   result.tempo = tempo_.dancer_tempo();
   previous_state_ = result.state;
   previous_lost_ = result.lost;

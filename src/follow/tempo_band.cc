@@ -43,9 +43,87 @@ BandProbabilities tilt_band(const BandProbabilities& base, float tempo) {
 
 void TempoEstimator::update(int previous_state, int state, int steps, double dt_s, bool usable,
                             const TempoLimits& limits) noexcept {
-  if (!usable || previous_state < 0 || steps < 1 || !(dt_s > 0.0) || !std::isfinite(dt_s)) return;
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s) || steps < 1) return;
+  const bool windowed = limits.hold_window_s > 0.0;
+  if (!usable || previous_state < 0) {
+    // A jump, a lost or missing frame ends the window: judged if long enough to tell a hold.
+    if (windowed) settle_window(pending_s_ >= 0.5 * limits.hold_window_s, limits);
+    return;
+  }
   const int moved = state - previous_state;
-  if (moved < 0 || moved > 2 * steps) return;  // not a band move
+  const bool band_move = moved >= 0 && moved <= 2 * steps;
+  if (!windowed) {
+    if (band_move) teach(moved, steps, dt_s, limits);
+    return;
+  }
+  // Taught at once; undone below if the window it opens turns out to be a hold.
+  if (pending_count_ == kMaxPending) forget_oldest();
+  PendingMove move;
+  move.moved = moved;
+  move.dt_s = dt_s;
+  // The dancer's tempo, not the steps': a sensor faster than the template makes a step per frame.
+  const double template_frames =
+      limits.template_fps > 0.0 ? dt_s * limits.template_fps : static_cast<double>(steps);
+  move.template_frames = template_frames;
+  move.within_reach = moved >= -2 * steps && moved <= 2 * steps;
+  move.tempo_before = tempo_;
+  move.updates_before = updates_;
+  if (band_move) teach(moved, steps, dt_s, limits);
+  pending_[static_cast<std::size_t>((pending_first_ + pending_count_) % kMaxPending)] = move;
+  ++pending_count_;
+  pending_s_ += dt_s;
+  if (move.within_reach) {
+    pending_moved_ += moved;
+    pending_frames_ += template_frames;
+  }
+  if (pending_s_ < limits.hold_window_s) return;
+  if (!is_hold(limits)) {
+    held_s_ = 0.0;
+  } else if (held_s_ + pending_s_ <= limits.hold_max_s) {
+    held_s_ += pending_s_;
+    settle_window(true, limits);
+    return;
+  } else {
+    held_s_ += dt_s;  // standing this long is no dancer's hold: the tempo falls again
+  }
+  // What left the window stands.
+  while (pending_count_ > 0 &&
+         pending_s_ - pending_[static_cast<std::size_t>(pending_first_)].dt_s >=
+             limits.hold_window_s) {
+    forget_oldest();
+  }
+}
+
+bool TempoEstimator::is_hold(const TempoLimits& limits) const noexcept {
+  return pending_frames_ > 0.0 &&
+         static_cast<double>(pending_moved_) < double{limits.hold_advance} * pending_frames_;
+}
+
+void TempoEstimator::settle_window(bool judge, const TempoLimits& limits) noexcept {
+  if (pending_count_ > 0 && judge && is_hold(limits)) {
+    const PendingMove& first = pending_[static_cast<std::size_t>(pending_first_)];
+    tempo_ = first.tempo_before;
+    updates_ = first.updates_before;
+  }
+  pending_first_ = 0;
+  pending_count_ = 0;
+  pending_s_ = 0.0;
+  pending_moved_ = 0;
+  pending_frames_ = 0.0;
+}
+
+void TempoEstimator::forget_oldest() noexcept {
+  const PendingMove& oldest = pending_[static_cast<std::size_t>(pending_first_)];
+  if (oldest.within_reach) {
+    pending_moved_ -= oldest.moved;
+    pending_frames_ -= oldest.template_frames;
+  }
+  pending_s_ -= oldest.dt_s;
+  pending_first_ = (pending_first_ + 1) % kMaxPending;
+  --pending_count_;
+}
+
+void TempoEstimator::teach(int moved, int steps, double dt_s, const TempoLimits& limits) noexcept {
   const double rate = static_cast<double>(moved) / steps;
   // An exponential average, but a plain running mean while there are fewer moves than its memory
   // holds, so the first second of a dance already counts fully rather than being pulled to 1.
@@ -73,6 +151,16 @@ void TempoEstimator::observe_rate(int steps, double dt_s, double template_fps,
   const double weight = 1.0 - std::exp(-dt_s / limits.time_constant_s);
   mean_steps_ += weight * (steps - mean_steps_);
   mean_template_frames_ += weight * (frames - mean_template_frames_);
+}
+
+void TempoEstimator::start_at_template_tempo(const TempoLimits& limits) noexcept {
+  // Until a move is taught the estimate is the prior that the dancer moves at the template's
+  // tempo, in steps: half a frame a step from a 120 Hz sensor on a 60 Hz template. At 1 a step it
+  // ran ahead through a standing start, until a hold there happened to drag it down.
+  if (updates_ > 0 || !(mean_template_frames_ > 0.0)) return;
+  const double steps_per_frame = std::max(mean_steps_ / mean_template_frames_, 1.0);
+  tempo_ = static_cast<float>(
+      std::clamp(1.0 / steps_per_frame, double{limits.min_tempo}, double{limits.max_tempo}));
 }
 
 float TempoEstimator::dancer_tempo() const noexcept {

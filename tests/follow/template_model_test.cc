@@ -234,6 +234,10 @@ TEST(FollowParams, RejectsBadValues) {
   check([](FollowParams& p) { p.tempo_time_constant_s = 0.0; }, "tempo_time_constant_s");
   check([](FollowParams& p) { p.max_tempo = 2.0f; }, "tempo range");
   check([](FollowParams& p) { p.min_tempo = 0.0f; }, "tempo range");
+  check([](FollowParams& p) { p.tempo_hold_window_s = -0.1f; }, "tempo_hold_window_s");
+  check([](FollowParams& p) { p.tempo_hold_window_s = std::nanf(""); }, "tempo_hold_window_s");
+  check([](FollowParams& p) { p.tempo_hold_advance = 2.0f; }, "tempo_hold_advance");
+  check([](FollowParams& p) { p.tempo_hold_max_s = -1.0f; }, "tempo_hold_max_s");
   check([](FollowParams& p) { p.skip_prob = 0.0f; }, "tempo_adaptive needs");
   check([](FollowParams& p) { p.max_steps_per_frame = 0; }, "max_steps_per_frame");
   check([](FollowParams& p) { p.jump_hold_s = -0.1f; }, "jump_hold_s");
@@ -247,6 +251,24 @@ TEST(FollowParams, RejectsBadValues) {
         p.resume_weights[3] = -1.0f;
       },
       "resume_weights[3]");
+}
+
+TEST(FollowParams, TempoLimitsCarryEveryTempoField) {
+  FollowParams params;
+  params.tempo_time_constant_s = 1.5;
+  params.min_tempo = 0.5f;
+  params.max_tempo = 1.6f;
+  params.tempo_hold_window_s = 0.2f;
+  params.tempo_hold_advance = 0.25f;
+  params.tempo_hold_max_s = 1.25f;
+  const TempoLimits limits = params.tempo_limits(60.0);
+  EXPECT_EQ(limits.time_constant_s, 1.5);
+  EXPECT_EQ(limits.min_tempo, 0.5f);
+  EXPECT_EQ(limits.max_tempo, 1.6f);
+  EXPECT_EQ(limits.hold_window_s, double{0.2f});
+  EXPECT_EQ(limits.hold_advance, 0.25f);
+  EXPECT_EQ(limits.hold_max_s, double{1.25f});
+  EXPECT_EQ(limits.template_fps, 60.0);
 }
 
 TEST(FollowParams, TrackersRefuseBadParameters) {

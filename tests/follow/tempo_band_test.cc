@@ -108,6 +108,14 @@ TEST(TempoEstimator, ReportsTheDancersTempoAtAnySensorRate) {
   }
   EXPECT_NEAR(fast.tempo(), 0.5f, 0.02f);
   EXPECT_NEAR(fast.dancer_tempo(), 1.0f, 0.04f);
+  // Before any move is taught the estimate is the template's tempo at the sensor's rate.
+  TempoEstimator untaught;
+  for (int t = 0; t < 30; ++t) {
+    untaught.observe_rate(1, 1.0 / 120, 60.0, limits);
+    untaught.start_at_template_tempo(limits);
+  }
+  EXPECT_FLOAT_EQ(untaught.tempo(), 0.5f);
+  EXPECT_FLOAT_EQ(untaught.dancer_tempo(), 1.0f);
   // 30 Hz (two steps a frame) and 60 Hz with late and early frames: a step is a template frame.
   TempoEstimator slow, jittered;
   for (int t = 0; t < 300; ++t) {
@@ -126,6 +134,86 @@ TEST(TempoEstimator, ReportsTheDancersTempoAtAnySensorRate) {
   EXPECT_EQ(fast.dancer_tempo(), before);
   fast.reset();
   EXPECT_EQ(fast.dancer_tempo(), 1.0f);
+}
+
+// A dancer at the template's tempo, 30 Hz (two steps a frame), `frames` frames from `state`.
+int dance(TempoEstimator& estimator, int state, int frames, const TempoLimits& limits) {
+  for (int t = 0; t < frames; ++t) {
+    estimator.update(state, state + 2, 2, 1.0 / 30, true, limits);
+    state += 2;
+  }
+  return state;
+}
+
+TEST(TempoEstimator, AHeldPoseTeachesNoTempo) {
+  TempoLimits limits;
+  limits.time_constant_s = 2.0;
+  limits.hold_window_s = 0.25;
+  limits.hold_advance = 0.3f;
+  TempoEstimator estimator;
+  int state = dance(estimator, 100, 120, limits);
+  EXPECT_NEAR(estimator.tempo(), 1.0f, 1e-3f);
+  // A hold of 0.6 s: the estimate stays, wobbles a frame back and on, as it does on a held pose.
+  const int wobble[] = {0, 1, 0, -1, 0, 0, 1, 0, -1, 0};
+  for (int t = 0; t < 18; ++t) {
+    const int next = state + wobble[t % 10];
+    estimator.update(state, next, 2, 1.0 / 30, true, limits);
+    state = next;
+  }
+  // Whatever the window taught before the hold was seen is undone; at most the hold's last
+  // quarter-second is still pending.
+  EXPECT_GT(estimator.tempo(), 0.9f);
+  state = dance(estimator, state, 60, limits);
+  EXPECT_NEAR(estimator.tempo(), 1.0f, 0.02f);
+
+  // Standing for 3 s is no dancer's hold: past hold_max_s (1 s) its moves stand.
+  TempoEstimator standing;
+  state = dance(standing, 100, 120, limits);
+  for (int t = 0; t < 90; ++t) standing.update(state, state, 2, 1.0 / 30, true, limits);
+  EXPECT_LT(standing.tempo(), 0.6f);
+
+  // Without the window (0) the hold drags the estimate down, as before.
+  TempoLimits every_move = limits;
+  every_move.hold_window_s = 0.0;
+  TempoEstimator dragged;
+  state = dance(dragged, 100, 120, every_move);
+  for (int t = 0; t < 18; ++t) dragged.update(state, state, 2, 1.0 / 30, true, every_move);
+  EXPECT_LT(dragged.tempo(), 0.8f);
+}
+
+TEST(TempoEstimator, ASlowDancerIsNoHold) {
+  TempoLimits limits;
+  limits.time_constant_s = 2.0;
+  limits.hold_window_s = 0.25;
+  limits.hold_advance = 0.3f;
+  // 0.45x at 60 Hz: 9 frames every 20 steps, in runs of zero and one moves.
+  TempoEstimator estimator;
+  int state = 100;
+  double position = 100.0;
+  for (int t = 0; t < 600; ++t) {
+    position += 0.45;
+    const int next = static_cast<int>(position);
+    estimator.update(state, next, 1, 1.0 / 60, true, limits);
+    state = next;
+  }
+  EXPECT_NEAR(estimator.tempo(), 0.45f, 0.02f);
+  // A 120 Hz sensor makes a step a frame: a 0.5x dancer moves a quarter frame a step, under the
+  // hold's 0.3, but half a template frame per template frame of time.
+  TempoLimits fast_sensor = limits;
+  fast_sensor.template_fps = 60.0;
+  fast_sensor.min_tempo = 0.1f;  // the follower's 0.4 a step would clamp it
+  TempoEstimator at_120_hz;
+  int fast_state = 100;
+  for (int t = 0; t < 1200; ++t) {
+    const int next = 100 + (t + 1) / 4;
+    at_120_hz.update(fast_state, next, 1, 1.0 / 120, true, fast_sensor);
+    fast_state = next;
+  }
+  EXPECT_NEAR(at_120_hz.tempo(), 0.25f, 0.02f);
+  // Jumps, lost and missing frames pass time but are neither taught nor a hold.
+  const float learnt = estimator.tempo();
+  for (int t = 0; t < 30; ++t) estimator.update(state, state + 500, 1, 1.0 / 60, false, limits);
+  EXPECT_EQ(estimator.tempo(), learnt);
 }
 
 TEST(TempoEstimator, StaysInItsRange) {

@@ -169,6 +169,26 @@ TEST_F(TrackingTest, TempoCentredBandRemovesTheLagOfAWeakEmission) {
   }
 }
 
+TEST_F(TrackingTest, AHeldPoseLeavesTheDancersTempo) {
+  // 5 s of dance at the template's tempo from a 30 Hz sensor, a pose held for 0.6 s, the dance
+  // again. The follower stands still through the hold; it is no slower dancer.
+  const std::vector<Frame> frames =
+      perform({{0, 150, 1.0}, {300, 18, 0.0}, {300, 60, 1.0}}, 1.0 / 30);
+  FollowParams params;
+  HmmFollower follower = HmmFollower::create(model_, params).value();
+  const Trace trace = replay(follower, model_, frames);
+  const std::size_t after_hold = 150 + 18;
+  EXPECT_NEAR(trace.results[149].tempo, 1.0f, 0.02f);
+  EXPECT_GT(trace.results[after_hold].tempo, 0.92f);
+  EXPECT_EQ(misses(trace, 3), 0);
+
+  // Every band move taught (0), the hold drags the tempo down.
+  params.tempo_hold_window_s = 0.0f;
+  HmmFollower dragged = HmmFollower::create(model_, params).value();
+  const Trace slow = replay(dragged, model_, frames);
+  EXPECT_LT(slow.results[after_hold].tempo, 0.85f);
+}
+
 TEST(VelocityCap, LetsThePostureDecideWhileTheVelocitiesAreCorrupt) {
   // The last 6 of 60 dimensions are velocities. For 6 frames they are far off (a tracking glitch,
   // or the window after a dancer's jump): uncapped, they pull the estimate elsewhere; capped, the
