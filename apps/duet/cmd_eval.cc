@@ -53,6 +53,7 @@ struct EvalArgs {
   bool noise_sweep = false;
   bool suit_sweep = false;
   bool body_sweep = false;
+  bool rate_sweep = false;
   std::vector<std::string> recorded;  // TAKE=FILE
   MotionFileOptions recorded_motion;
   std::string partner_csv_path;
@@ -207,7 +208,7 @@ int run_eval(EvalArgs& args) {
   std::string error;
   // A sweep or --recorded alone runs only those; with --cases, after them.
   if (args.cases.empty() && !args.noise_sweep && !args.suit_sweep && !args.body_sweep &&
-      args.recorded.empty()) {
+      !args.rate_sweep && args.recorded.empty()) {
     args.cases = {"all"};
   }
   if (!select_cases(args.cases, standard, options.cases, error)) return usage_error(error);
@@ -217,6 +218,9 @@ int run_eval(EvalArgs& args) {
   }
   if (args.body_sweep) {
     std::ranges::move(body_sweep_cases(args.settings), std::back_inserter(options.cases));
+  }
+  if (args.rate_sweep) {
+    std::ranges::move(rate_sweep_cases(args.settings), std::back_inserter(options.cases));
   }
   if (args.trackers.empty()) {
     options.trackers = all_tracker_kinds();
@@ -524,19 +528,20 @@ Command register_eval(CLI::App& app) {
                  "is also followed looped to 30 s, reported as NAME looped")
       ->delimiter(',');
   app.add_option("--cases", args->cases,
-                 "Cases to run, comma-separated (default all): clean, tempo-slow, tempo-fast "
-                 "(or tempo), drift, improv, improv-pause, improv-library, noise, 30hz-noisy, "
-                 "late-frames, body-size, room-place, partner-role, improv-30hz-noisy, harsh "
-                 "(30 Hz, 4 deg per axis + 1 cm noise, 3% repeated frames, a 1.1x body), "
-                 "120hz-noisy (a 120 Hz sensor with the noise), dropouts (the noise, and the "
-                 "sensor loses the dancer for 0.3-1 s every 8 s), stalls (the noise, and the "
-                 "sensor holds its last pose for 0.3-2 s every 8 s), suit-drift (an inertial "
-                 "suit: the noise, and every joint off by a calibration error and a slow drift), "
-                 "tilted (the noise in a tilted world, as a camera pitched down sees it), occluded "
-                 "(the noise, and one arm held where last seen for 0.3-1.5 s every 6 s, as an "
-                 "optical system does when the partner hides its markers), glitches (the noise, "
-                 "and one joint turned 30-90 deg for 1-3 frames every 2 s, as a marker swap or a "
-                 "flipped limb; three points: also a controller reported 10-40 cm off)")
+                 "Cases to run, comma-separated (default all): clean, tempo-slow, tempo-fast (or "
+                 "tempo), drift, improv, improv-pause, improv-library, noise, 30hz-noisy, "
+                 "late-frames, body-size, room-place, partner-role, improv-30hz-noisy, harsh (30 "
+                 "Hz, 4 deg per axis + 1 cm noise, 3% repeated frames, a 1.1x body), 120hz-noisy "
+                 "(a 120 Hz sensor with the noise), 240hz-slow (a 240 Hz sensor with the noise, "
+                 "the dancer at 0.7x), dropouts (the noise, and the sensor loses the dancer for "
+                 "0.3-1 s every 8 s), stalls (the noise, and the sensor holds its last pose for "
+                 "0.3-2 s every 8 s), suit-drift (an inertial suit: the noise, and every joint off "
+                 "by a calibration error and a slow drift), tilted (the noise in a tilted world, "
+                 "as a camera pitched down sees it), occluded (the noise, and one arm held where "
+                 "last seen for 0.3-1.5 s every 6 s, as an optical system does when the partner "
+                 "hides its markers), glitches (the noise, and one joint turned 30-90 deg for 1-3 "
+                 "frames every 2 s, as a marker swap or a flipped limb; three points: also a "
+                 "controller reported 10-40 cm off)")
       ->delimiter(',');
   app.add_flag("--noise-sweep", args->noise_sweep,
                "Also run noise-sweep-0 ... noise-sweep-5: improv-pause with 0 to 5 degrees of "
@@ -549,6 +554,10 @@ Command register_eval(CLI::App& app) {
   app.add_flag("--body-sweep", args->body_sweep,
                "Also run body-sweep-80, -90, ... -120: improv-pause with the noise, danced by a "
                "body 0.8x to 1.2x the template dancer's; alone (without --cases) only these");
+  app.add_flag("--rate-sweep", args->rate_sweep,
+               "Also run rate-sweep-20, -25, -30, -50, -60, -72, -90, -120, -240: improv-pause "
+               "with the noise from a sensor at that rate (a phone's pose estimator, video, VR "
+               "headsets, inertial suits); alone (without --cases) only these");
   app.add_option("--recorded", args->recorded,
                  "A recording of one of the library's takes danced again, scored like the cases "
                  "(its frame i is the take's moment i / rate), as TAKE=FILE: TAKE a take's name "

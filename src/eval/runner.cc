@@ -104,6 +104,14 @@ std::vector<EvalCase> standard_cases(const CaseSettings& settings) {
     c.recipe.noise = noise;
   }
   {
+    // A learner on a fast suit (Xsens, Rokoko: 240 Hz): slower than the template, at four steps
+    // a template frame of time, 0.175 template frames a step.
+    EvalCase& c = add("240hz-slow", "a 240 Hz sensor with the noise, the dancer at 0.7x tempo");
+    c.recipe.play.rate_hz = 240.0;
+    c.recipe.play.tempo.factor = 0.7;
+    c.recipe.noise = noise;
+  }
+  {
     // A sensor that loses the dancer now and then: a suit's occluded markers, a controller out of
     // the headset's view. The dancer dances on through the loss.
     EvalCase& c = add("dropouts", "the take with the noise, tracking lost for 0.3-1 s every 8 s");
@@ -217,6 +225,24 @@ std::vector<EvalCase> body_sweep_cases(const CaseSettings& settings) {
     c.recipe.improvise_options.pause_prob = 1.0;
     c.recipe.noise = {settings.noise_rotation_deg, settings.noise_position_m, 0};
     c.recipe.body_scale = percent / 100.0;
+    cases.push_back(std::move(c));
+  }
+  return cases;
+}
+
+std::vector<EvalCase> rate_sweep_cases(const CaseSettings& settings) {
+  std::vector<EvalCase> cases;
+  // A phone's pose estimator (20-30 Hz), a webcam (25), PAL video (50), the salsa's own 60, VR
+  // headsets (72, 90, 120), inertial suits (100-240).
+  for (const int hz : {20, 25, 30, 50, 60, 72, 90, 120, 240}) {
+    EvalCase c;
+    c.name = fmt::format("rate-sweep-{}", hz);
+    c.description = fmt::format("improv-pause from a {} Hz sensor (noise {:g} deg, {:g} cm)", hz,
+                                settings.noise_rotation_deg, settings.noise_position_m * 100.0);
+    c.recipe.improvise = true;
+    c.recipe.improvise_options.pause_prob = 1.0;
+    c.recipe.improvise_options.rate_hz = hz;
+    c.recipe.noise = {settings.noise_rotation_deg, settings.noise_position_m, 0};
     cases.push_back(std::move(c));
   }
   return cases;

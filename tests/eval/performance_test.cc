@@ -724,6 +724,26 @@ TEST(EvalCases, HarshCaseAndNoiseSweepHaveIssue11sMagnitudes) {
     EXPECT_DOUBLE_EQ(c.recipe.improvise_options.pause_prob, 1.0);
   }
 
+  // The rate sweep: improv-pause with the settings' noise, from a 20 to a 240 Hz sensor.
+  const std::vector<EvalCase> rates = rate_sweep_cases(noisier);
+  const std::vector<int> hz = {20, 25, 30, 50, 60, 72, 90, 120, 240};
+  ASSERT_EQ(rates.size(), hz.size());
+  for (std::size_t i = 0; i < hz.size(); ++i) {
+    const EvalCase& c = rates[i];
+    EXPECT_EQ(c.name, "rate-sweep-" + std::to_string(hz[i]));
+    EXPECT_DOUBLE_EQ(c.recipe.improvise_options.rate_hz, hz[i]);
+    EXPECT_DOUBLE_EQ(c.recipe.noise.rotation_deg, 4.0);
+    EXPECT_TRUE(c.recipe.improvise);
+    EXPECT_DOUBLE_EQ(c.recipe.improvise_options.pause_prob, 1.0);
+  }
+
+  // A learner on a fast suit: 240 Hz, 0.7x, the noise.
+  const auto learner = std::ranges::find(cases, std::string("240hz-slow"), &EvalCase::name);
+  ASSERT_NE(learner, cases.end());
+  EXPECT_DOUBLE_EQ(learner->recipe.play.rate_hz, 240.0);
+  EXPECT_DOUBLE_EQ(learner->recipe.play.tempo.factor, 0.7);
+  EXPECT_DOUBLE_EQ(learner->recipe.noise.rotation_deg, CaseSettings{}.noise_rotation_deg);
+
   // The inertial suit: the default noise plus its calibration error and drift.
   const auto suit = std::ranges::find(cases, std::string("suit-drift"), &EvalCase::name);
   ASSERT_NE(suit, cases.end());

@@ -62,7 +62,8 @@ struct CaseSettings {
 // The standard cases, in report order: clean, tempo-slow, tempo-fast, drift, improv,
 // improv-pause, improv-library, noise, 30hz-noisy, late-frames, body-size, room-place,
 // partner-role, improv-30hz-noisy, harsh (issue 11's sensor: fixed magnitudes, not the settings),
-// 120hz-noisy (a sensor faster than the template, with the noise), dropouts (the noise, and
+// 120hz-noisy (a sensor faster than the template, with the noise), 240hz-slow (a 240 Hz sensor
+// with the noise, the dancer at 0.7x: a learner on a fast suit), dropouts (the noise, and
 // tracking lost for 0.3-1 s every 8 s on average), suit-drift (an inertial suit: the noise, and
 // every joint off by a calibration error and a slow drift), tilted (the noise, in a world tilted as
 // a pitched camera sees it; levelled as a loaded file is), occluded (the noise, and one arm held
@@ -82,6 +83,11 @@ std::vector<EvalCase> suit_sweep_cases(const CaseSettings& settings = {});
 // take's rate with the settings' noise, danced by a body 0.8x to 1.2x the template dancer's
 // (skeleton and root path scaled): issue 10's users of other sizes, jumps and held hands included.
 std::vector<EvalCase> body_sweep_cases(const CaseSettings& settings = {});
+
+// The rate sweep (`duet eval --rate-sweep`): rate-sweep-20, -25, -30, -50, -60, -72, -90, -120,
+// -240, improv-pause with the settings' noise from a sensor at that rate: a phone's pose
+// estimator, video, VR headsets, inertial suits (the salsa's own rate is 60 Hz).
+std::vector<EvalCase> rate_sweep_cases(const CaseSettings& settings = {});
 
 enum class TrackerKind {
   kHmm,               // the jump HMM with EvalOptions::hmm (the defaults unless tuned)
