@@ -131,7 +131,12 @@ void TempoEstimator::teach(int moved, int steps, double dt_s, const TempoLimits&
   const double weight =
       std::max(1.0 - std::exp(-dt_s / limits.time_constant_s), 1.0 / (updates_ + 1));
   const double next = tempo_ + weight * (rate - tempo_);
-  tempo_ = static_cast<float>(std::clamp(next, double{limits.min_tempo}, double{limits.max_tempo}));
+  // The range bounds the dancer's tempo, so per step it shrinks with the steps a template frame
+  // of time takes: a 240 Hz sensor's template tempo is 0.25 a step, under the 0.4 the range
+  // allows a 60 Hz step (clamped there it held every dancer at 1.6x or faster).
+  const double steps_per_frame = steps_per_template_frame();
+  tempo_ = static_cast<float>(
+      std::clamp(next, limits.min_tempo / steps_per_frame, limits.max_tempo / steps_per_frame));
 }
 
 void TempoEstimator::observe_rate(int steps, double dt_s, double template_fps,
@@ -141,14 +146,14 @@ void TempoEstimator::observe_rate(int steps, double dt_s, double template_fps,
     return;
   }
   const double frames = dt_s * template_fps;
-  if (!(mean_template_frames_ > 0.0)) {  // the first frame with a time sets both
-    mean_steps_ = steps;
-    mean_template_frames_ = frames;
-    return;
-  }
   // Means of a ratio's two sides, not of the ratio: a late frame (1.4 periods, one step) and the
-  // early one after it (0.6, one step) average to one step per template frame.
-  const double weight = 1.0 - std::exp(-dt_s / limits.time_constant_s);
+  // early one after it (0.6, one step) average to one step per template frame. A plain running
+  // mean over the first frames (with the prior's), as in teach(): when the first frame set both,
+  // a first frame 0.1 ms after the one before read as a sensor 166 times faster than the
+  // template for seconds, the reported tempo and the tempo's range with it.
+  ++rate_frames_;
+  const double weight =
+      std::max(1.0 - std::exp(-dt_s / limits.time_constant_s), 1.0 / rate_frames_);
   mean_steps_ += weight * (steps - mean_steps_);
   mean_template_frames_ += weight * (frames - mean_template_frames_);
 }
@@ -157,18 +162,19 @@ void TempoEstimator::start_at_template_tempo(const TempoLimits& limits) noexcept
   // Until a move is taught the estimate is the prior that the dancer moves at the template's
   // tempo, in steps: half a frame a step from a 120 Hz sensor on a 60 Hz template. At 1 a step it
   // ran ahead through a standing start, until a hold there happened to drag it down.
-  if (updates_ > 0 || !(mean_template_frames_ > 0.0)) return;
-  const double steps_per_frame = std::max(mean_steps_ / mean_template_frames_, 1.0);
-  tempo_ = static_cast<float>(
-      std::clamp(1.0 / steps_per_frame, double{limits.min_tempo}, double{limits.max_tempo}));
+  if (updates_ > 0) return;
+  tempo_ = static_cast<float>(std::clamp(1.0, double{limits.min_tempo}, double{limits.max_tempo}) /
+                              steps_per_template_frame());
 }
 
 float TempoEstimator::dancer_tempo() const noexcept {
-  if (!(mean_template_frames_ > 0.0)) return tempo_;
+  return static_cast<float>(tempo_ * steps_per_template_frame());
+}
+
+double TempoEstimator::steps_per_template_frame() const noexcept {
   // At the template's rate or slower one step is one template frame of time; only a sensor
   // faster than the template makes more steps than frames of time.
-  const double steps_per_frame = std::max(mean_steps_ / mean_template_frames_, 1.0);
-  return static_cast<float>(tempo_ * steps_per_frame);
+  return std::max(mean_steps_ / mean_template_frames_, 1.0);
 }
 
 }  // namespace duet

@@ -110,12 +110,44 @@ TEST(TempoEstimator, ReportsTheDancersTempoAtAnySensorRate) {
   EXPECT_NEAR(fast.dancer_tempo(), 1.0f, 0.04f);
   // Before any move is taught the estimate is the template's tempo at the sensor's rate.
   TempoEstimator untaught;
-  for (int t = 0; t < 30; ++t) {
+  for (int t = 0; t < 1200; ++t) {
     untaught.observe_rate(1, 1.0 / 120, 60.0, limits);
     untaught.start_at_template_tempo(limits);
   }
-  EXPECT_FLOAT_EQ(untaught.tempo(), 0.5f);
-  EXPECT_FLOAT_EQ(untaught.dancer_tempo(), 1.0f);
+  EXPECT_NEAR(untaught.tempo(), 0.5f, 1e-3f);
+  EXPECT_NEAR(untaught.dancer_tempo(), 1.0f, 1e-3f);
+  // 240 Hz, four steps a template frame of time: the range bounds the dancer's tempo, not a
+  // step's (a step's 0.4 held every dancer at 1.6x or faster). A learner at 0.7x moves 0.175 a
+  // step.
+  TempoEstimator at_240_hz, untaught_240_hz;
+  double position = 100.0;
+  state = 100;
+  for (int t = 0; t < 2400; ++t) {
+    position += 0.175;
+    const int next = static_cast<int>(position);
+    at_240_hz.observe_rate(1, 1.0 / 240, 60.0, limits);
+    at_240_hz.update(state, next, 1, 1.0 / 240, true, limits);
+    state = next;
+    untaught_240_hz.observe_rate(1, 1.0 / 240, 60.0, limits);
+    untaught_240_hz.start_at_template_tempo(limits);
+  }
+  EXPECT_NEAR(at_240_hz.dancer_tempo(), 0.7f, 0.04f);
+  EXPECT_NEAR(untaught_240_hz.tempo(), 0.25f, 1e-3f);
+  EXPECT_NEAR(untaught_240_hz.dancer_tempo(), 1.0f, 1e-3f);
+  // A 60 Hz stream whose second frame comes 0.1 ms after the first (frames bunched by the
+  // network): one step for 0.006 template frames of time. Read alone it was a 10 kHz sensor:
+  // the reported tempo 166x, and the range a step may take shrunk to nothing.
+  TempoEstimator bunched;
+  bunched.observe_rate(1, 0.0001, 60.0, limits);
+  bunched.start_at_template_tempo(limits);
+  EXPECT_GT(bunched.tempo(), 0.7f);
+  EXPECT_LT(bunched.dancer_tempo(), 1.01f);
+  for (int t = 0; t < 120; ++t) {
+    bunched.update(t, t + 1, 1, 1.0 / 60, true, limits);
+    bunched.observe_rate(1, 1.0 / 60, 60.0, limits);
+  }
+  EXPECT_NEAR(bunched.tempo(), 1.0f, 0.02f);
+  EXPECT_NEAR(bunched.dancer_tempo(), 1.0f, 0.02f);
   // 30 Hz (two steps a frame) and 60 Hz with late and early frames: a step is a template frame.
   TempoEstimator slow, jittered;
   for (int t = 0; t < 300; ++t) {

@@ -189,6 +189,23 @@ TEST_F(TrackingTest, AHeldPoseLeavesTheDancersTempo) {
   EXPECT_LT(slow.results[after_hold].tempo, 0.85f);
 }
 
+TEST_F(TrackingTest, ASlowDancerOnAFastSensor) {
+  // A learner at 0.7x on a 240 Hz suit: four steps a template frame of time, 0.175 template
+  // frames a step. The tempo's range bounds the dancer's tempo; clamped per step (0.4, as at
+  // 60 Hz) it held this dancer at 1.6x, and a weak emission let the estimate run ahead.
+  FollowParams params;
+  params.emission_sigma = 4.0f;
+  params.pause_distance_per_dim = 50.0f;
+  params.lost_distance_per_dim = 1e9f;
+  const double speed = 0.7;
+  const std::vector<Frame> frames =
+      perform({{0, static_cast<int>(590 / speed * 4), speed}}, 1.0 / 240);
+  HmmFollower hmm = HmmFollower::create(model_, params).value();
+  const Trace r = replay(hmm, model_, frames, 0.5f);
+  EXPECT_NEAR(r.results.back().tempo, speed, 0.1);
+  EXPECT_LT(std::abs(mean_offset(r)), 1.0);  // 2.6 frames ahead when the range bounded a step
+}
+
 TEST(VelocityCap, LetsThePostureDecideWhileTheVelocitiesAreCorrupt) {
   // The last 6 of 60 dimensions are velocities. For 6 frames they are far off (a tracking glitch,
   // or the window after a dancer's jump): uncapped, they pull the estimate elsewhere; capped, the

@@ -39,7 +39,8 @@ BandProbabilities tilt_band(const BandProbabilities& base, float tempo);
 // tempo across jumps (the music does not change) and a pause does not drag it to zero; nor does a
 // hold the follower reads as the band's self moves (hold_window_s below).
 // How the estimate moves: its memory (the step response reaches 63% after time_constant_s of
-// input) and the range it is clamped to.
+// input) and the range of the dancer's tempo it is clamped to (per template frame of input time:
+// per step the range shrinks on a sensor faster than the template, [0.1, 0.45] at 240 Hz).
 struct TempoLimits {
   double time_constant_s = 1.0;
   float min_tempo = 0.4f;
@@ -67,8 +68,9 @@ class TempoEstimator {
     pending_moved_ = 0;
     pending_frames_ = 0.0;
     held_s_ = 0.0;
-    mean_steps_ = 0.0;
-    mean_template_frames_ = 0.0;
+    mean_steps_ = 1.0;
+    mean_template_frames_ = 1.0;
+    rate_frames_ = kRatePriorFrames;
   }
   // One decision: the estimate moved from previous_state to state in `steps` template-rate steps
   // over dt_s seconds of input; usable is false for frames that must not count (see above).
@@ -112,13 +114,20 @@ class TempoEstimator {
   void settle_window(bool judge, const TempoLimits& limits) noexcept;
   // Drops the oldest move from the window: it stands.
   void forget_oldest() noexcept;
+  // Steps applied per template frame of input time (observe_rate); 1 at the template's rate or
+  // slower.
+  double steps_per_template_frame() const noexcept;
 
   float tempo_ = 1.0f;
   int updates_ = 0;  // band moves seen since reset, for the start-up average
   // Averages of the steps applied per frame and of the template frames of input time per frame
-  // (observe_rate); their ratio is 1 at the template's rate or slower.
-  double mean_steps_ = 0.0;
-  double mean_template_frames_ = 0.0;
+  // (observe_rate); their ratio is 1 at the template's rate or slower. They start from a prior
+  // of kRatePriorFrames frames at the template's rate: a sensor's first frames may come bunched
+  // (0.1 ms apart, one step each), and read alone they made a 60 Hz stream a 10 kHz one.
+  static constexpr int kRatePriorFrames = 4;
+  double mean_steps_ = 1.0;
+  double mean_template_frames_ = 1.0;
+  int rate_frames_ = kRatePriorFrames;  // frames averaged, the prior's included
   // Pending moves, a ring: the oldest at pending_first_; their input time, net advance and steps.
   std::array<PendingMove, kMaxPending> pending_{};
   int pending_first_ = 0;
