@@ -5,6 +5,12 @@
 
 namespace duet {
 
+namespace {
+// The start-up averages count at most this many frames: past a few hundred the exponential
+// weight is the larger anyway, and a count that keeps growing would overflow in a long session.
+constexpr int kMaxCounted = 1 << 20;
+}  // namespace
+
 float BandProbabilities::mean_advance() const {
   const float sum = total();
   return sum > 0.0f ? (next + 2.0f * skip) / sum : 0.0f;
@@ -127,7 +133,7 @@ void TempoEstimator::teach(int moved, int steps, double dt_s, const TempoLimits&
   const double rate = static_cast<double>(moved) / steps;
   // An exponential average, but a plain running mean while there are fewer moves than its memory
   // holds, so the first second of a dance already counts fully rather than being pulled to 1.
-  ++updates_;
+  updates_ = std::min(updates_ + 1, kMaxCounted);
   const double weight =
       std::max(1.0 - std::exp(-dt_s / limits.time_constant_s), 1.0 / (updates_ + 1));
   const double next = tempo_ + weight * (rate - tempo_);
@@ -151,7 +157,7 @@ void TempoEstimator::observe_rate(int steps, double dt_s, double template_fps,
   // mean over the first frames (with the prior's), as in teach(): when the first frame set both,
   // a first frame 0.1 ms after the one before read as a sensor 166 times faster than the
   // template for seconds, the reported tempo and the tempo's range with it.
-  ++rate_frames_;
+  rate_frames_ = std::min(rate_frames_ + 1, kMaxCounted);
   const double weight =
       std::max(1.0 - std::exp(-dt_s / limits.time_constant_s), 1.0 / rate_frames_);
   mean_steps_ += weight * (steps - mean_steps_);
