@@ -54,6 +54,7 @@ struct EvalArgs {
   bool suit_sweep = false;
   bool body_sweep = false;
   bool rate_sweep = false;
+  bool tempo_sweep = false;
   std::vector<std::string> recorded;  // TAKE=FILE
   MotionFileOptions recorded_motion;
   std::string partner_csv_path;
@@ -208,7 +209,7 @@ int run_eval(EvalArgs& args) {
   std::string error;
   // A sweep or --recorded alone runs only those; with --cases, after them.
   if (args.cases.empty() && !args.noise_sweep && !args.suit_sweep && !args.body_sweep &&
-      !args.rate_sweep && args.recorded.empty()) {
+      !args.rate_sweep && !args.tempo_sweep && args.recorded.empty()) {
     args.cases = {"all"};
   }
   if (!select_cases(args.cases, standard, options.cases, error)) return usage_error(error);
@@ -221,6 +222,9 @@ int run_eval(EvalArgs& args) {
   }
   if (args.rate_sweep) {
     std::ranges::move(rate_sweep_cases(args.settings), std::back_inserter(options.cases));
+  }
+  if (args.tempo_sweep) {
+    std::ranges::move(tempo_sweep_cases(args.settings), std::back_inserter(options.cases));
   }
   if (args.trackers.empty()) {
     options.trackers = all_tracker_kinds();
@@ -558,6 +562,10 @@ Command register_eval(CLI::App& app) {
                "Also run rate-sweep-20, -25, -30, -50, -60, -72, -90, -120, -240: improv-pause "
                "with the noise from a sensor at that rate (a phone's pose estimator, video, VR "
                "headsets, inertial suits); alone (without --cases) only these");
+  app.add_flag("--tempo-sweep", args->tempo_sweep,
+               "Also run tempo-sweep-50, -60, -70, -85, -100, -120, -140, -160: improv-pause "
+               "with the noise danced at 0.5x to 1.6x the capture's tempo (a learner at half "
+               "tempo to a dancer well ahead); alone (without --cases) only these");
   app.add_option("--recorded", args->recorded,
                  "A recording of one of the library's takes danced again, scored like the cases "
                  "(its frame i is the take's moment i / rate), as TAKE=FILE: TAKE a take's name "

@@ -248,6 +248,24 @@ std::vector<EvalCase> rate_sweep_cases(const CaseSettings& settings) {
   return cases;
 }
 
+std::vector<EvalCase> tempo_sweep_cases(const CaseSettings& settings) {
+  std::vector<EvalCase> cases;
+  // A learner at half the music's tempo to a dancer well ahead of the capture.
+  for (const int percent : {50, 60, 70, 85, 100, 120, 140, 160}) {
+    EvalCase c;
+    c.name = fmt::format("tempo-sweep-{}", percent);
+    c.description =
+        fmt::format("improv-pause danced at {:g}x tempo (noise {:g} deg, {:g} cm)", percent / 100.0,
+                    settings.noise_rotation_deg, settings.noise_position_m * 100.0);
+    c.recipe.improvise = true;
+    c.recipe.improvise_options.pause_prob = 1.0;
+    c.recipe.improvise_options.tempo.factor = percent / 100.0;
+    c.recipe.noise = {settings.noise_rotation_deg, settings.noise_position_m, 0};
+    cases.push_back(std::move(c));
+  }
+  return cases;
+}
+
 std::vector<EvalCase> cases_on_rigs(const std::vector<EvalCase>& cases,
                                     const std::vector<EvalRig>& rigs) {
   std::vector<EvalCase> out;

@@ -737,6 +737,18 @@ TEST(EvalCases, HarshCaseAndNoiseSweepHaveIssue11sMagnitudes) {
     EXPECT_DOUBLE_EQ(c.recipe.improvise_options.pause_prob, 1.0);
   }
 
+  // The tempo sweep: improv-pause with the settings' noise, danced at 0.5x to 1.6x.
+  const std::vector<EvalCase> tempi = tempo_sweep_cases(noisier);
+  const std::vector<int> percent = {50, 60, 70, 85, 100, 120, 140, 160};
+  ASSERT_EQ(tempi.size(), percent.size());
+  for (std::size_t i = 0; i < percent.size(); ++i) {
+    const EvalCase& c = tempi[i];
+    EXPECT_EQ(c.name, "tempo-sweep-" + std::to_string(percent[i]));
+    EXPECT_DOUBLE_EQ(c.recipe.improvise_options.tempo.factor, percent[i] / 100.0);
+    EXPECT_DOUBLE_EQ(c.recipe.noise.rotation_deg, 4.0);
+    EXPECT_TRUE(c.recipe.improvise);
+  }
+
   // A learner on a fast suit: 240 Hz, 0.7x, the noise.
   const auto learner = std::ranges::find(cases, std::string("240hz-slow"), &EvalCase::name);
   ASSERT_NE(learner, cases.end());

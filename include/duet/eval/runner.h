@@ -89,6 +89,11 @@ std::vector<EvalCase> body_sweep_cases(const CaseSettings& settings = {});
 // estimator, video, VR headsets, inertial suits (the salsa's own rate is 60 Hz).
 std::vector<EvalCase> rate_sweep_cases(const CaseSettings& settings = {});
 
+// The tempo sweep (`duet eval --tempo-sweep`): tempo-sweep-50, -60, -70, -85, -100, -120, -140,
+// -160, improv-pause with the settings' noise danced at 0.5x to 1.6x the capture's tempo: a
+// learner at half tempo to a dancer well ahead of the music.
+std::vector<EvalCase> tempo_sweep_cases(const CaseSettings& settings = {});
+
 enum class TrackerKind {
   kHmm,               // the jump HMM with EvalOptions::hmm (the defaults unless tuned)
   kHmmPaper,          // FollowParams::paper() transitions, emission settings from EvalOptions::hmm
