@@ -137,12 +137,13 @@ void TempoEstimator::teach(int moved, int steps, double dt_s, const TempoLimits&
   const double weight =
       std::max(1.0 - std::exp(-dt_s / limits.time_constant_s), 1.0 / (updates_ + 1));
   const double next = tempo_ + weight * (rate - tempo_);
-  // The range bounds the dancer's tempo, so per step it shrinks with the steps a template frame
-  // of time takes: a 240 Hz sensor's template tempo is 0.25 a step, under the 0.4 the range
-  // allows a 60 Hz step (clamped there it held every dancer at 1.6x or faster).
-  const double steps_per_frame = steps_per_template_frame();
+  // The floor is the slowest dancer's tempo, so per step it falls with the steps a template
+  // frame of time takes: a 240 Hz sensor's template tempo is 0.25 a step, under the 0.4 a 60 Hz
+  // step may take (a floor per step held every dancer at 1.6x or faster). The ceiling is what the
+  // band reaches in a step: a faster sensor follows a faster motion (a 60 Hz file read at 120 fps
+  // moves 2x, which `duet follow` names by its rate).
   tempo_ = static_cast<float>(
-      std::clamp(next, limits.min_tempo / steps_per_frame, limits.max_tempo / steps_per_frame));
+      std::clamp(next, limits.min_tempo / steps_per_template_frame(), double{limits.max_tempo}));
 }
 
 void TempoEstimator::observe_rate(int steps, double dt_s, double template_fps,
@@ -169,8 +170,9 @@ void TempoEstimator::start_at_template_tempo(const TempoLimits& limits) noexcept
   // tempo, in steps: half a frame a step from a 120 Hz sensor on a 60 Hz template. At 1 a step it
   // ran ahead through a standing start, until a hold there happened to drag it down.
   if (updates_ > 0) return;
-  tempo_ = static_cast<float>(std::clamp(1.0, double{limits.min_tempo}, double{limits.max_tempo}) /
-                              steps_per_template_frame());
+  tempo_ = static_cast<float>(std::clamp(1.0 / steps_per_template_frame(),
+                                         limits.min_tempo / steps_per_template_frame(),
+                                         double{limits.max_tempo}));
 }
 
 float TempoEstimator::dancer_tempo() const noexcept {

@@ -39,8 +39,9 @@ BandProbabilities tilt_band(const BandProbabilities& base, float tempo);
 // tempo across jumps (the music does not change) and a pause does not drag it to zero; nor does a
 // hold the follower reads as the band's self moves (hold_window_s below).
 // How the estimate moves: its memory (the step response reaches 63% after time_constant_s of
-// input) and the range of the dancer's tempo it is clamped to (per template frame of input time:
-// per step the range shrinks on a sensor faster than the template, [0.1, 0.45] at 240 Hz).
+// input) and the range it is clamped to: min_tempo is the slowest dancer's tempo (per template
+// frame of input time: per step it falls on a sensor faster than the template, 0.1 at 240 Hz);
+// max_tempo is per step, what the band reaches (under 2).
 struct TempoLimits {
   double time_constant_s = 1.0;
   float min_tempo = 0.4f;
